@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Configures and builds one flavour of uphill into build/<flavour>.
+#   bash scripts/build.sh release    optimised build (the programs you run)
+#   bash scripts/build.sh sanitize   AddressSanitizer + UndefinedBehaviorSanitizer build
+set -euo pipefail
+cd "$(dirname "$0")/.."
+flavour="${1:-release}"
+case "$flavour" in
+  release) flags=(-DCMAKE_BUILD_TYPE=Release) ;;
+  sanitize) flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DUPHILL_SANITIZE=ON) ;;
+  *) echo "build.sh: unknown flavour '$flavour' (release|sanitize)" >&2; exit 2 ;;
+esac
+cmake -S . -B "build/$flavour" -G Ninja "${flags[@]}" > /dev/null
+cmake --build "build/$flavour" -j"${UPHILL_JOBS:-2}"

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package uphill needs to build and test (run as root).
+# The README's two Quick-start commands and .ci/run all go through this one script.
+#   bash scripts/install-deps.sh          build + test dependencies
+#   bash scripts/install-deps.sh --bench  also NumPy/SciPy for the benchmarks' comparisons
+set -euo pipefail
+
+packages=(
+  g++ cmake ninja-build ccache pkg-config
+  libeigen3-dev libceres-dev nlohmann-json3-dev libgtest-dev libcli11-dev libboost-dev
+  libfccp-dev gnuplot-nox
+)
+if [[ "${1:-}" == "--bench" ]]; then
+  packages+=(python3-numpy python3-scipy)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]} == 0)); then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

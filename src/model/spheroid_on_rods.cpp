@@ -1,0 +1,132 @@
+#include "model/spheroid_on_rods.hpp"
+
+#include <ceres/jet.h>
+
+#include <boost/math/tools/roots.hpp>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "model/input_error.hpp"
+
+namespace uphill {
+namespace {
+
+// Contact geometry for the unit normal n(β) (see the header); templated for ceres::Jet.
+template <typename S>
+struct Contact {
+  S nx, ny, nz;  // outward unit normal of the body at the contact
+  S sx, sz;      // contact point on the body relative to the centre (x and z parts)
+  S x, z;        // the centre
+};
+
+template <typename S>
+Contact<S> ContactForNormal(const S& nx, const S& ny, const S& nz, double a, double b, double B,
+                            double T, double r) {
+  using std::sqrt;
+  const S norm = sqrt(a * a * nx * nx + b * b * ny * ny + a * a * nz * nz);
+  const S t = (b * b * ny / norm + r * ny) / T;
+  Contact<S> c{nx, ny, nz, a * a * nx / norm, a * a * nz / norm, S(), S()};
+  c.x = t - c.sx - r * nx;
+  c.z = t * B - c.sz - r * nz;
+  return c;
+}
+
+template <typename S>
+Contact<S> ContactAtAngle(const S& beta, double a, double b, double B, double T, double r) {
+  using std::cos;
+  using std::sin;
+  const double s1 = std::sqrt(1.0 + T * T);
+  const double dn = std::sqrt(1.0 + T * T + B * B);
+  const S c = cos(beta), s = sin(beta);
+  return ContactForNormal<S>((-T * c + B * s / dn) / s1, (c + T * B * s / dn) / s1,
+                             -(1.0 + T * T) * s / (dn * s1), a, b, B, T, r);
+}
+
+}  // namespace
+
+SpheroidOnRods::SpheroidOnRods(double a, double b, double tan_theta, double tan_half_alpha,
+                               double rod_radius)
+    : a_(a), b_(b), B_(tan_theta), T_(tan_half_alpha), r_(rod_radius) {
+  RequirePositiveFinite("rod radius", rod_radius);
+  // Closed forms (PHYSICS.md): x_max(r) = sqrt(a² + b²cot²(α/2)) + r/sin(α/2),
+  // x_eq(r) = b²B/(T·sqrt(b²B² + a²T²)) + r·B/(T·sqrt(B² + T²)).
+  x_max_ = std::hypot(a, b / T_) + r_ * std::hypot(1.0, T_) / T_;
+  x_eq_ = b * b * B_ / (T_ * std::hypot(b * B_, a * T_)) + r_ * B_ / (T_ * std::hypot(B_, T_));
+  double x_unused;
+  CentreForNormal(0.0, B_ / T_, -1.0, &x_unused, &z_eq_);
+  // The branch used: β from 0 (fall-off) while the contact stays at t ≥ 0 (n_y ≥ 0) and x(β)
+  // keeps decreasing. n_y = 0 at β_n = π − atan(|d|/(T·B)); scan for a turning point of x(β)
+  // before it (there is none for the apparatus' geometries; the scan makes the domain explicit).
+  const double dn = std::sqrt(1.0 + T_ * T_ + B_ * B_);
+  const double beta_n = std::numbers::pi - std::atan2(dn, T_ * B_);
+  const int kScan = 256;
+  beta_low_ = beta_n;
+  double x_prev = x_max_;
+  for (int i = 1; i <= kScan; ++i) {
+    const double beta = beta_n * i / kScan;
+    double xb, zb;
+    CentreAtNormalAngle(beta, &xb, &zb);
+    if (!(xb < x_prev)) {
+      beta_low_ = beta_n * (i - 1) / kScan;
+      break;
+    }
+    x_prev = xb;
+  }
+  double z_unused;
+  CentreAtNormalAngle(beta_low_, &x_low_, &z_unused);
+}
+
+void SpheroidOnRods::CentreForNormal(double nx, double ny, double nz, double* x, double* z) const {
+  const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+  const auto c = ContactForNormal(nx / len, ny / len, nz / len, a_, b_, B_, T_, r_);
+  *x = c.x;
+  *z = c.z;
+}
+
+void SpheroidOnRods::CentreAtNormalAngle(double beta, double* x, double* z) const {
+  const auto c = ContactAtAngle(beta, a_, b_, B_, T_, r_);
+  *x = c.x;
+  *z = c.z;
+}
+
+double SpheroidOnRods::RestX(double mu) const {
+  // z' = −n_x/n_z = −mu with n·d = 0: n ∝ (−mu, (B + mu)/T, −1).
+  double x, z;
+  CentreForNormal(-mu, (B_ + mu) / T_, -1.0, &x, &z);
+  return x;
+}
+
+double SpheroidOnRods::BetaOf(double x) const {
+  if (x >= x_max_) return 0.0;
+  using Jet = ceres::Jet<double, 1>;
+  auto f = [&](double beta) {
+    const auto c = ContactAtAngle(Jet(beta, 0), a_, b_, B_, T_, r_);
+    return std::make_pair(c.x.a - x, c.x.v[0]);
+  };
+  // Near the fall-off x(β) ≈ x_max − c·β², so start from that parabola (c from the curvature
+  // at a small β) and let Newton, kept inside the bracket, polish to full precision.
+  const double probe = 1e-3 * beta_low_;
+  double xp, zp;
+  CentreAtNormalAngle(probe, &xp, &zp);
+  const double c = (x_max_ - xp) / (probe * probe);
+  double guess = std::sqrt((x_max_ - x) / c);
+  if (!(guess < beta_low_)) guess = 0.5 * beta_low_;
+  std::uintmax_t iterations = 200;
+  return boost::math::tools::newton_raphson_iterate(f, guess, 0.0, beta_low_,
+                                                    std::numeric_limits<double>::digits - 2,
+                                                    iterations);
+}
+
+SpheroidPathPoint<double> SpheroidOnRods::At(double x) const {
+  const auto c = ContactAtAngle(BetaOf(x), a_, b_, B_, T_, r_);
+  SpheroidPathPoint<double> p;
+  p.dzdx = c.nz == 0.0 ? -std::numeric_limits<double>::infinity() : -c.nx / c.nz;
+  // The solved β reproduces x to about an ulp; carry z to the requested x to first order.
+  p.z = std::isfinite(p.dzdx) ? c.z + p.dzdx * (x - c.x) : c.z;
+  p.r_star = std::hypot(c.sx, c.sz);
+  p.x_contact = x + c.sx;
+  return p;
+}
+
+}  // namespace uphill

@@ -1,0 +1,53 @@
+// SpheroidOnRods: a spheroid on round rods of radius r > 0 (the rail lines are the rods' axes).
+//
+// No closed form exists for z(x) (PHYSICS.md "Round rods"), so this is the one numeric contact
+// solve of the model, used only when the scene needs it (a non-spherical body on rods; a sphere
+// on rods is the closed form of a sphere of radius R + r).
+//
+// Method: the normal-angle parametrisation. Let n(β) be the outward unit normal of the body at
+// the contact; it is perpendicular to the rail direction d = (1, T, B), so
+//   n(β) = cosβ·u + sinβ·v,  u = (−T, 1, 0)/sqrt(1 + T²),  v = (B, T·B, −(1 + T²))/(|u×d|…),
+// β = 0 being the fall-off (horizontal normal, contact level with the centre). The surface point
+// with normal n is S = (a²n_x, b²n_y, a²n_z)/sqrt(a²n_x² + b²n_y² + a²n_z²) from the centre, and
+// the rod axis passes through C + S + r·n, which must lie on the rail line (t, t·T, t·B). That
+// gives the centre explicitly:  t = (S_y + r·n_y)/T,  x = t − S_x − r·n_x,  z = t·B − S_z − r·n_z.
+// The slope follows from the contact normal alone, z'(x) = −n_x/n_z, so x_eq (n_x = 0) and
+// x_rest(μ) (n_x = μ·n_z) are closed form; only z(x) at a given x needs a 1-D root solve of
+// x(β) = x (Newton with bracketing, Boost.Math, derivative by ceres::Jet).
+//
+// Accuracy: x_eq, x_max, x_rest within a few ulp; At(x) to the solver's full precision (a few
+// ulp in β, amplified only by the conditioning of the value itself, e.g. near x_max).
+// Tested against the 60-digit reference and, for r → 0, against SpheroidOnLineRails.
+#pragma once
+
+#include "model/spheroid_on_line_rails.hpp"
+
+namespace uphill {
+
+class SpheroidOnRods {
+ public:
+  // a, b > 0 (semi-axes as in SpheroidOnLineRails), r > 0 the rod radius.
+  SpheroidOnRods(double a, double b, double tan_theta, double tan_half_alpha, double rod_radius);
+
+  double x_max() const { return x_max_; }
+  double x_eq() const { return x_eq_; }
+  double z_eq() const { return z_eq_; }
+  // Smallest x for which the solver is valid (the contact on the rod axis at t = 0 or the
+  // end of the monotone branch of x(β), whichever comes first).
+  double x_low() const { return x_low_; }
+  // Farthest rest position for rolling-resistance coefficient mu (mu < 0: nearest).
+  double RestX(double mu) const;
+  SpheroidPathPoint<double> At(double x) const;
+  // The centre (x, z) for a contact normal at angle beta (see above); exposed for tests.
+  void CentreAtNormalAngle(double beta, double* x, double* z) const;
+
+ private:
+  // Centre for a given (not necessarily unit) normal with n·d = 0.
+  void CentreForNormal(double nx, double ny, double nz, double* x, double* z) const;
+  double BetaOf(double x) const;
+
+  double a_, b_, B_, T_, r_;
+  double x_max_, x_eq_, z_eq_, x_low_, beta_low_;
+};
+
+}  // namespace uphill
