@@ -8,7 +8,7 @@ set -euo pipefail
 packages=(
   g++ cmake ninja-build ccache pkg-config
   libeigen3-dev libceres-dev nlohmann-json3-dev libgtest-dev libcli11-dev libboost-dev
-  libfccp-dev gnuplot-nox
+  libcsv-dev gnuplot-nox
 )
 if [[ "${1:-}" == "--bench" ]]; then
   packages+=(python3-numpy python3-scipy)

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "model/input_error.hpp"
+#include "model/spheroid_on_rods_closed_forms.hpp"
 
 namespace uphill {
 namespace {
@@ -49,10 +50,9 @@ SpheroidOnRods::SpheroidOnRods(double a, double b, double tan_theta, double tan_
                                double rod_radius)
     : a_(a), b_(b), B_(tan_theta), T_(tan_half_alpha), r_(rod_radius) {
   RequirePositiveFinite("rod radius", rod_radius);
-  // Closed forms (PHYSICS.md): x_max(r) = sqrt(a² + b²cot²(α/2)) + r/sin(α/2),
-  // x_eq(r) = b²B/(T·sqrt(b²B² + a²T²)) + r·B/(T·sqrt(B² + T²)).
-  x_max_ = std::hypot(a, b / T_) + r_ * std::hypot(1.0, T_) / T_;
-  x_eq_ = b * b * B_ / (T_ * std::hypot(b * B_, a * T_)) + r_ * B_ / (T_ * std::hypot(B_, T_));
+  // Closed forms (PHYSICS.md), shared with first-order propagation: spheroid_on_rods_closed_forms.hpp.
+  x_max_ = SpheroidOnRodsXMax(a, b, T_, r_);
+  x_eq_ = SpheroidOnRodsXEq(a, b, B_, T_, r_);
   double x_unused;
   CentreForNormal(0.0, B_ / T_, -1.0, &x_unused, &z_eq_);
   // The branch used: β from 0 (fall-off) while the contact stays at t ≥ 0 (n_y ≥ 0) and x(β)
@@ -74,7 +74,14 @@ SpheroidOnRods::SpheroidOnRods(double a, double b, double tan_theta, double tan_
     x_prev = xb;
   }
   double z_unused;
-  CentreAtNormalAngle(beta_low_, &x_low_, &z_unused);
+  if (beta_low_ == beta_n) {
+    // The contact at t = 0: the normal with n_y = 0, n·d = 0 is ∝ (tanθ, 0, −1), taken exactly
+    // rather than through the rounded angle β_n (whose n_y ≈ 1e-17 put x_low above x_eq = 0 at
+    // θ = 0, so that At(x_eq) was refused).
+    CentreForNormal(B_, 0.0, -1.0, &x_low_, &z_unused);
+  } else {
+    CentreAtNormalAngle(beta_low_, &x_low_, &z_unused);
+  }
 }
 
 void SpheroidOnRods::CentreForNormal(double nx, double ny, double nz, double* x, double* z) const {

@@ -1,0 +1,38 @@
+// FitOptions: the knobs every fit shares.
+//
+// Every fit is solved by Ceres (Levenberg-Marquardt, dense QR) on a standardised problem:
+// X and Y are centred at a (weighted) mean and divided by a power of two near their spread, so
+// that the tolerances below are relative, unit-free numbers and X ≈ 1e9 with a spread of 1 loses
+// no digits (the centring is exact by Sterbenz's lemma only for close values; the subtraction
+// X_i − x0 is done once, in binary64, and is the only rounding the data see).
+//
+// The tolerances default to "as tight as binary64 allows". Even so, Ceres' termination tests look
+// at the cost, which is flat to ~sqrt(ε) relative at a minimum: Ceres stops when a step no longer
+// changes the cost, with parameters good to ~1e-9 relative. Every fit therefore ends with a
+// Gauss-Newton refinement on Ceres' own residuals and Jacobian (Problem::Evaluate; for a robust
+// loss the IRLS step), which stops where the step no longer shrinks: the gradient is accurate to
+// ~ε, so the parameters are too (SolverInfo::refinement_steps counts the steps; a linear fit
+// seeded with its closed form needs at most one). From a cold start (seed_with_closed_form =
+// false) Ceres plus the refinement reach NIST's certified values to ≥ 13 digits.
+#pragma once
+
+namespace uphill {
+
+struct FitOptions {
+  // |normalised residual| above this flags a row as an outlier (RowResult::outlier). 3 means
+  // "beyond 3 sigma": about 0.27 % of rows for Gaussian errors, so a few flags among 10^3 rows
+  // are expected, not alarming.
+  double outlier_threshold = 3.0;
+  // Start Ceres at the closed-form solution (Eigen QR of the centred design; York: a few
+  // effective-variance iterations). false starts at slope 0, intercept = weighted mean of Y
+  // (friction: mu = 0), to show that Ceres on its own reaches the same values.
+  bool seed_with_closed_form = true;
+  // Ceres termination (Solver::Options of the same names). gradient_tolerance is absolute in
+  // Ceres, hence 0 here: only the relative tests below end the solve.
+  int max_iterations = 200;
+  double function_tolerance = 1e-15;
+  double gradient_tolerance = 0.0;
+  double parameter_tolerance = 1e-15;
+};
+
+}  // namespace uphill

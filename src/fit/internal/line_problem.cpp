@@ -1,0 +1,275 @@
+#include "fit/internal/line_problem.hpp"
+
+#include <Eigen/QR>
+#include <boost/math/distributions/chi_squared.hpp>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "model/input_error.hpp"
+
+namespace uphill::fit_internal {
+
+std::string Num(double v) {
+  std::ostringstream out;
+  out.precision(17);
+  out << v;
+  return out.str();
+}
+
+double WeightedMean(const std::vector<double>& v, const std::vector<double>& w) {
+  const std::size_t n = v.size();
+  long double sw = 0, swv = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const long double wi = w.empty() ? 1.0L : w[i];
+    sw += wi;
+    swv += wi * v[i];
+  }
+  const double first = static_cast<double>(swv / sw);
+  long double swd = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const long double wi = w.empty() ? 1.0L : w[i];
+    swd += wi * (static_cast<long double>(v[i]) - first);
+  }
+  return static_cast<double>(first + swd / sw);
+}
+
+double PowerOfTwoBelow(double v) {
+  int e = 0;
+  std::frexp(v, &e);  // v = f·2^e, f ∈ [0.5, 1)
+  return std::ldexp(1.0, e - 1);
+}
+
+namespace {
+
+// Power of two near the largest |v_i − centre|, or near |centre| (or 1) when all v equal it.
+double SpreadScale(const std::vector<double>& v, double centre) {
+  double largest = 0.0;
+  for (double vi : v) largest = std::max(largest, std::abs(vi - centre));
+  if (largest > 0.0 && std::isfinite(largest)) return PowerOfTwoBelow(largest);
+  if (centre != 0.0) return PowerOfTwoBelow(std::abs(centre));
+  return 1.0;
+}
+
+}  // namespace
+
+Standardised Standardise(const LineData& data, const std::vector<double>& centre_weights,
+                         bool keep_ux, bool keep_uy) {
+  Standardised s;
+  const std::size_t n = data.size();
+  s.x0 = WeightedMean(data.x, centre_weights);
+  s.y0 = WeightedMean(data.y, centre_weights);
+  s.sx = SpreadScale(data.x, s.x0);
+  s.sy = SpreadScale(data.y, s.y0);
+  s.x.resize(n);
+  s.y.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    // One rounding each (the subtraction); the division by a power of two is exact.
+    s.x[i] = (data.x[i] - s.x0) / s.sx;
+    s.y[i] = (data.y[i] - s.y0) / s.sy;
+  }
+  if (keep_ux) {
+    s.ux.resize(n);
+    for (std::size_t i = 0; i < n; ++i) s.ux[i] = data.u_x[i] / s.sx;
+  }
+  if (keep_uy) {
+    s.uy.resize(n);
+    for (std::size_t i = 0; i < n; ++i) s.uy[i] = data.u_y[i] / s.sy;
+  }
+  return s;
+}
+
+Eigen::Vector2d ClosedFormLine(const Standardised& s, const std::vector<double>& inv_sigma) {
+  const Eigen::Index n = static_cast<Eigen::Index>(s.size());
+  // Thin N×2 design and N-vector: O(N) memory; Householder QR never forms Q.
+  Eigen::MatrixX2d design(n, 2);
+  Eigen::VectorXd rhs(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double w = inv_sigma.empty() ? 1.0 : inv_sigma[static_cast<std::size_t>(i)];
+    design(i, 0) = s.x[static_cast<std::size_t>(i)] * w;
+    design(i, 1) = w;
+    rhs(i) = s.y[static_cast<std::size_t>(i)] * w;
+  }
+  return design.householderQr().solve(rhs);
+}
+
+SolverInfo RunCeres(const FitOptions& options, bool seeded, ceres::Problem* problem) {
+  ceres::Solver::Options solver;
+  solver.minimizer_type = ceres::TRUST_REGION;
+  solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  // Dense QR of the N×p Jacobian: O(N·p²), accurate, and p ≤ 2 here.
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = options.function_tolerance;
+  solver.gradient_tolerance = options.gradient_tolerance;
+  solver.parameter_tolerance = options.parameter_tolerance;
+  solver.num_threads = 1;  // the fits are cheap per row; threads would compete with callers
+  solver.logging_type = ceres::SILENT;
+  solver.minimizer_progress_to_stdout = false;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, problem, &summary);
+  if (!summary.IsSolutionUsable())
+    throw std::runtime_error("Ceres found no usable solution: " + summary.message);
+  SolverInfo info;
+  info.converged = summary.termination_type == ceres::CONVERGENCE;
+  info.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
+  info.seeded_with_closed_form = seeded;
+  info.termination =
+      std::string(ceres::TerminationTypeToString(summary.termination_type)) + ": " + summary.message;
+  info.seconds = summary.total_time_in_seconds;
+  return info;
+}
+
+int RefineGaussNewton(ceres::Problem* problem, double* block, int size,
+                      std::optional<double> lower_bound_0) {
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = {block};
+  evaluate.apply_loss_function = true;
+  evaluate.num_threads = 1;
+  std::vector<double> residuals;
+  ceres::CRSMatrix jacobian;
+  double previous_norm = std::numeric_limits<double>::infinity();
+  int steps = 0;
+  for (int iteration = 0; iteration < 100; ++iteration) {
+    double cost = 0.0;
+    if (!problem->Evaluate(evaluate, &cost, &residuals, nullptr, &jacobian)) break;
+    // JᵀJ and Jᵀr from the CRS Jacobian: O(N·p²). The gradient is summed in long double so
+    // that the point where it vanishes is found to the precision of the residuals.
+    Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(size, size);
+    std::vector<long double> gradient(static_cast<std::size_t>(size), 0.0L);
+    for (int row = 0; row < jacobian.num_rows; ++row) {
+      const int begin = jacobian.rows[static_cast<std::size_t>(row)];
+      const int end = jacobian.rows[static_cast<std::size_t>(row) + 1];
+      const double r = residuals[static_cast<std::size_t>(row)];
+      for (int a = begin; a < end; ++a) {
+        const int col_a = jacobian.cols[static_cast<std::size_t>(a)];
+        const double v_a = jacobian.values[static_cast<std::size_t>(a)];
+        gradient[static_cast<std::size_t>(col_a)] += static_cast<long double>(v_a) * r;
+        for (int b = begin; b < end; ++b)
+          normal(col_a, jacobian.cols[static_cast<std::size_t>(b)]) +=
+              v_a * jacobian.values[static_cast<std::size_t>(b)];
+      }
+    }
+    Eigen::VectorXd g(size);
+    for (int j = 0; j < size; ++j) g(j) = static_cast<double>(gradient[static_cast<std::size_t>(j)]);
+    Eigen::Map<Eigen::VectorXd> theta(block, size);
+    const Eigen::VectorXd start = theta;
+    Eigen::VectorXd step = normal.ldlt().solve(-g);
+    if (lower_bound_0 && start(0) + step(0) < *lower_bound_0) {
+      // θ0 stays on its bound; Gauss-Newton in the other parameters only.
+      step.setZero();
+      step(0) = *lower_bound_0 - start(0);
+      if (size > 1)
+        step.tail(size - 1) =
+            normal.bottomRightCorner(size - 1, size - 1).ldlt().solve(-g.tail(size - 1));
+    }
+    if (!step.allFinite()) break;
+    const double norm = step.norm();
+    if (norm == 0.0 || !(norm < previous_norm)) break;  // at the rounding floor
+    theta = start + step;
+    double candidate = 0.0;
+    if (!problem->Evaluate(evaluate, &candidate, nullptr, nullptr, nullptr) ||
+        !(candidate <= cost * (1.0 + 1e-12) + std::numeric_limits<double>::min())) {
+      theta = start;  // not a descent beyond rounding: keep Ceres' point
+      break;
+    }
+    ++steps;
+    previous_norm = norm;
+    if (norm <= 0.25 * std::numeric_limits<double>::epsilon() * start.norm()) break;
+  }
+  return steps;
+}
+
+std::optional<Eigen::MatrixXd> CeresCovariance(ceres::Problem* problem, const double* block,
+                                               int size, bool apply_loss_function) {
+  ceres::Covariance::Options options;
+  // Sparse QR of the Jacobian (Eigen's, the one sparse library every Ceres build has): O(N)
+  // for our N×p Jacobians, and it reports rank deficiency instead of returning garbage.
+  options.algorithm_type = ceres::SPARSE_QR;
+  options.num_threads = 1;
+  options.apply_loss_function = apply_loss_function;
+  ceres::Covariance covariance(options);
+  const std::vector<std::pair<const double*, const double*>> blocks = {{block, block}};
+  if (!covariance.Compute(blocks, problem)) return std::nullopt;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> c(size, size);
+  if (!covariance.GetCovarianceBlock(block, block, c.data())) return std::nullopt;
+  return Eigen::MatrixXd(c);
+}
+
+LineParameters Unstandardise(const Standardised& s, const Eigen::Vector2d& theta,
+                             const Eigen::Matrix2d& covariance_theta) {
+  // k = (sy/sx)·θ0;  c = y0 + sy·θ1 − k·x0. The intercept at the centre, y0 + sy·θ1, is
+  // uncorrelated (or nearly) with k, so the x0²·var(k) term carries the ill-conditioning of c
+  // for data far from X = 0 honestly and without cancellation.
+  LineParameters p;
+  const double ratio = s.sy / s.sx;
+  p.k = ratio * theta(0);
+  p.c = (s.y0 + s.sy * theta(1)) - p.k * s.x0;
+  Eigen::Matrix2d jacobian;
+  jacobian << ratio, 0.0, -ratio * s.x0, s.sy;
+  p.covariance = jacobian * covariance_theta * jacobian.transpose();
+  return p;
+}
+
+void RequireRepresentable(const std::vector<double>& standardised_u, const std::string& quantity) {
+  for (std::size_t i = 0; i < standardised_u.size(); ++i) {
+    const double u = standardised_u[i];
+    const double u2 = u * u;
+    if (!(u2 > 0.0) || !std::isfinite(u2) || !std::isfinite(1.0 / u2))
+      throw InputError(quantity + "[" + std::to_string(i) + "]",
+                       "is out of binary64 range relative to the spread of the data "
+                       "(u/spread = " + Num(u) + "); rescale the data");
+  }
+}
+
+double UpperTailChiSquared(double chi2, int dof) {
+  boost::math::chi_squared_distribution<double> distribution(dof);
+  return boost::math::cdf(boost::math::complement(distribution, chi2));
+}
+
+void FinishReport(FitReport& report, const std::vector<std::string>& names,
+                  const Eigen::VectorXd& values, bool p_value_applies) {
+  const int p = static_cast<int>(values.size());
+  report.dof = static_cast<int>(report.n) - p;
+  report.exact = report.dof == 0;
+  if (report.dof > 0) {
+    const double factor = report.chi2 / report.dof;
+    report.reduced_chi2 = factor;
+    report.covariance_scaled = report.covariance * factor;
+    if (p_value_applies) report.p_value = UpperTailChiSquared(report.chi2, report.dof);
+  }
+  report.correlation = Eigen::MatrixXd::Identity(p, p);
+  for (int i = 0; i < p; ++i)
+    for (int j = 0; j < p; ++j)
+      if (i != j) {
+        const double d = std::sqrt(report.covariance(i, i) * report.covariance(j, j));
+        report.correlation(i, j) = d > 0.0 ? report.covariance(i, j) / d : 0.0;
+      }
+  report.parameters.clear();
+  for (int i = 0; i < p; ++i) {
+    ParameterEstimate e;
+    e.name = names[static_cast<std::size_t>(i)];
+    e.value = values(i);
+    e.se_unscaled = std::sqrt(report.covariance(i, i));
+    if (report.covariance_scaled) e.se_scaled = std::sqrt((*report.covariance_scaled)(i, i));
+    report.parameters.push_back(e);
+  }
+  report.outliers.clear();
+  for (RowResult& row : report.rows) {
+    row.outlier = std::abs(row.normalised) > report.outlier_threshold;
+    if (row.outlier) report.outliers.push_back(row.row);
+  }
+  if (report.exact) {
+    std::string note = "exact fit: " + std::to_string(report.n) + " rows determine the " +
+                       std::to_string(p) +
+                       " parameters (nu = 0), so no uncertainty can be estimated from the "
+                       "scatter: reduced chi2, p-value and scaled standard errors are absent";
+    note += report.uses_stated_uncertainties
+                ? "; the unscaled standard errors are the stated uncertainties propagated"
+                : "; without stated uncertainties the unscaled covariance assumes u(Y) = 1";
+    report.notes.push_back(note);
+  }
+}
+
+}  // namespace uphill::fit_internal

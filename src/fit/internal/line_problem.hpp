@@ -1,0 +1,85 @@
+// Internal to the fit layer (not installed, not for callers): what all fits share - the
+// standardised data, the closed-form seed, running Ceres, ceres::Covariance, and filling the
+// common statistics of a FitReport.
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fit/fit_options.hpp"
+#include "fit/fit_report.hpp"
+#include "fit/line_data.hpp"
+
+namespace uphill::fit_internal {
+
+// Weighted mean Σw·v/Σw (w empty: unit weights), two passes: the second adds the mean of the
+// deviations from the first, which removes the rounding of the first to a few ulp even when
+// |mean| ≫ spread (X ≈ 1e9 with spread 1). Accumulates in long double.
+double WeightedMean(const std::vector<double>& v, const std::vector<double>& w);
+
+// 2^e with 2^e ≤ v < 2^(e+1), v > 0 finite: scaling by it is exact in binary.
+double PowerOfTwoBelow(double v);
+
+// The data in standardised coordinates: X = x0 + sx·x, Y = y0 + sy·y. x0, y0 are weighted
+// means (centre_weights, empty = unit); sx, sy powers of two near the largest deviation, so the
+// only rounding is that of X_i − x0 and Y_i − y0.
+struct Standardised {
+  double x0 = 0.0, y0 = 0.0, sx = 1.0, sy = 1.0;
+  std::vector<double> x, y;    // standardised values
+  std::vector<double> ux, uy;  // u(X)/sx, u(Y)/sy, or empty when not used
+  std::size_t size() const { return x.size(); }
+};
+Standardised Standardise(const LineData& data, const std::vector<double>& centre_weights,
+                         bool keep_ux, bool keep_uy);
+
+// Weighted least-squares line through standardised data, by Householder QR of the design
+// [x_i·w_i, w_i] (w_i = inv_sigma_i, empty: 1). Returns (slope, intercept) in standardised units.
+Eigen::Vector2d ClosedFormLine(const Standardised& s, const std::vector<double>& inv_sigma);
+
+// Ceres' Levenberg-Marquardt with the options' tolerances, silent, one thread. Throws
+// std::runtime_error if Ceres returns no usable solution.
+SolverInfo RunCeres(const FitOptions& options, bool seeded, ceres::Problem* problem);
+
+// Gauss-Newton refinement of one parameter block on Ceres' own residuals and Jacobian
+// (Problem::Evaluate, loss applied: for a robust loss this is the IRLS step), repeated while the
+// step shrinks; a step that raises the cost beyond rounding is undone. Why: Ceres' termination
+// tests look at the cost, which is flat to ~sqrt(ε) relative at a minimum, so Ceres stops with
+// parameters good to ~1e-9; the gradient Jᵀr is accurate to ~ε, and so is the point where it
+// vanishes. lower_bound_0 keeps θ0 ≥ bound (then only the other parameters move). Returns the
+// number of steps taken.
+int RefineGaussNewton(ceres::Problem* problem, double* block, int size,
+                      std::optional<double> lower_bound_0 = std::nullopt);
+
+// ceres::Covariance of one parameter block of `size` (apply_loss_function as given). nullopt
+// when the Jacobian is rank deficient (Ceres' reciprocal condition number test).
+std::optional<Eigen::MatrixXd> CeresCovariance(ceres::Problem* problem, const double* block,
+                                               int size, bool apply_loss_function = true);
+
+// Slope and intercept in data units from standardised (slope, intercept) and their covariance.
+struct LineParameters {
+  double k = 0.0, c = 0.0;
+  Eigen::Matrix2d covariance;  // of (k, c)
+};
+LineParameters Unstandardise(const Standardised& s, const Eigen::Vector2d& theta,
+                             const Eigen::Matrix2d& covariance_theta);
+
+// Throws InputError unless every standardised uncertainty can be squared and inverted in binary64
+// (u must not be below ~1e-150 times the spread of the data).
+void RequireRepresentable(const std::vector<double>& standardised_u, const std::string& quantity);
+
+double UpperTailChiSquared(double chi2, int dof);
+
+// Fills parameters (with both standard errors), covariance_scaled, correlation, dof,
+// reduced_chi2, p_value (when p_value_applies), exact (+ note), the per-row outlier flags and
+// the outlier list. Expects method, n, chi2, covariance, rows, outlier_threshold set.
+void FinishReport(FitReport& report, const std::vector<std::string>& names,
+                  const Eigen::VectorXd& values, bool p_value_applies);
+
+// "1.2345678901234567" (17 significant digits) for messages.
+std::string Num(double v);
+
+}  // namespace uphill::fit_internal

@@ -1,0 +1,72 @@
+#include "fit/line_data.hpp"
+
+#include <cmath>
+
+#include "fit/internal/line_problem.hpp"
+#include "model/input_error.hpp"
+
+namespace uphill {
+namespace {
+
+using fit_internal::Num;
+
+std::string At(const std::string& column, std::size_t i) {
+  return column + "[" + std::to_string(i) + "]";
+}
+
+void RequireFinite(const std::vector<double>& v, const std::string& column) {
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v[i])) throw InputError(At(column, i), "must be finite (got " + Num(v[i]) + ")");
+}
+
+// The column must be present with one value per row, each finite and > 0 (or ≥ 0).
+void RequireUncertainties(const std::vector<double>& u, std::size_t n, const std::string& column,
+                          const std::string& method, bool zero_allowed) {
+  if (u.empty())
+    throw InputError(column, method + " needs an uncertainty for every row (none given)");
+  if (u.size() != n)
+    throw InputError(column, "must have one value per row (" + std::to_string(n) + " rows, got " +
+                                 std::to_string(u.size()) + ")");
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool ok = std::isfinite(u[i]) && (zero_allowed ? u[i] >= 0.0 : u[i] > 0.0);
+    if (!ok)
+      throw InputError(At(column, i), std::string("must be finite and ") +
+                                          (zero_allowed ? ">= 0" : "> 0") + " for " + method +
+                                          " (got " + Num(u[i]) + ")");
+  }
+}
+
+}  // namespace
+
+void ValidateLineData(const LineData& data, UncertaintyUse use, const std::string& method) {
+  const std::size_t n = data.x.size();
+  if (data.y.size() != n)
+    throw InputError("Y", "must have one value per row of X (X has " + std::to_string(n) +
+                              ", Y has " + std::to_string(data.y.size()) + ")");
+  if (n < 2)
+    throw InputError("rows", "a straight-line fit needs at least 2 rows (got " +
+                                 std::to_string(n) + ")");
+  RequireFinite(data.x, "X");
+  RequireFinite(data.y, "Y");
+  bool all_equal = true;
+  for (std::size_t i = 1; i < n && all_equal; ++i) all_equal = data.x[i] == data.x[0];
+  if (all_equal)
+    throw InputError("X", "all " + std::to_string(n) + " values are equal (" + Num(data.x[0]) +
+                              "), so the slope is undefined: vary the apparatus setting");
+  switch (use) {
+    case UncertaintyUse::kNone:
+      break;
+    case UncertaintyUse::kOptionalY:
+      if (!data.u_y.empty()) RequireUncertainties(data.u_y, n, "u(Y)", method, false);
+      break;
+    case UncertaintyUse::kY:
+      RequireUncertainties(data.u_y, n, "u(Y)", method, false);
+      break;
+    case UncertaintyUse::kXY:
+      RequireUncertainties(data.u_y, n, "u(Y)", method, false);
+      RequireUncertainties(data.u_x, n, "u(X)", method, true);
+      break;
+  }
+}
+
+}  // namespace uphill

@@ -1,0 +1,73 @@
+// Configuration: one apparatus setting as a person enters it — a body with its dimensions, the
+// rails given either by the crossbar measurements (L, H, D) or by the angles (θ, α), an optional
+// rod diameter, and optional standard uncertainties — parsed from named text fields with units.
+//
+// The same names serve the command line (`--L 1165mm`) and CSV columns (`L_mm` with plain
+// numbers, or `L` with a unit in every cell):
+//   body            sphere | spheroid | double-cone
+//   R               sphere radius; double-cone base radius              (length)
+//   a, b            spheroid semi-axes: a across (x, z), b along the rolling axis (length)
+//   h               double-cone half-length                              (length)
+//   L, H, D         crossbar distance, height, rail separation           (length)
+//   theta, alpha    inclination, divergence angle (instead of L, H, D)   (angle)
+//   rod_diameter    diameter of round rods; 0 or absent: line rails      (length)
+//   u_<name>        standard uncertainty of <name>, same dimension        (e.g. u_D_mm)
+//   L_convention    horizontal (default) | along-rail
+//   label           free text carried to the output
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/body.hpp"
+#include "model/propagation.hpp"
+#include "model/rails.hpp"
+#include "model/scene.hpp"
+
+namespace uphill::io {
+
+struct Configuration {
+  std::string label;
+  BodyKind body_kind = BodyKind::kSpheroid;
+  Uncertain across;  // R (sphere, cone) or a (spheroid)
+  Uncertain along;   // R (sphere), b (spheroid), h (cone)
+  bool from_apparatus = true;
+  Uncertain L, H, D;  // when from_apparatus
+  LConvention convention = LConvention::kHorizontal;
+  Uncertain theta, alpha;  // when !from_apparatus
+  Uncertain rod_radius;    // half the rod diameter
+
+  bool HasUncertainty() const;
+  Body MakeBody() const;    // throws InputError
+  Rails MakeRails() const;  // throws InputError
+  Scene MakeScene() const;  // throws InputError
+  // The inputs with their uncertainties, for Propagate (model/propagation.hpp).
+  UncertainRails MakeUncertainRails() const;
+  UncertainBody MakeUncertainBody() const;
+  // Horizontal distance O→crossbar (m) when given by L, H, D.
+  std::optional<double> CrossbarDistance() const;
+};
+
+// Where the fields come from. Lookup(name) returns the text and the unit implied by its
+// source (a CSV header suffix), or nullopt when absent. Context(name) names the field for
+// messages: "--L" or "runs.csv, row 4, column L_mm".
+struct FieldSource {
+  struct Field {
+    std::string text;
+    std::string default_unit;
+  };
+  std::function<std::optional<Field>(const std::string& name)> lookup;
+  std::function<std::string(const std::string& name)> context;
+};
+
+// Parses a configuration. Throws InputError whose quantity is the field's context and whose
+// rule says what is wrong (missing field, bad number or unit, conflicting L/H/D and θ/α, a
+// dimension that does not belong to the body, invalid geometry).
+Configuration ParseConfiguration(const FieldSource& source);
+
+// The field names ParseConfiguration understands (for "unknown column" checks).
+const std::vector<std::string>& ConfigurationFieldNames();
+
+}  // namespace uphill::io

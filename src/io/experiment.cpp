@@ -1,0 +1,185 @@
+#include "io/experiment.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include "io/csv_table.hpp"
+#include "io/units.hpp"
+#include "model/input_error.hpp"
+
+namespace uphill::io {
+namespace {
+
+using nlohmann::json;
+
+const std::set<std::string> kTopKeys = {"format", "title", "operator", "date", "notes", "body",
+                                         "apparatus", "uncertainties"};
+const std::set<std::string> kApparatusKeys = {"L", "H", "D", "theta", "alpha", "rod_diameter",
+                                              "L_convention"};
+const std::set<std::string> kUncertaintyKeys = {"L", "H", "D", "Y", "R", "a", "b", "h",
+                                                "theta", "alpha", "rod_diameter"};
+const std::set<std::string> kColumns = {"trial", "series", "note", "L", "H", "D", "Y",
+                                        "u_L", "u_H", "u_D", "u_Y"};
+
+std::string Text(const json& j, const std::string& context) {
+  if (j.is_string()) return j.get<std::string>();
+  throw InputError(context, "must be a string with a unit, e.g. \"300 mm\" (got " + j.dump() + ")");
+}
+
+json ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "cannot be opened for reading");
+  try {
+    return json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw InputError(path, std::string("is not valid JSON: ") + e.what());
+  }
+}
+
+void CheckKeys(const json& object, const std::set<std::string>& allowed, const std::string& context) {
+  if (!object.is_object()) throw InputError(context, "must be a JSON object");
+  for (const auto& [key, value] : object.items())
+    if (!allowed.count(key)) throw InputError(context + "." + key, "unknown key");
+}
+
+std::string OptionalString(const json& meta, const std::string& key, const std::string& file) {
+  if (!meta.contains(key)) return "";
+  const json& v = meta.at(key);
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_array()) {  // notes may be a list of paragraphs
+    std::string joined;
+    for (const json& p : v) joined += (joined.empty() ? "" : "\n") + Text(p, file + ": " + key);
+    return joined;
+  }
+  throw InputError(file + ": " + key, "must be a string");
+}
+
+}  // namespace
+
+std::vector<const ExperimentRow*> Experiment::UsableRows() const {
+  std::vector<const ExperimentRow*> out;
+  for (const auto& r : rows)
+    if (r.error.empty()) out.push_back(&r);
+  return out;
+}
+
+std::vector<std::string> Experiment::Errors() const {
+  std::vector<std::string> out;
+  for (const auto& r : rows)
+    if (!r.error.empty()) out.push_back(r.error);
+  return out;
+}
+
+Experiment LoadExperiment(const std::string& directory) {
+  namespace fs = std::filesystem;
+  if (!fs::is_directory(directory)) throw InputError(directory, "is not an experiment folder");
+  const std::string json_path = (fs::path(directory) / "experiment.json").string();
+  const std::string csv_path = (fs::path(directory) / "measurements.csv").string();
+  Experiment e;
+  e.directory = directory;
+  e.metadata = ReadJson(json_path);
+  const json& meta = e.metadata;
+  CheckKeys(meta, kTopKeys, json_path);
+  if (!meta.contains("format") || meta.at("format") != kExperimentFormat)
+    throw InputError(json_path + ": format",
+                     std::string("must be \"") + kExperimentFormat + "\" (got " +
+                         (meta.contains("format") ? meta.at("format").dump() : "nothing") + ")");
+  e.title = OptionalString(meta, "title", json_path);
+  e.operator_name = OptionalString(meta, "operator", json_path);
+  e.date = OptionalString(meta, "date", json_path);
+  e.notes = OptionalString(meta, "notes", json_path);
+  if (!meta.contains("body")) throw InputError(json_path + ": body", "is missing");
+  const json& body = meta.at("body");
+  CheckKeys(body, {"type", "R", "a", "b", "h"}, json_path + ": body");
+  const json apparatus = meta.value("apparatus", json::object());
+  CheckKeys(apparatus, kApparatusKeys, json_path + ": apparatus");
+  const json defaults = meta.value("uncertainties", json::object());
+  CheckKeys(defaults, kUncertaintyKeys, json_path + ": uncertainties");
+
+  const CsvTable table = ReadCsvFile(csv_path);
+  std::map<std::string, int> column;  // quantity -> column index
+  for (size_t i = 0; i < table.header.size(); ++i) {
+    const std::string base = SplitUnitSuffix(table.header[i]).first;
+    const std::string where = CellContext(table, 1, table.header[i]);
+    if (!kColumns.count(base)) throw InputError(where, "unknown column (see data/README.md)");
+    if (!column.emplace(base, static_cast<int>(i)).second)
+      throw InputError(where, "gives '" + base + "' a second time");
+    if (apparatus.contains(base))
+      throw InputError(where, "'" + base + "' is also a constant in experiment.json (apparatus." + base +
+                                  "): give it in one place only");
+  }
+  for (const char* required : {"trial", "Y"})
+    if (!column.count(required))
+      throw InputError(csv_path + ", row 1", std::string("column '") + required + "' is missing");
+  if (table.rows.empty()) throw InputError(csv_path, "has a header but no data rows");
+
+  std::set<std::string> trials;
+  for (const CsvRow& csv_row : table.rows) {
+    ExperimentRow row;
+    row.row = csv_row.row;
+    const auto cell = [&](const std::string& name) -> std::string {
+      auto it = column.find(name);
+      return it == column.end() || !csv_row.error.empty() ? "" : csv_row.cells[it->second];
+    };
+    try {
+      if (!csv_row.error.empty()) throw InputError(csv_path + ", row " + std::to_string(row.row), csv_row.error);
+      row.trial = cell("trial");
+      row.series = cell("series");
+      row.note = cell("note");
+      if (row.trial.empty())
+        throw InputError(CellContext(table, row.row, table.header[column.at("trial")]), "is empty");
+      if (!trials.insert(row.trial).second)
+        throw InputError(CellContext(table, row.row, table.header[column.at("trial")]),
+                         "duplicate trial label '" + row.trial + "'");
+      FieldSource source;
+      source.lookup = [&](const std::string& name) -> std::optional<FieldSource::Field> {
+        if (name == "body") return FieldSource::Field{Text(body.at("type"), json_path + ": body.type"), ""};
+        if (name == "L_convention")
+          return apparatus.contains(name)
+                     ? std::optional<FieldSource::Field>({Text(apparatus.at(name), json_path), ""})
+                     : std::nullopt;
+        if (auto it = column.find(name); it != column.end()) {
+          const std::string& text = csv_row.cells[it->second];
+          if (text.find_first_not_of(" \t") == std::string::npos) {
+            if (name.rfind("u_", 0) != 0) return FieldSource::Field{"", ""};  // refused as empty
+          } else {
+            return FieldSource::Field{text, SplitUnitSuffix(table.header[it->second]).second};
+          }
+        }
+        if (body.contains(name)) return FieldSource::Field{Text(body.at(name), json_path + ": body." + name), ""};
+        if (apparatus.contains(name))
+          return FieldSource::Field{Text(apparatus.at(name), json_path + ": apparatus." + name), ""};
+        if (name.rfind("u_", 0) == 0 && defaults.contains(name.substr(2)))
+          return FieldSource::Field{Text(defaults.at(name.substr(2)), json_path + ": uncertainties"), ""};
+        return std::nullopt;
+      };
+      source.context = [&](const std::string& name) -> std::string {
+        if (auto it = column.find(name); it != column.end()) return CellContext(table, row.row, table.header[it->second]);
+        if (name == "body") return json_path + ": body.type";
+        if (body.contains(name)) return json_path + ": body." + name;
+        if (apparatus.contains(name)) return json_path + ": apparatus." + name;
+        if (name.rfind("u_", 0) == 0) return json_path + ": uncertainties." + name.substr(2);
+        return csv_path + ", row " + std::to_string(row.row) + ": " + name +
+               " (neither a column nor a constant in experiment.json)";
+      };
+      row.configuration = ParseConfiguration(source);
+      const auto y = source.lookup("Y");
+      row.Y.value = ParseQuantity(y ? y->text : "", Dimension::kLength, source.context("Y"),
+                                  y ? y->default_unit : "");
+      if (!(row.Y.value > 0.0)) throw InputError(source.context("Y"), "must be > 0 (a position beyond O)");
+      if (const auto uy = source.lookup("u_Y")) {
+        row.Y.u = ParseQuantity(uy->text, Dimension::kLength, source.context("u_Y"), uy->default_unit);
+        if (row.Y.u < 0.0) throw InputError(source.context("u_Y"), "must be >= 0");
+      }
+    } catch (const InputError& err) {
+      row.error = err.what();
+      row.configuration.reset();
+    }
+    e.rows.push_back(std::move(row));
+  }
+  return e;
+}
+
+}  // namespace uphill::io

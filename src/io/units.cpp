@@ -1,0 +1,114 @@
+#include "io/units.hpp"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+
+#include "model/input_error.hpp"
+
+namespace uphill::io {
+namespace {
+
+struct UnitEntry {
+  Dimension dimension;
+  std::string_view name;
+  double factor;  // SI value of one unit
+  bool listed;    // shown in messages (aliases are not)
+};
+
+constexpr double kPi = 3.14159265358979323846;
+
+constexpr std::array<UnitEntry, 14> kUnits{{
+    {Dimension::kLength, "mm", 1e-3, true},
+    {Dimension::kLength, "cm", 1e-2, true},
+    {Dimension::kLength, "m", 1.0, true},
+    {Dimension::kLength, "km", 1e3, true},
+    {Dimension::kLength, "um", 1e-6, true},
+    {Dimension::kLength, "\xC2\xB5m", 1e-6, false},
+    {Dimension::kLength, "in", 0.0254, true},
+    {Dimension::kLength, "inch", 0.0254, false},
+    {Dimension::kAngle, "deg", kPi / 180.0, true},
+    {Dimension::kAngle, "rad", 1.0, true},
+    {Dimension::kAcceleration, "m/s2", 1.0, true},
+    {Dimension::kAcceleration, "m/s^2", 1.0, false},
+    {Dimension::kAcceleration, "mm/s2", 1e-3, false},
+    {Dimension::kAcceleration, "mm/s^2", 1e-3, false},
+}};
+
+std::string_view Trim(std::string_view s) {
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  return s;
+}
+
+}  // namespace
+
+std::string AcceptedUnits(Dimension dimension) {
+  if (dimension == Dimension::kDimensionless) return "a plain number, no unit";
+  std::string out;
+  for (const auto& u : kUnits) {
+    if (u.dimension != dimension || !u.listed) continue;
+    if (!out.empty()) out += ", ";
+    out += u.name;
+  }
+  return out;
+}
+
+double UnitFactor(Dimension dimension, std::string_view unit) {
+  for (const auto& u : kUnits)
+    if (u.dimension == dimension && u.name == unit) return u.factor;
+  return 0.0;
+}
+
+double ParseQuantity(std::string_view text, Dimension dimension, const std::string& quantity,
+                     std::string_view default_unit) {
+  const std::string_view trimmed = Trim(text);
+  if (trimmed.empty()) throw InputError(quantity, "is empty (expected a number with a unit)");
+  double number = 0.0;
+  const char* begin = trimmed.data();
+  const char* end = begin + trimmed.size();
+  // A leading '+' is allowed (spreadsheets write it); from_chars does not accept it.
+  if (*begin == '+') ++begin;
+  const auto [ptr, ec] = std::from_chars(begin, end, number);
+  if (ec == std::errc::result_out_of_range)
+    throw InputError(quantity, "'" + std::string(trimmed) + "' is out of the range of a double");
+  if (ec != std::errc() || ptr == begin)
+    throw InputError(quantity, "'" + std::string(trimmed) + "' is not a number");
+  if (!std::isfinite(number))
+    throw InputError(quantity, "'" + std::string(trimmed) + "' is not a finite number");
+  const std::string_view unit = Trim(std::string_view(ptr, end - ptr));
+  if (dimension == Dimension::kDimensionless) {
+    if (!unit.empty())
+      throw InputError(quantity, "'" + std::string(trimmed) + "' must be a plain number, without a unit");
+    return number;
+  }
+  const std::string_view used = unit.empty() ? default_unit : unit;
+  if (used.empty())
+    throw InputError(quantity, "'" + std::string(trimmed) + "' has no unit (accepted: " +
+                                   AcceptedUnits(dimension) + ")");
+  const double factor = UnitFactor(dimension, used);
+  if (factor == 0.0)
+    throw InputError(quantity, "unit '" + std::string(used) + "' is not accepted here (accepted: " +
+                                   AcceptedUnits(dimension) + ")");
+  return number * factor;
+}
+
+double ToUnit(double value_si, Dimension dimension, std::string_view unit) {
+  if (dimension == Dimension::kDimensionless) return value_si;
+  const double factor = UnitFactor(dimension, unit);
+  if (factor == 0.0)
+    throw InputError("unit", "'" + std::string(unit) + "' is not accepted (accepted: " +
+                                 AcceptedUnits(dimension) + ")");
+  return value_si / factor;
+}
+
+std::pair<std::string, std::string> SplitUnitSuffix(const std::string& header) {
+  const auto pos = header.rfind('_');
+  if (pos == std::string::npos || pos == 0) return {header, ""};
+  const std::string suffix = header.substr(pos + 1);
+  for (const auto& u : kUnits)
+    if (u.name == suffix) return {header.substr(0, pos), suffix};
+  return {header, ""};
+}
+
+}  // namespace uphill::io

@@ -1,0 +1,459 @@
+#include "model/batch_convert.hpp"
+
+#include <immintrin.h>
+
+#include <algorithm>
+#include <boost/random/normal_distribution.hpp>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include "model/spheroid_on_rods_closed_forms.hpp"
+
+// glibc's libmvec vector variants (x86_64 "d" = AVX2 ABI, 4 doubles). Declared by hand rather than
+// reached through <math.h>'s `#pragma omp declare simd` so that the choice does not depend on
+// -ffast-math or -fopenmp-simd, which the project does not use.
+#if defined(UPHILL_HAVE_LIBMVEC) && defined(__x86_64__)
+#define UPHILL_BATCH_AVX2 1
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+extern "C" __m256d _ZGVdN4v_atan(__m256d);
+extern "C" __m256d _ZGVdN4v_tan(__m256d);
+#pragma GCC pop_options
+#else
+#define UPHILL_BATCH_AVX2 0
+#endif
+
+namespace uphill {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Scalar kernels: the model's own expressions (rails.cpp, SpheroidOnLineRails, the rods closed
+// forms, DoubleConeOnLineRails), so that kScalar is bit-identical to the scalar model.
+
+void ScalarRailsTail(std::size_t i, const double* B, const double* T, const RailsArrays& out) {
+  if (out.phi) out.phi[i] = std::atan2(T[i], std::hypot(1.0, B[i]));
+}
+
+void ScalarRailsFromApparatus(std::size_t n, const double* L, const double* H, const double* D,
+                              LConvention convention, const RailsArrays& out, double* B,
+                              double* T) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const double horizontal = HorizontalDistance(L[i], H[i], D[i], convention);
+    B[i] = H[i] / horizontal;
+    T[i] = D[i] / (2 * horizontal);
+    if (out.theta) out.theta[i] = std::atan2(H[i], horizontal);
+    if (out.alpha) out.alpha[i] = 2 * std::atan2(D[i] / 2, horizontal);
+    ScalarRailsTail(i, B, T, out);
+  }
+}
+
+void ScalarRailsFromAngles(std::size_t n, const double* theta, const double* alpha,
+                           const RailsArrays& out, double* B, double* T) {
+  for (std::size_t i = 0; i < n; ++i) {
+    B[i] = std::tan(theta[i]);
+    T[i] = std::tan(alpha[i] / 2);
+    if (out.theta) out.theta[i] = theta[i];
+    if (out.alpha) out.alpha[i] = alpha[i];
+    ScalarRailsTail(i, B, T, out);
+  }
+}
+
+void ScalarSpheroid(std::size_t n, const double* a, const double* b, const double* r,
+                    const double* B, const double* T, double* x_eq, double* x_max) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (r) {
+      if (x_eq) x_eq[i] = SpheroidOnRodsXEq(a[i], b[i], B[i], T[i], r[i]);
+      if (x_max) x_max[i] = SpheroidOnRodsXMax(a[i], b[i], T[i], r[i]);
+    } else {
+      const double A = a[i] * T[i] / b[i];
+      if (x_eq) x_eq[i] = a[i] * B[i] / (A * std::hypot(A, B[i]));
+      if (x_max) x_max[i] = std::hypot(a[i], b[i] / T[i]);
+    }
+  }
+}
+
+void ScalarDoubleCone(std::size_t n, const double* R, const double* h, const double* B,
+                      const double* T, double* x_fall, double* theta0, double* q) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const double kT = R[i] / h[i] * T[i];
+    if (x_fall) x_fall[i] = h[i] / T[i];
+    if (theta0) theta0[i] = std::atan(kT);
+    if (q) q[i] = 1.0 + B[i] * B[i] - kT * kT;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// AVX2 + FMA kernels. Compiled for that target by pragma rather than by a per-file -mavx2: with
+// -mavx2 on a whole file every inline function instantiated there (std::vector, <cmath> wrappers)
+// may be emitted with AVX2 instructions and chosen by the linker for the whole program, which then
+// crashes on a CPU without AVX2. Here only the functions defined between push and pop are AVX2
+// code, and they are reached only after the run-time check.
+#if UPHILL_BATCH_AVX2
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+
+// hypot(x, y) as sqrt(x² + y²) with one rounding inside: ≤ 1 ulp more than hypot, and safe here
+// because the model's quantities are far from overflow and underflow (|x|, |y| in 1e-150..1e150).
+inline __m256d Hypot(__m256d x, __m256d y) {
+  return _mm256_sqrt_pd(_mm256_fmadd_pd(x, x, _mm256_mul_pd(y, y)));
+}
+
+// Loads n < 4 values padded with `pad` (a harmless in-domain value), so that a short tail goes
+// through the same vector code as full lanes: every element's result depends on its inputs only.
+inline __m256d LoadTail(const double* p, std::size_t n, double pad) {
+  alignas(32) double tmp[4] = {pad, pad, pad, pad};
+  for (std::size_t k = 0; k < n; ++k) tmp[k] = p[k];
+  return _mm256_load_pd(tmp);
+}
+inline void StoreTail(double* p, std::size_t n, __m256d v) {
+  alignas(32) double tmp[4];
+  _mm256_store_pd(tmp, v);
+  for (std::size_t k = 0; k < n; ++k) p[k] = tmp[k];
+}
+
+// Loads lanes [i, i + 4) or the padded tail; m = number of valid lanes.
+inline __m256d Load(const double* p, std::size_t i, std::size_t m, double pad) {
+  return m == 4 ? _mm256_loadu_pd(p + i) : LoadTail(p + i, m, pad);
+}
+inline void Store(double* p, std::size_t i, std::size_t m, __m256d v) {
+  if (!p) return;
+  if (m == 4) {
+    _mm256_storeu_pd(p + i, v);
+  } else {
+    StoreTail(p + i, m, v);
+  }
+}
+
+inline void Avx2RailsTail(std::size_t i, std::size_t m, __m256d B, __m256d T,
+                          const RailsArrays& out, double* B_out, double* T_out) {
+  Store(B_out, i, m, B);
+  Store(T_out, i, m, T);
+  if (out.phi) {
+    const __m256d one = _mm256_set1_pd(1.0);
+    const __m256d sec = _mm256_sqrt_pd(_mm256_fmadd_pd(B, B, one));  // hypot(1, B)
+    Store(out.phi, i, m, _ZGVdN4v_atan(_mm256_div_pd(T, sec)));
+  }
+}
+
+void Avx2RailsFromApparatus(std::size_t n, const double* L, const double* H, const double* D,
+                            LConvention convention, const RailsArrays& out, double* B_out,
+                            double* T_out) {
+  const __m256d half = _mm256_set1_pd(0.5), two = _mm256_set1_pd(2.0);
+  for (std::size_t i = 0; i < n; i += 4) {
+    const std::size_t m = std::min<std::size_t>(4, n - i);
+    const __m256d l = Load(L, i, m, 1.0), h = Load(H, i, m, 0.0), d = Load(D, i, m, 0.1);
+    __m256d horizontal = l;
+    if (convention == LConvention::kAlongRail) {
+      const __m256d s = Hypot(h, _mm256_mul_pd(d, half));  // D/2 is exact
+      horizontal = _mm256_sqrt_pd(_mm256_mul_pd(_mm256_sub_pd(l, s), _mm256_add_pd(l, s)));
+    }
+    const __m256d B = _mm256_div_pd(h, horizontal);
+    const __m256d T = _mm256_div_pd(d, _mm256_mul_pd(two, horizontal));
+    // atan(H/Lh) = atan2(H, Lh) for H ≥ 0, Lh > 0; B is the ratio the model uses anyway, and
+    // atan is ~1.4× cheaper than atan2 in libmvec.
+    if (out.theta) Store(out.theta, i, m, _ZGVdN4v_atan(B));
+    if (out.alpha) Store(out.alpha, i, m, _mm256_mul_pd(two, _ZGVdN4v_atan(T)));
+    Avx2RailsTail(i, m, B, T, out, B_out, T_out);
+  }
+}
+
+void Avx2RailsFromAngles(std::size_t n, const double* theta, const double* alpha,
+                         const RailsArrays& out, double* B_out, double* T_out) {
+  const __m256d half = _mm256_set1_pd(0.5);
+  for (std::size_t i = 0; i < n; i += 4) {
+    const std::size_t m = std::min<std::size_t>(4, n - i);
+    const __m256d th = Load(theta, i, m, 0.1), al = Load(alpha, i, m, 0.1);
+    const __m256d B = _ZGVdN4v_tan(th);
+    const __m256d T = _ZGVdN4v_tan(_mm256_mul_pd(al, half));
+    Store(out.theta, i, m, th);
+    Store(out.alpha, i, m, al);
+    Avx2RailsTail(i, m, B, T, out, B_out, T_out);
+  }
+}
+
+void Avx2Spheroid(std::size_t n, const double* a, const double* b, const double* r,
+                  const double* tB, const double* tT, double* x_eq, double* x_max) {
+  const __m256d one = _mm256_set1_pd(1.0);
+  for (std::size_t i = 0; i < n; i += 4) {
+    const std::size_t m = std::min<std::size_t>(4, n - i);
+    const __m256d va = Load(a, i, m, 1.0), vb = Load(b, i, m, 1.0);
+    const __m256d B = Load(tB, i, m, 0.1), T = Load(tT, i, m, 0.1);
+    if (r) {
+      const __m256d vr = Load(r, i, m, 0.0);
+      if (x_eq) {
+        const __m256d bB = _mm256_mul_pd(vb, B);
+        const __m256d lhs = _mm256_div_pd(_mm256_mul_pd(_mm256_mul_pd(vb, vb), B),
+                                          _mm256_mul_pd(T, Hypot(bB, _mm256_mul_pd(va, T))));
+        const __m256d rhs =
+            _mm256_div_pd(_mm256_mul_pd(vr, B), _mm256_mul_pd(T, Hypot(B, T)));
+        Store(x_eq, i, m, _mm256_add_pd(lhs, rhs));
+      }
+      if (x_max) {
+        const __m256d csc = _mm256_div_pd(_mm256_sqrt_pd(_mm256_fmadd_pd(T, T, one)), T);
+        Store(x_max, i, m, _mm256_fmadd_pd(vr, csc, Hypot(va, _mm256_div_pd(vb, T))));
+      }
+    } else {
+      if (x_eq) {
+        const __m256d A = _mm256_div_pd(_mm256_mul_pd(va, T), vb);
+        Store(x_eq, i, m,
+              _mm256_div_pd(_mm256_mul_pd(va, B), _mm256_mul_pd(A, Hypot(A, B))));
+      }
+      if (x_max) Store(x_max, i, m, Hypot(va, _mm256_div_pd(vb, T)));
+    }
+  }
+}
+
+void Avx2DoubleCone(std::size_t n, const double* R, const double* h, const double* tB,
+                    const double* tT, double* x_fall, double* theta0, double* q) {
+  const __m256d one = _mm256_set1_pd(1.0);
+  for (std::size_t i = 0; i < n; i += 4) {
+    const std::size_t m = std::min<std::size_t>(4, n - i);
+    const __m256d vR = Load(R, i, m, 1.0), vh = Load(h, i, m, 1.0);
+    const __m256d B = Load(tB, i, m, 0.1), T = Load(tT, i, m, 0.1);
+    const __m256d kT = _mm256_mul_pd(_mm256_div_pd(vR, vh), T);
+    Store(x_fall, i, m, _mm256_div_pd(vh, T));
+    if (theta0) Store(theta0, i, m, _ZGVdN4v_atan(kT));
+    // 1 + B² − (kT)²: the difference of squares as (1 + B²) − kT·kT with one rounding.
+    Store(q, i, m, _mm256_fnmadd_pd(kT, kT, _mm256_fmadd_pd(B, B, one)));
+  }
+}
+
+#pragma GCC pop_options
+#endif  // UPHILL_BATCH_AVX2
+
+bool CpuHasAvx2() {
+#if UPHILL_BATCH_AVX2
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return has;
+#else
+  return false;
+#endif
+}
+
+bool UseAvx2(BatchKernel kernel) {
+  switch (kernel) {
+    case BatchKernel::kAuto: return CpuHasAvx2();
+    case BatchKernel::kScalar: return false;
+    case BatchKernel::kAvx2:
+      if (!CpuHasAvx2())
+        throw std::runtime_error("batch kernel avx2+fma requested but not available here");
+      return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+bool BatchKernelAvailable(BatchKernel kernel) {
+  return kernel != BatchKernel::kAvx2 || CpuHasAvx2();
+}
+
+const char* BatchKernelName(BatchKernel kernel) {
+  if (kernel == BatchKernel::kAuto) kernel = CpuHasAvx2() ? BatchKernel::kAvx2 : BatchKernel::kScalar;
+  return kernel == BatchKernel::kAvx2 ? "avx2+fma (libmvec)" : "scalar (libm)";
+}
+
+// The stage kernels write B and T only where the caller asked for them; a caller that wants
+// neither still needs them internally for φ, so they go through a small stack block then.
+namespace {
+constexpr std::size_t kBlock = 256;  // 2 KiB per array: a stage's working set stays in L1
+
+template <typename Run>
+void WithSlopes(std::size_t n, const RailsArrays& out, Run run) {
+  if (out.tan_theta && out.tan_half_alpha) {
+    run(0, n, out, out.tan_theta, out.tan_half_alpha);
+    return;
+  }
+  double B[kBlock], T[kBlock];
+  for (std::size_t i = 0; i < n; i += kBlock) {
+    const std::size_t m = std::min(kBlock, n - i);
+    RailsArrays part;
+    part.theta = out.theta ? out.theta + i : nullptr;
+    part.alpha = out.alpha ? out.alpha + i : nullptr;
+    part.phi = out.phi ? out.phi + i : nullptr;
+    run(i, m, part, out.tan_theta ? out.tan_theta + i : B,
+        out.tan_half_alpha ? out.tan_half_alpha + i : T);
+  }
+}
+}  // namespace
+
+void RailsFromApparatusBatch(std::size_t n, const double* L, const double* H, const double* D,
+                             LConvention convention, const RailsArrays& out, BatchKernel kernel) {
+  const bool avx2 = UseAvx2(kernel);
+  WithSlopes(n, out, [&](std::size_t i, std::size_t m, const RailsArrays& o, double* B, double* T) {
+#if UPHILL_BATCH_AVX2
+    if (avx2) return Avx2RailsFromApparatus(m, L + i, H + i, D + i, convention, o, B, T);
+#endif
+    (void)avx2;
+    ScalarRailsFromApparatus(m, L + i, H + i, D + i, convention, o, B, T);
+  });
+}
+
+void RailsFromAnglesBatch(std::size_t n, const double* theta, const double* alpha,
+                          const RailsArrays& out, BatchKernel kernel) {
+  const bool avx2 = UseAvx2(kernel);
+  WithSlopes(n, out, [&](std::size_t i, std::size_t m, const RailsArrays& o, double* B, double* T) {
+#if UPHILL_BATCH_AVX2
+    if (avx2) return Avx2RailsFromAngles(m, theta + i, alpha + i, o, B, T);
+#endif
+    (void)avx2;
+    ScalarRailsFromAngles(m, theta + i, alpha + i, o, B, T);
+  });
+}
+
+void SpheroidBatch(std::size_t n, const double* a, const double* b, const double* rod_radius,
+                   const double* tan_theta, const double* tan_half_alpha, double* x_eq,
+                   double* x_max, BatchKernel kernel) {
+#if UPHILL_BATCH_AVX2
+  if (UseAvx2(kernel))
+    return Avx2Spheroid(n, a, b, rod_radius, tan_theta, tan_half_alpha, x_eq, x_max);
+#else
+  UseAvx2(kernel);
+#endif
+  ScalarSpheroid(n, a, b, rod_radius, tan_theta, tan_half_alpha, x_eq, x_max);
+}
+
+void DoubleConeBatch(std::size_t n, const double* R, const double* h, const double* tan_theta,
+                     const double* tan_half_alpha, double* x_fall, double* theta0, double* q,
+                     BatchKernel kernel) {
+#if UPHILL_BATCH_AVX2
+  if (UseAvx2(kernel))
+    return Avx2DoubleCone(n, R, h, tan_theta, tan_half_alpha, x_fall, theta0, q);
+#else
+  UseAvx2(kernel);
+#endif
+  ScalarDoubleCone(n, R, h, tan_theta, tan_half_alpha, x_fall, theta0, q);
+}
+
+void ConvertApparatusBatch(std::size_t n, const double* L, const double* H, const double* D,
+                           double a, double b, double* theta, double* alpha, double* x_eq,
+                           BatchKernel kernel) {
+  // Block-wise through the two stages: B, T and the broadcast a, b live in L1 between them.
+  double B[kBlock], T[kBlock], av[kBlock], bv[kBlock];
+  std::fill_n(av, kBlock, a);
+  std::fill_n(bv, kBlock, b);
+  for (std::size_t i = 0; i < n; i += kBlock) {
+    const std::size_t m = std::min(kBlock, n - i);
+    RailsArrays rails;
+    rails.theta = theta ? theta + i : nullptr;
+    rails.alpha = alpha ? alpha + i : nullptr;
+    rails.tan_theta = B;
+    rails.tan_half_alpha = T;
+    RailsFromApparatusBatch(m, L + i, H + i, D + i, LConvention::kHorizontal, rails, kernel);
+    if (x_eq) SpheroidBatch(m, av, bv, nullptr, B, T, x_eq + i, nullptr, kernel);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// GaussianStream
+
+// Boost's normal_distribution reads the engine through this view of the stream's buffer, so the
+// scalar path and the vector path's fallback consume exactly the outputs Boost would.
+struct GaussianStreamAccess {
+  using result_type = std::uint64_t;
+  static constexpr result_type min() { return 0; }
+  static constexpr result_type max() { return ~result_type{0}; }
+  GaussianStream* s;
+  result_type operator()() {
+    if (s->pos_ == s->end_) s->Refill();
+    return s->buffer_[s->pos_++];
+  }
+  static double Next(GaussianStream* stream) {
+    // The same range as boost::random::mt19937_64 (0 .. 2^64 − 1): Boost sees the engine it would.
+    GaussianStreamAccess engine{stream};
+    return boost::random::normal_distribution<double>()(engine);
+  }
+  static std::size_t Available(const GaussianStream* s) { return s->end_ - s->pos_; }
+  static const std::uint64_t* Peek(const GaussianStream* s) { return s->buffer_ + s->pos_; }
+  static void Skip(GaussianStream* s, std::size_t k) { s->pos_ += k; }
+};
+
+void GaussianStream::Refill() {
+  const std::size_t left = end_ - pos_;
+  std::memmove(buffer_, buffer_ + pos_, left * sizeof buffer_[0]);
+  for (std::size_t k = left; k < kBuffer; ++k) buffer_[k] = engine_();
+  pos_ = 0;
+  end_ = kBuffer;
+}
+
+namespace {
+
+#if UPHILL_BATCH_AVX2
+#pragma GCC push_options
+// No "fma": nothing here may be contracted, the values must be Boost's to the bit.
+#pragma GCC target("avx2,bmi")
+
+// Boost 1.74's unit_normal_distribution fast path for a 64-bit engine (detail/int_float_pair.hpp,
+// normal_distribution.hpp), four outputs u at a time:
+//   bucket = u & 0xFF; i = bucket >> 1; sign = bucket & 1 ? +1 : −1
+//   r = double((u & ~(1 << 11)) >> 8) · 2^-56     (the int → double conversion rounds to nearest)
+//   x = r · table_x[i]; accepted iff x < table_x[i + 1]; value x·sign.
+// The 56-bit integer is converted exactly as cvtsi2sd does: high and low 32-bit halves are exact
+// doubles, and their sum hi·2^32 + lo is rounded once. Returns the accepted lanes as a bit mask.
+int FastNormals4(const std::uint64_t* u, double* z) {
+  const double* table_x = boost::random::detail::normal_table<double>::table_x;
+  const __m256i raw = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(u));
+  const __m256i bucket = _mm256_and_si256(raw, _mm256_set1_epi64x(0xFF));
+  const __m256i bits = _mm256_srli_epi64(_mm256_andnot_si256(_mm256_set1_epi64x(1 << 11), raw), 8);
+  // 2^52 + k as a double is exact for k < 2^32: the classic exact uint32 → double conversion.
+  const __m256i magic = _mm256_set1_epi64x(0x4330000000000000LL);
+  const __m256d two52 = _mm256_set1_pd(4503599627370496.0);
+  const __m256d lo = _mm256_sub_pd(
+      _mm256_castsi256_pd(_mm256_or_si256(_mm256_and_si256(bits, _mm256_set1_epi64x(0xFFFFFFFFLL)), magic)),
+      two52);
+  const __m256d hi = _mm256_sub_pd(
+      _mm256_castsi256_pd(_mm256_or_si256(_mm256_srli_epi64(bits, 32), magic)), two52);
+  const __m256d r = _mm256_mul_pd(
+      _mm256_add_pd(_mm256_mul_pd(hi, _mm256_set1_pd(4294967296.0)), lo),
+      _mm256_set1_pd(1.0 / 72057594037927936.0));  // 2^-56
+  // Table lookups by scalar loads: AVX2 gathers are slower than four loads on current x86 cores.
+  const std::size_t i0 = (u[0] & 0xFF) >> 1, i1 = (u[1] & 0xFF) >> 1, i2 = (u[2] & 0xFF) >> 1,
+                    i3 = (u[3] & 0xFF) >> 1;
+  const __m256d x = _mm256_mul_pd(r, _mm256_set_pd(table_x[i3], table_x[i2], table_x[i1], table_x[i0]));
+  const __m256d next = _mm256_set_pd(table_x[i3 + 1], table_x[i2 + 1], table_x[i1 + 1], table_x[i0 + 1]);
+  const int accepted = _mm256_movemask_pd(_mm256_cmp_pd(x, next, _CMP_LT_OQ));
+  // sign −1 (bucket bit 0 clear): flip the sign bit, which is what x·(−1.0) does, also for 0.
+  const __m256i minus = _mm256_slli_epi64(
+      _mm256_xor_si256(_mm256_and_si256(bucket, _mm256_set1_epi64x(1)), _mm256_set1_epi64x(1)), 63);
+  _mm256_storeu_pd(z, _mm256_xor_pd(x, _mm256_castsi256_pd(minus)));
+  return accepted;
+}
+
+void Avx2Normals(GaussianStream* stream, std::size_t n, double* z) {
+  std::size_t k = 0;
+  while (k + 4 <= n) {
+    if (GaussianStreamAccess::Available(stream) < 4) {
+      z[k++] = GaussianStreamAccess::Next(stream);  // refills the buffer, keeping order
+      continue;
+    }
+    const int accepted = FastNormals4(GaussianStreamAccess::Peek(stream), z + k);
+    if (accepted == 0xF) {
+      GaussianStreamAccess::Skip(stream, 4);
+      k += 4;
+      continue;
+    }
+    // Lanes before the first rejected one are final; Boost produces the rejected one.
+    const int good = __builtin_ctz(~accepted & 0xF);
+    GaussianStreamAccess::Skip(stream, static_cast<std::size_t>(good));
+    k += static_cast<std::size_t>(good);
+    z[k++] = GaussianStreamAccess::Next(stream);
+  }
+  for (; k < n; ++k) z[k] = GaussianStreamAccess::Next(stream);
+}
+
+#pragma GCC pop_options
+#endif  // UPHILL_BATCH_AVX2
+
+}  // namespace
+
+void GaussianStream::Fill(std::size_t n, double* z, BatchKernel kernel) {
+#if UPHILL_BATCH_AVX2
+  if (UseAvx2(kernel)) return Avx2Normals(this, n, z);
+#else
+  UseAvx2(kernel);
+#endif
+  for (std::size_t k = 0; k < n; ++k) z[k] = GaussianStreamAccess::Next(this);
+}
+
+}  // namespace uphill

@@ -1,0 +1,123 @@
+// Batch conversion kernels: the closed forms of the model evaluated for many configurations at
+// once, arrays in, arrays out (structure of arrays, one array per quantity).
+//
+// Why a separate path: the Monte Carlo propagation (propagation.hpp) and `uphill bench convert`
+// evaluate the closed forms 10^6–10^7 times. Through Rails/Scene each evaluation costs ~100 ns,
+// mostly scalar libm atan2; here the same formulas run 4 lanes at a time using glibc's libmvec
+// AVX2 variants (_ZGVdN4v_atan, _ZGVdN4v_tan, ≤ 4 ulp) when the CPU has AVX2 + FMA, chosen at run
+// time, with a scalar fallback that evaluates the model's own expressions (bit for bit those of
+// Rails, SpheroidOnLineRails, spheroid_on_rods_closed_forms.hpp and DoubleConeOnLineRails).
+//
+// Formulas, per element (PHYSICS.md; SI units: metres, radians):
+//   rails from L, H, D    Lh = L (LConvention::kHorizontal) or sqrt((L − s)(L + s)), s = hypot(H, D/2)
+//                         B = tanθ = H/Lh,  T = tan(α/2) = D/(2·Lh)
+//                         θ = atan(B), α = 2·atan(T), φ = atan(T/sqrt(1 + B²))   [= atan2 forms]
+//   rails from θ, α       B = tanθ, T = tan(α/2), φ as above
+//   sphere, spheroid      A = a·T/b,  x_eq = a·B/(A·sqrt(A² + B²)),  x_max = sqrt(a² + (b/T)²)
+//     on rods r > 0       x_eq(r), x_max(r) of spheroid_on_rods_closed_forms.hpp
+//                         (a sphere on rods is the sphere of radius R + r on line rails: pass
+//                         a = b = R + r and no rods, as Scene does)
+//   double cone           x_fall = h/T,  θ0 = atan((R/h)·T),  Q = 1 + B² − (R/h)²·T²
+//
+// Contract:
+//   - Domain as in the model (L, D, a, b, R, h > 0; H ≥ 0; kAlongRail needs L > hypot(H, D/2);
+//     0 ≤ θ < π/2, 0 < α < π; r > 0 when given). The kernels do not check: outside the domain they
+//     return whatever IEEE arithmetic gives (NaN, ±inf, or a meaningless number) and never trap or
+//     throw, so a caller (the Monte Carlo) can screen its draws before or after, in bulk.
+//   - Accuracy against the scalar model: kScalar is bit-identical to it; kAvx2 agrees within a few
+//     ulp (libmvec's ≤ 4 ulp for the angles, sqrt(fma) for hypot: ≤ 1e-15 relative for θ, α, φ,
+//     x_eq, x_max away from the domain edges; tests/batch_convert_test.cpp checks 4e-16·16).
+//   - Each element's result depends only on that element's inputs (a tail shorter than a vector is
+//     padded, not sent through another code path), so results do not depend on n or on where an
+//     element sits in its array: a reordered or compacted batch gives the same numbers.
+//   - Arrays of one call may be the same array only where noted; no allocation, no virtual
+//     dispatch: one indirect branch per call to pick the kernel.
+#pragma once
+
+#include <boost/random/mersenne_twister.hpp>
+#include <cstddef>
+#include <cstdint>
+
+#include "model/rails.hpp"
+
+namespace uphill {
+
+// Which implementation runs. kAuto picks kAvx2 when the CPU has AVX2 and FMA and the build found
+// libmvec, else kScalar. Asking for kAvx2 where it is not available throws std::runtime_error.
+enum class BatchKernel { kAuto, kScalar, kAvx2 };
+
+bool BatchKernelAvailable(BatchKernel kernel);
+// "avx2+fma (libmvec)" or "scalar (libm)": what `kernel` (kAuto: what it resolves to) runs.
+const char* BatchKernelName(BatchKernel kernel = BatchKernel::kAuto);
+
+// Outputs of the rails stage, n values each. A null pointer means "not wanted".
+struct RailsArrays {
+  double* theta = nullptr;           // θ, rad
+  double* alpha = nullptr;           // α, rad
+  double* phi = nullptr;             // φ, rad (3-D half angle between the rails)
+  double* tan_theta = nullptr;       // B = tanθ
+  double* tan_half_alpha = nullptr;  // T = tan(α/2)
+};
+
+// Rails from crossbar measurements L, H, D (metres) with the given L convention.
+void RailsFromApparatusBatch(std::size_t n, const double* L, const double* H, const double* D,
+                             LConvention convention, const RailsArrays& out,
+                             BatchKernel kernel = BatchKernel::kAuto);
+
+// Rails from angles θ, α (radians). out.theta/out.alpha, if given, receive copies.
+void RailsFromAnglesBatch(std::size_t n, const double* theta, const double* alpha,
+                          const RailsArrays& out, BatchKernel kernel = BatchKernel::kAuto);
+
+// Sphere (a = b = R) or spheroid: x_eq and x_max (metres; either may be null). rod_radius null:
+// line rails; otherwise the rods' radii (> 0), closed forms of spheroid_on_rods_closed_forms.hpp.
+void SpheroidBatch(std::size_t n, const double* a, const double* b, const double* rod_radius,
+                   const double* tan_theta, const double* tan_half_alpha, double* x_eq,
+                   double* x_max, BatchKernel kernel = BatchKernel::kAuto);
+
+// Double cone (base radius R, half-length h) on line rails: x_fall = h·cot(α/2) (m), θ0 (rad),
+// and Q = 1 + tan²θ − (R/h)²tan²(α/2) (the closed form and the scene need Q > 0). Any output may
+// be null.
+void DoubleConeBatch(std::size_t n, const double* R, const double* h, const double* tan_theta,
+                     const double* tan_half_alpha, double* x_fall, double* theta0, double* q,
+                     BatchKernel kernel = BatchKernel::kAuto);
+
+// The converter's common case in one pass: crossbar L, H, D (metres, horizontal convention) to
+// θ, α (rad) and X = x_eq (m) of one spheroid (semi-axes a, b, m) on line rails. Processes the
+// arrays in L1-sized blocks (the intermediates never leave the cache). Same numbers as
+// RailsFromApparatusBatch followed by SpheroidBatch. Outputs may be null.
+void ConvertApparatusBatch(std::size_t n, const double* L, const double* H, const double* D,
+                           double a, double b, double* theta, double* alpha, double* x_eq,
+                           BatchKernel kernel = BatchKernel::kAuto);
+
+// GaussianStream: the Monte Carlo's source of standard normal deviates, reproducible and fast.
+//
+// Contract: Fill(n, z) writes the next n values that
+//     boost::random::normal_distribution<double> unit;  unit(engine)
+// returns for a boost::random::mt19937_64 engine seeded with `seed`, bit for bit, whichever
+// kernel runs (tests/batch_convert_test.cpp compares 10^6 values). So the trials depend only on
+// the seed and the Boost version, not on the CPU or the C++ library (std::normal_distribution's
+// algorithm is implementation-defined, which is why Boost's is used at all).
+//
+// Why not just call unit(engine): Boost's ziggurat costs ~6 ns per value here, the largest part
+// of a Monte Carlo trial. Its fast path (≈ 98.8 % of values: one 64-bit engine output gives a
+// layer index, a sign and a 53-bit fraction r; x = r·x[i] is accepted if x < x[i+1]) is plain
+// integer and IEEE arithmetic with correctly rounded conversions, so the AVX2 kernel evaluates it
+// for four consecutive engine outputs at once, with the same operations and Boost's own tables.
+// At the first lane that the fast path rejects it stops and lets Boost's normal_distribution
+// itself produce that value from the same buffered engine outputs (wedge, tail, retries), then
+// resumes. The engine is Boost's, called in a tight loop into a buffer.
+class GaussianStream {
+ public:
+  explicit GaussianStream(std::uint64_t seed) : engine_(seed) {}
+  void Fill(std::size_t n, double* z, BatchKernel kernel = BatchKernel::kAuto);
+
+ private:
+  friend struct GaussianStreamAccess;
+  static constexpr std::size_t kBuffer = 512;
+  void Refill();  // keeps the unread outputs, tops the buffer up from the engine
+  boost::random::mt19937_64 engine_;
+  std::uint64_t buffer_[kBuffer] = {};
+  std::size_t pos_ = 0, end_ = 0;  // unread outputs: buffer_[pos_, end_)
+};
+
+}  // namespace uphill

@@ -1,0 +1,224 @@
+// The rolling-resistance fit (src/fit/friction_fit.hpp): μ recovered from synthetic lab data,
+// the scale factor, rods (numeric derivatives), the comparison with the straight line, an
+// independent covariance, and the hard cases.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "fit/friction_fit.hpp"
+#include "model/input_error.hpp"
+#include "model/spheroid_on_line_rails.hpp"
+
+namespace uphill {
+namespace {
+
+// The paper's spheroid (2 × 1.25 × 1.25 inch, long axis across the rails) and crossbar height.
+constexpr double kA = 0.015875, kB = 0.0254, kH = 0.300;
+
+Scene LabScene(double L_mm, double D_mm, double rod_radius = 0.0,
+               const Body& body = Body::Spheroid(kA, kB)) {
+  return Scene(body, Rails::FromApparatus(L_mm / 1000.0, kH, D_mm / 1000.0, LConvention::kHorizontal),
+               rod_radius);
+}
+
+// 15 settings: L around 1165 mm, D from 100 to 200 mm.
+std::vector<Scene> LabScenes() {
+  std::vector<Scene> scenes;
+  for (double L : {1140.0, 1165.0, 1190.0})
+    for (double D : {100.0, 125.0, 150.0, 175.0, 200.0}) scenes.push_back(LabScene(L, D));
+  return scenes;
+}
+
+// Y_i = s·x_rest,i(μ) + u·noise.
+FrictionData Synthetic(std::vector<Scene> scenes, double mu, double u, std::uint64_t seed,
+                       double scale = 1.0) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal;
+  FrictionData d;
+  for (const Scene& scene : scenes) {
+    d.y.push_back(scale * scene.Rest(mu)->high + (u > 0 ? u * normal(rng) : 0.0));
+    d.u_y.push_back(u > 0 ? u : 2e-5);
+  }
+  d.scenes = std::move(scenes);
+  return d;
+}
+
+::testing::AssertionResult RelNear(double actual, double expected, double rel) {
+  const double err = std::abs(actual - expected);
+  if (err <= rel * std::abs(expected)) return ::testing::AssertionSuccess();
+  std::ostringstream msg;
+  msg.precision(17);
+  msg << "actual " << actual << ", expected " << expected << ", relative error "
+      << err / std::abs(expected) << " > " << rel;
+  return ::testing::AssertionFailure() << msg.str();
+}
+
+template <typename F>
+void ExpectInputError(F&& f, const std::string& quantity) {
+  try {
+    f();
+    ADD_FAILURE() << "no InputError (expected one about " << quantity << ")";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.quantity(), quantity) << e.what();
+  }
+}
+
+bool HasNote(const FitReport& fit, const std::string& text) {
+  for (const std::string& note : fit.notes)
+    if (note.find(text) != std::string::npos) return true;
+  return false;
+}
+
+TEST(Friction, NoiseFreeDataGiveMuBackFromAnyStart) {
+  const double mu = 0.008;
+  const FrictionData d = Synthetic(LabScenes(), mu, 0.0, 1);
+  FrictionOptions cold;
+  cold.fit.seed_with_closed_form = false;  // Ceres from μ = 0
+  for (const FrictionOptions& options : {FrictionOptions{}, cold}) {
+    const FitReport fit = FitFriction(d, options);
+    EXPECT_TRUE(RelNear(fit.Parameter("mu").value, mu, 1e-10));
+    EXPECT_LT(fit.chi2, 1e-15);
+    EXPECT_TRUE(fit.solver.converged) << fit.solver.termination;
+    EXPECT_EQ(fit.parameters.size(), 1u);
+  }
+}
+
+TEST(Friction, RecoversMuWithinItsStandardError) {
+  const double mu = 0.008;
+  const FrictionData d = Synthetic(LabScenes(), mu, 2e-5, 2);  // u(Y) = 0.02 mm
+  const FitReport fit = FitFriction(d);
+  const ParameterEstimate& p = fit.Parameter("mu");
+  std::printf("  mu = %.6g ± %.2g (true %.6g), chi2/nu = %.3f\n", p.value, p.se_unscaled, mu,
+              *fit.reduced_chi2);
+  EXPECT_LT(std::abs(p.value - mu), 2.0 * p.se_unscaled);
+  EXPECT_LT(p.se_unscaled, 0.1 * mu);  // μ is well determined by such data
+  EXPECT_EQ(fit.primary_scaling, ErrorScaling::kUnscaled);
+  ASSERT_TRUE(fit.p_value);
+  EXPECT_GT(*fit.p_value, 0.001);
+  // The reported rows are the Scene's own rest positions at the fitted μ.
+  for (const RowResult& row : fit.rows)
+    EXPECT_EQ(row.fitted, d.scenes[row.row].Rest(p.value)->high);
+}
+
+TEST(Friction, FitsAScaleFactor) {
+  const double mu = 0.006, scale = 1.003;
+  const FrictionData d = Synthetic(LabScenes(), mu, 2e-5, 3, scale);
+  FrictionOptions options;
+  options.fit_scale = true;
+  const FitReport fit = FitFriction(d, options);
+  ASSERT_EQ(fit.parameters.size(), 2u);
+  EXPECT_LT(std::abs(fit.Parameter("mu").value - mu), 3.0 * fit.Parameter("mu").se_unscaled);
+  EXPECT_LT(std::abs(fit.Parameter("s").value - scale), 3.0 * fit.Parameter("s").se_unscaled);
+  EXPECT_EQ(fit.dof, 13);
+  // Noise-free: both exactly.
+  const FitReport exact = FitFriction(Synthetic(LabScenes(), mu, 0.0, 3, scale), options);
+  EXPECT_TRUE(RelNear(exact.Parameter("mu").value, mu, 1e-9));
+  EXPECT_TRUE(RelNear(exact.Parameter("s").value, scale, 1e-12));
+}
+
+TEST(Friction, PreferredOverTheStraightLineByAicAndBic) {
+  for (const bool stated : {true, false}) {
+    SCOPED_TRACE(stated ? "u(Y) given" : "scatter estimated");
+    FrictionData d = Synthetic(LabScenes(), 0.008, 2e-5, 4);
+    if (!stated) d.u_y.clear();
+    const FrictionVersusLine both = CompareFrictionWithLine(d);
+    std::printf("  %s: chi2 line %.4g, friction %.4g; %s\n", stated ? "WLS" : "OLS",
+                both.line.chi2, both.friction.chi2, both.comparison.verdict.c_str());
+    EXPECT_EQ(both.comparison.first, stated ? "wls" : "ols");
+    EXPECT_EQ(both.comparison.second, "friction");
+    EXPECT_LT(both.comparison.delta_aic, -10.0);
+    EXPECT_LT(both.comparison.delta_bic, -10.0);
+    EXPECT_GT(both.comparison.akaike_weight_second, 0.99);
+    EXPECT_NE(both.comparison.verdict.find("prefer friction"), std::string::npos);
+    // The line is fitted against X = x_eq of each scene.
+    EXPECT_EQ(both.line.n, d.size());
+  }
+}
+
+TEST(Friction, RodsAndSpheresShareOneFit) {
+  // Spheroid on rods (numeric derivatives), sphere on rods and spheres on line rails (autodiff
+  // through the closed form of a sphere of radius R + r), and the lab spheroid.
+  std::vector<Scene> scenes;
+  for (double D : {110.0, 150.0, 190.0}) {
+    scenes.push_back(LabScene(1165.0, D, 0.003));
+    scenes.push_back(LabScene(1165.0, D, 0.003, Body::Sphere(0.0127)));
+    scenes.push_back(LabScene(1165.0, D, 0.0, Body::Sphere(0.0127)));
+    scenes.push_back(LabScene(1165.0, D));
+  }
+  const double mu = 0.01;
+  const FitReport fit = FitFriction(Synthetic(scenes, mu, 0.0, 5));
+  EXPECT_TRUE(RelNear(fit.Parameter("mu").value, mu, 1e-8));
+  EXPECT_TRUE(HasNote(fit, "numeric derivatives"));
+  const FitReport noisy = FitFriction(Synthetic(scenes, mu, 2e-5, 6));
+  EXPECT_LT(std::abs(noisy.Parameter("mu").value - mu), 3.0 * noisy.Parameter("mu").se_unscaled);
+}
+
+TEST(Friction, CovarianceMatchesAnAnalyticGaussNewtonOne) {
+  // x_rest(μ) = x_max·K/sqrt(PA² + K²), K = B + μ(1 + A²):
+  // dx/dμ = x_max·PA²(1 + A²)/(PA² + K²)^(3/2). Var(μ) = 1/Σ (dx_i/dμ / u_i)², and at the
+  // optimum Σ (dx_i/dμ)·r_i/u_i² = 0.
+  const FrictionData d = Synthetic(LabScenes(), 0.008, 2e-5, 7);
+  const FitReport fit = FitFriction(d);
+  const double mu = fit.Parameter("mu").value;
+  long double information = 0, gradient = 0, scale = 0;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const Rails& rails = d.scenes[i].rails();
+    const SpheroidOnLineRails<long double> path(kA, kB, rails.tan_theta, rails.tan_half_alpha);
+    const long double A2 = path.A() * path.A(), PA2 = path.P() * A2;
+    const long double K = rails.tan_theta + mu * (1 + A2);
+    const long double dx = path.x_max() * PA2 * (1 + A2) / std::pow(PA2 + K * K, 1.5L);
+    const long double r = d.y[i] - path.RestX(mu);
+    information += dx * dx / (static_cast<long double>(d.u_y[i]) * d.u_y[i]);
+    gradient += dx * r / (static_cast<long double>(d.u_y[i]) * d.u_y[i]);
+    scale += std::fabs(dx * d.y[i]) / (static_cast<long double>(d.u_y[i]) * d.u_y[i]);
+  }
+  EXPECT_TRUE(RelNear(fit.covariance(0, 0), static_cast<double>(1.0L / information), 1e-9));
+  EXPECT_LT(std::fabs(gradient), 1e-12 * scale);
+}
+
+TEST(Friction, MuAtItsBoundIsSaidSo) {
+  // Y below x_eq everywhere (μ would be negative): μ = 0 with a note.
+  FrictionData d = Synthetic(LabScenes(), 0.0, 0.0, 8);
+  for (double& y : d.y) y -= 1e-4;
+  const FitReport fit = FitFriction(d);
+  EXPECT_EQ(fit.Parameter("mu").value, 0.0);
+  EXPECT_TRUE(HasNote(fit, "bound 0"));
+}
+
+TEST(Friction, HardCasesAreRefusedClearly) {
+  const FrictionData good = Synthetic(LabScenes(), 0.008, 2e-5, 9);
+  ExpectInputError([] { FitFriction(FrictionData{}); }, "rows");
+  FrictionData d = good;
+  d.y.pop_back();
+  ExpectInputError([&] { FitFriction(d); }, "Y");
+  d = good;
+  d.y[0] = std::nan("");
+  ExpectInputError([&] { FitFriction(d); }, "Y[0]");
+  d = good;
+  d.u_y[3] = 0.0;
+  ExpectInputError([&] { FitFriction(d); }, "u(Y)[3]");
+  d = good;
+  d.scenes[1] = LabScene(1165.0, 150.0, 0.0, Body::DoubleCone(0.03, 0.05));
+  ExpectInputError([&] { FitFriction(d); }, "scene[1]");
+  // One setting, repeated: μ and s cannot both be determined.
+  FrictionData same = Synthetic({LabScene(1165, 150), LabScene(1165, 150), LabScene(1165, 150)},
+                                0.008, 2e-5, 10);
+  FrictionOptions with_scale;
+  with_scale.fit_scale = true;
+  ExpectInputError([&] { FitFriction(same, with_scale); }, "scenes");
+  FrictionOptions bad_start;
+  bad_start.mu_start = -0.1;
+  ExpectInputError([&] { FitFriction(good, bad_start); }, "mu start");
+  // One row, one parameter: exact, flagged.
+  const FitReport one = FitFriction(Synthetic({LabScene(1165, 150)}, 0.008, 0.0, 11));
+  EXPECT_TRUE(one.exact);
+  EXPECT_TRUE(RelNear(one.Parameter("mu").value, 0.008, 1e-10));
+  EXPECT_TRUE(HasNote(one, "exact fit"));
+}
+
+}  // namespace
+}  // namespace uphill

@@ -1,0 +1,133 @@
+#!/usr/bin/python3
+"""NumPy peer of `uphill bench convert`: the same conversion and the same Monte Carlo, vectorised.
+
+Run by `uphill bench convert` as a subprocess (it is also usable by hand):
+
+  numpy_convert.py convert IN.npy OUT.npy [--repeats K]
+      IN.npy: float64 array of shape (3, n) holding L, H, D (metres, horizontal convention);
+      computes θ, α (rad) and X = x_eq (m) of the spheroid --a/--b on line rails and saves them to
+      OUT.npy, shape (3, n). The formulas are uphill's (src/model/batch_convert.hpp):
+      B = H/L, T = D/(2L), θ = atan(B), α = 2 atan(T), A = a·T/b, X = a·B/(A·hypot(A, B)).
+  numpy_convert.py mc --trials M --seed S [--repeats K]
+      GUM Supplement 1 Monte Carlo of the lab case below: Gaussian L, H, D, a, b; θ, α, φ, X, x_max;
+      per output the mean, the standard deviation (ddof 1) and the probabilistically symmetric 95 %
+      interval from order statistics (np.partition), as uphill's propagation reports them.
+
+Prints one JSON object on stdout: timings (best of K repeats, seconds) and, for mc, the statistics.
+Written to be a fair, tuned NumPy baseline: float64 throughout, in-place ufuncs with out= to avoid
+temporaries, atan of the ratios (cheaper than arctan2 here), one np.partition per output for both
+ends of the interval.
+"""
+import argparse
+import json
+import sys
+import time
+
+import numpy as np
+
+LAB = {  # the lab spheroid and a plausible set of measurement uncertainties (metres)
+    "L": (1.165, 0.002), "H": (0.300, 0.001), "D": (0.045, 0.0005),
+    "a": (0.015875, 2e-5), "b": (0.0254, 2e-5),
+}
+
+
+def convert(L, H, D, a, b):
+    B = np.divide(H, L)
+    T = np.multiply(L, 2.0)
+    np.divide(D, T, out=T)
+    theta = np.arctan(B)
+    alpha = np.arctan(T)
+    alpha *= 2.0
+    A = np.multiply(T, a)
+    A /= b
+    h = np.hypot(A, B)
+    h *= A
+    X = np.multiply(B, a)
+    X /= h
+    return theta, alpha, X
+
+
+def monte_carlo(trials, seed, coverage=0.95):
+    rng = np.random.default_rng(seed)
+    draws = {}
+    for name in ("L", "H", "D", "a", "b"):
+        value, u = LAB[name]
+        x = rng.standard_normal(trials)
+        x *= u
+        x += value
+        draws[name] = x
+    L, H, D, a, b = (draws[k] for k in ("L", "H", "D", "a", "b"))
+    # Screen unphysical draws as uphill does (none are expected for these uncertainties).
+    ok = (L > 0) & (H >= 0) & (D > 0) & (a > 0) & (b > 0)
+    if not ok.all():
+        L, H, D, a, b = L[ok], H[ok], D[ok], a[ok], b[ok]
+    B = np.divide(H, L)
+    T = np.multiply(L, 2.0)
+    np.divide(D, T, out=T)
+    theta = np.arctan(B)
+    alpha = np.arctan(T)
+    alpha *= 2.0
+    sec = np.hypot(1.0, B)
+    phi = np.divide(T, sec)
+    np.arctan(phi, out=phi)
+    A = np.multiply(a, T)
+    A /= b
+    h = np.hypot(A, B)
+    h *= A
+    x_eq = np.multiply(a, B)
+    x_eq /= h
+    x_max = np.divide(b, T)
+    np.hypot(a, x_max, out=x_max)
+    m = theta.size
+    pm = coverage * m
+    q = int(pm) if float(int(pm)) == pm else int(pm + 0.5)
+    r = max((m - q + 1) // 2, 1)
+    hi = min(r + q, m)
+    stats = {}
+    for name, y in (("theta", theta), ("alpha", alpha), ("phi", phi), ("x_eq", x_eq),
+                    ("x_max", x_max)):
+        part = np.partition(y, (r - 1, hi - 1))
+        stats[name] = {"mean": float(y.mean()), "u": float(y.std(ddof=1)),
+                       "low": float(part[r - 1]), "high": float(part[hi - 1])}
+    return stats, int(trials - m)
+
+
+def best_of(repeats, fn):
+    best, result = float("inf"), None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        result = fn()
+        best = min(best, time.perf_counter() - t0)
+    return best, result
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = ap.add_subparsers(dest="mode", required=True)
+    c = sub.add_parser("convert")
+    c.add_argument("input")
+    c.add_argument("output")
+    c.add_argument("--a", type=float, default=LAB["a"][0])
+    c.add_argument("--b", type=float, default=LAB["b"][0])
+    c.add_argument("--repeats", type=int, default=3)
+    m = sub.add_parser("mc")
+    m.add_argument("--trials", type=int, default=1_000_000)
+    m.add_argument("--seed", type=int, default=1)
+    m.add_argument("--repeats", type=int, default=3)
+    args = ap.parse_args()
+    info = {"numpy": np.__version__, "python": sys.version.split()[0]}
+    if args.mode == "convert":
+        L, H, D = np.load(args.input)
+        seconds, (theta, alpha, X) = best_of(args.repeats, lambda: convert(L, H, D, args.a, args.b))
+        np.save(args.output, np.stack((theta, alpha, X)))
+        info.update(mode="convert", n=int(L.size), seconds=seconds, repeats=args.repeats)
+    else:
+        seconds, (stats, rejected) = best_of(args.repeats, lambda: monte_carlo(args.trials, args.seed))
+        info.update(mode="mc", trials=args.trials, seconds=seconds, repeats=args.repeats,
+                    rejected=rejected, stats=stats, inputs=LAB)
+    json.dump(info, sys.stdout)
+    sys.stdout.write("\n")
+
+
+if __name__ == "__main__":
+    main()

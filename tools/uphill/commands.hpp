@@ -1,0 +1,21 @@
+// The subcommands of the `uphill` program. Each lives in its own file and adds itself to the
+// application here; main.cpp only wires them together and maps errors to exit codes.
+//
+// Exit codes (documented in README.md): 0 success; 1 internal error; 2 bad input (a flag, a
+// file, a row or a column), with a one-line message naming it and the rule broken.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace uphill::cli {
+
+// Exit status of a subcommand run, set by the subcommand's callback.
+int& ExitStatus();
+
+void AddConvertCommand(CLI::App& app);
+void AddBenchCommand(CLI::App& app);
+
+// `uphill bench <what>`: each benchmark adds itself to the bench subcommand.
+void AddBenchConvert(CLI::App& bench);
+
+}  // namespace uphill::cli

@@ -1,0 +1,152 @@
+// `uphill convert`: apparatus measurements (L, H, D) or angles → θ, α, φ, X, x_max, the rest
+// band, points on the path, uncertainties, and a plain-language verdict. One configuration from
+// flags, or a CSV batch (file or stdin) in which each row is one configuration and the flags
+// supply defaults for absent columns.
+#include <iostream>
+
+#include "commands.hpp"
+#include "convert_output.hpp"
+#include "io/csv_table.hpp"
+#include "io/units.hpp"
+#include "model/input_error.hpp"
+#include "scene_flags.hpp"
+
+namespace uphill::cli {
+namespace {
+
+struct ConvertFlags {
+  SceneFlags scene;
+  std::string batch;
+  std::string at_x;
+  std::string mu;
+  bool csv = false;
+  bool json = false;
+  std::string length_unit = "mm";
+  std::uint64_t mc_trials = 1000000;
+  std::uint64_t seed = 20261121;
+};
+
+std::vector<double> ParseLengthList(const std::string& text, const std::string& flag) {
+  std::vector<double> out;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t comma = text.find(',', start);
+    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    out.push_back(io::ParseQuantity(item, io::Dimension::kLength, flag));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+io::ConversionOptions Options(const ConvertFlags& f) {
+  io::ConversionOptions o;
+  if (io::UnitFactor(io::Dimension::kLength, f.length_unit) == 0.0)
+    throw InputError("--length-unit", "must be one of " + io::AcceptedUnits(io::Dimension::kLength));
+  o.length_unit = f.length_unit;
+  if (!f.at_x.empty()) o.at_x = ParseLengthList(f.at_x, "--at-x");
+  if (!f.mu.empty()) o.mu = io::ParseQuantity(f.mu, io::Dimension::kDimensionless, "--mu");
+  if (f.mc_trials < 100) throw InputError("--mc-trials", "must be at least 100");
+  o.propagation.trials = f.mc_trials;
+  o.propagation.seed = f.seed;
+  return o;
+}
+
+// A batch row as a field source: the row's non-empty cells, then the flags as defaults.
+io::FieldSource RowSource(const io::CsvTable& table, const io::CsvRow& row, const SceneFlags& flags,
+                          const std::map<std::string, int>& field_column) {
+  const io::FieldSource defaults = FlagSource(flags);
+  io::FieldSource source;
+  source.lookup = [&, defaults](const std::string& name) -> std::optional<io::FieldSource::Field> {
+    if (auto it = field_column.find(name); it != field_column.end()) {
+      const std::string& cell = row.cells[it->second];
+      if (cell.find_first_not_of(" \t") != std::string::npos)
+        return io::FieldSource::Field{cell, io::SplitUnitSuffix(table.header[it->second]).second};
+    }
+    return defaults.lookup(name);
+  };
+  source.context = [&, defaults](const std::string& name) {
+    if (auto it = field_column.find(name); it != field_column.end())
+      return io::CellContext(table, row.row, table.header[it->second]);
+    return table.source + ", row " + std::to_string(row.row) + ": " + defaults.context(name);
+  };
+  return source;
+}
+
+std::vector<ConvertedRow> ConvertBatch(const ConvertFlags& f, const io::ConversionOptions& options) {
+  const io::CsvTable table = io::ReadCsvFile(f.batch);
+  const auto& known = io::ConfigurationFieldNames();
+  std::map<std::string, int> field_column;
+  for (size_t i = 0; i < table.header.size(); ++i) {
+    const std::string base = io::SplitUnitSuffix(table.header[i]).first;
+    if (base == "note") continue;
+    if (std::find(known.begin(), known.end(), base) == known.end())
+      throw InputError(table.source + ", row 1, column " + table.header[i],
+                       "unknown column (see README.md, 'Batch CSV of convert', for the accepted names)");
+    if (!field_column.emplace(base, static_cast<int>(i)).second)
+      throw InputError(table.source + ", row 1, column " + table.header[i],
+                       "gives '" + base + "' a second time");
+  }
+  if (table.rows.empty()) throw InputError(table.source, "has a header but no data rows");
+  std::vector<ConvertedRow> rows;
+  for (const io::CsvRow& row : table.rows) {
+    ConvertedRow out;
+    out.row = row.row;
+    try {
+      if (!row.error.empty()) throw InputError(table.source + ", row " + std::to_string(row.row), row.error);
+      const io::Configuration c = io::ParseConfiguration(RowSource(table, row, f.scene, field_column));
+      try {
+        out.result = io::Convert(c, options);
+      } catch (const InputError& e) {
+        throw InputError(table.source + ", row " + std::to_string(row.row) + ": " + e.quantity(), e.rule());
+      }
+    } catch (const InputError& e) {
+      out.error = e.what();
+    }
+    rows.push_back(std::move(out));
+  }
+  return rows;
+}
+
+void Run(const ConvertFlags& f) {
+  const io::ConversionOptions options = Options(f);
+  std::vector<ConvertedRow> rows;
+  const bool batch = !f.batch.empty();
+  if (batch) {
+    rows = ConvertBatch(f, options);
+  } else {
+    ConvertedRow row;
+    row.result = io::Convert(io::ParseConfiguration(FlagSource(f.scene)), options);
+    rows.push_back(std::move(row));
+  }
+  const OutputFormat format = f.json ? OutputFormat::kJson : f.csv ? OutputFormat::kCsv : OutputFormat::kTable;
+  PrintConversion(std::cout, rows, format, batch, f.length_unit);
+  for (const auto& row : rows) {
+    if (row.error.empty()) continue;
+    std::cerr << "uphill: " << row.error << "\n";
+    ExitStatus() = 2;
+  }
+}
+
+}  // namespace
+
+void AddConvertCommand(CLI::App& app) {
+  auto flags = std::make_shared<ConvertFlags>();
+  CLI::App* cmd = app.add_subcommand(
+      "convert", "Apparatus measurements (L, H, D) or angles -> theta, alpha, X, x_max, rest band");
+  AddSceneFlags(cmd, &flags->scene);
+  cmd->add_option("--batch", flags->batch,
+                  "CSV file (or - for stdin), one configuration per row; flags give defaults");
+  cmd->add_option("--at-x", flags->at_x, "positions for the path, comma-separated, with unit");
+  cmd->add_option("--mu", flags->mu, "rolling-resistance coefficient (rest band where |dz/dx| <= mu)");
+  cmd->add_flag("--csv", flags->csv, "CSV output (units named in the header)");
+  cmd->add_flag("--json", flags->json, "JSON output (SI units; see README)");
+  cmd->add_option("--length-unit", flags->length_unit, "length unit of table and CSV: mm, cm, m, in")
+      ->capture_default_str();
+  cmd->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials for the uncertainties")
+      ->capture_default_str();
+  cmd->add_option("--seed", flags->seed, "Monte Carlo seed (same seed, same numbers)")->capture_default_str();
+  cmd->callback([flags] { Run(*flags); });
+}
+
+}  // namespace uphill::cli

@@ -1,0 +1,33 @@
+// uphill: analysis toolkit for the "rolling uphill" rail apparatus. See README.md.
+#include <iostream>
+
+#include "commands.hpp"
+#include "model/input_error.hpp"
+
+namespace uphill::cli {
+int& ExitStatus() {
+  static int status = 0;
+  return status;
+}
+}  // namespace uphill::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{"uphill: analysis toolkit for the rolling-uphill rail apparatus"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "uphill 0.1.0");
+  uphill::cli::AddConvertCommand(app);
+  uphill::cli::AddBenchCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  } catch (const uphill::InputError& e) {
+    std::cerr << "uphill: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "uphill: internal error: " << e.what() << "\n";
+    return 1;
+  }
+  return uphill::cli::ExitStatus();
+}
