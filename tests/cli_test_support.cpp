@@ -1,6 +1,10 @@
 #include "cli_test_support.hpp"
 
 #include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <stdexcept>
 
 #include <filesystem>
 #include <fstream>
@@ -17,15 +21,11 @@ std::string Slurp(const std::string& path) {
 }
 }  // namespace
 
-std::string TempDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("uphill_test_" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
-
 CommandResult RunUphill(const std::string& args, const std::string& input) {
-  const std::string dir = TempDir("run");
+  // A directory of its own per call: ctest runs test programs in parallel.
+  std::string pattern = (std::filesystem::temp_directory_path() / "uphill_run_XXXXXX").string();
+  if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+  const std::string dir = pattern;
   const std::string in_path = dir + "/stdin", out_path = dir + "/stdout", err_path = dir + "/stderr";
   std::ofstream(in_path) << input;
   const std::string command = std::string(UPHILL_PROGRAM) + " " + args + " < " + in_path + " > " +
@@ -35,6 +35,7 @@ CommandResult RunUphill(const std::string& args, const std::string& input) {
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
   r.out = Slurp(out_path);
   r.err = Slurp(err_path);
+  std::filesystem::remove_all(dir);
   return r;
 }
 

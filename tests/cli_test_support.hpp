@@ -13,7 +13,4 @@ struct CommandResult {
 // `args` is appended to the program path and run by /bin/sh; stdin from `input` if non-empty.
 CommandResult RunUphill(const std::string& args, const std::string& input = "");
 
-// A fresh empty directory under the system's temporary directory.
-std::string TempDir(const std::string& name);
-
 }  // namespace uphill::testing

@@ -21,7 +21,8 @@ constexpr double kA = 0.015875, kB = 0.0254, kH = 0.300;
 
 Scene LabScene(double L_mm, double D_mm, double rod_radius = 0.0,
                const Body& body = Body::Spheroid(kA, kB)) {
-  return Scene(body, Rails::FromApparatus(L_mm / 1000.0, kH, D_mm / 1000.0, LConvention::kHorizontal),
+  return Scene(body,
+               Rails::FromApparatus(L_mm / 1000.0, kH, D_mm / 1000.0, LConvention::kHorizontal),
                rod_radius);
 }
 
@@ -88,20 +89,39 @@ TEST(Friction, NoiseFreeDataGiveMuBackFromAnyStart) {
 }
 
 TEST(Friction, RecoversMuWithinItsStandardError) {
-  const double mu = 0.008;
-  const FrictionData d = Synthetic(LabScenes(), mu, 2e-5, 2);  // u(Y) = 0.02 mm
+  // One realisation (u(Y) = 0.02 mm) ...
+  const double mu = 0.008, u = 2e-5;
+  const FrictionData d = Synthetic(LabScenes(), mu, u, 2);
   const FitReport fit = FitFriction(d);
   const ParameterEstimate& p = fit.Parameter("mu");
   std::printf("  mu = %.6g ± %.2g (true %.6g), chi2/nu = %.3f\n", p.value, p.se_unscaled, mu,
               *fit.reduced_chi2);
-  EXPECT_LT(std::abs(p.value - mu), 2.0 * p.se_unscaled);
-  EXPECT_LT(p.se_unscaled, 0.1 * mu);  // μ is well determined by such data
+  EXPECT_LT(std::abs(p.value - mu), 3.0 * p.se_unscaled);
+  EXPECT_LT(p.se_unscaled, 0.05 * mu);  // μ is well determined by such data
   EXPECT_EQ(fit.primary_scaling, ErrorScaling::kUnscaled);
   ASSERT_TRUE(fit.p_value);
   EXPECT_GT(*fit.p_value, 0.001);
   // The reported rows are the Scene's own rest positions at the fitted μ.
   for (const RowResult& row : fit.rows)
     EXPECT_EQ(row.fitted, d.scenes[row.row].Rest(p.value)->high);
+  // ... and 200: "within its standard error" is a statement about the distribution of
+  // (μ̂ − μ)/σ_μ, which must be close to a standard normal: mean 0, SD 1, 68 % within ±1.
+  const int trials = 200;
+  double sum = 0, sum2 = 0;
+  int within = 0;
+  for (int t = 0; t < trials; ++t) {
+    const FitReport f = FitFriction(Synthetic(LabScenes(), mu, u, 1000 + t));
+    const double pull = (f.Parameter("mu").value - mu) / f.Parameter("mu").se_unscaled;
+    sum += pull;
+    sum2 += pull * pull;
+    within += std::abs(pull) < 1.0;
+  }
+  const double mean = sum / trials, sd = std::sqrt(sum2 / trials - mean * mean);
+  std::printf("  pulls over %d trials: mean %.3f, SD %.3f, %d%% within 1 sigma\n", trials, mean, sd,
+              100 * within / trials);
+  EXPECT_NEAR(mean, 0.0, 0.25);  // 3.5 × 1/sqrt(200)
+  EXPECT_NEAR(sd, 1.0, 0.15);
+  EXPECT_NEAR(within / static_cast<double>(trials), 0.683, 0.1);
 }
 
 TEST(Friction, FitsAScaleFactor) {
@@ -121,22 +141,35 @@ TEST(Friction, FitsAScaleFactor) {
 }
 
 TEST(Friction, PreferredOverTheStraightLineByAicAndBic) {
+  // Over the lab's settings the straight line Y = k·X + c mimics x_rest(μ) closely: noise-free
+  // at μ = 0.008 it misses by χ² ≈ 12 for u(Y) = 0.02 mm. With u(Y) = 0.01 mm the friction
+  // model wins decisively.
   for (const bool stated : {true, false}) {
     SCOPED_TRACE(stated ? "u(Y) given" : "scatter estimated");
-    FrictionData d = Synthetic(LabScenes(), 0.008, 2e-5, 4);
+    FrictionData d = Synthetic(LabScenes(), 0.008, 1e-5, 4);
     if (!stated) d.u_y.clear();
     const FrictionVersusLine both = CompareFrictionWithLine(d);
-    std::printf("  %s: chi2 line %.4g, friction %.4g; %s\n", stated ? "WLS" : "OLS",
-                both.line.chi2, both.friction.chi2, both.comparison.verdict.c_str());
+    std::printf("  %s: chi2 line %.4g, friction %.4g; %s\n", stated ? "WLS" : "OLS", both.line.chi2,
+                both.friction.chi2, both.comparison.verdict.c_str());
     EXPECT_EQ(both.comparison.first, stated ? "wls" : "ols");
     EXPECT_EQ(both.comparison.second, "friction");
     EXPECT_LT(both.comparison.delta_aic, -10.0);
     EXPECT_LT(both.comparison.delta_bic, -10.0);
     EXPECT_GT(both.comparison.akaike_weight_second, 0.99);
     EXPECT_NE(both.comparison.verdict.find("prefer friction"), std::string::npos);
-    // The line is fitted against X = x_eq of each scene.
     EXPECT_EQ(both.line.n, d.size());
+    if (stated) {
+      // Same σ_i: ΔAIC = Δχ² + 2Δp, ΔBIC = Δχ² + Δp·ln N.
+      EXPECT_NEAR(both.comparison.delta_aic, both.comparison.delta_chi2 - 2.0, 1e-9);
+      EXPECT_NEAR(both.comparison.delta_bic, both.comparison.delta_chi2 - std::log(15.0), 1e-9);
+    }
   }
+  // Noise-free (Synthetic then states u(Y) = 0.02 mm): the line's misfit alone.
+  const FrictionVersusLine exact = CompareFrictionWithLine(Synthetic(LabScenes(), 0.008, 0.0, 4));
+  std::printf("  noise-free, u(Y) = 0.02 mm: line chi2 %.3g\n", exact.line.chi2);
+  EXPECT_LT(exact.friction.chi2, 1e-12);
+  EXPECT_GT(exact.line.chi2, 5.0);
+  EXPECT_LT(exact.comparison.delta_aic, -7.0);
 }
 
 TEST(Friction, RodsAndSpheresShareOneFit) {
@@ -159,25 +192,46 @@ TEST(Friction, RodsAndSpheresShareOneFit) {
 
 TEST(Friction, CovarianceMatchesAnAnalyticGaussNewtonOne) {
   // x_rest(μ) = x_max·K/sqrt(PA² + K²), K = B + μ(1 + A²):
-  // dx/dμ = x_max·PA²(1 + A²)/(PA² + K²)^(3/2). Var(μ) = 1/Σ (dx_i/dμ / u_i)², and at the
-  // optimum Σ (dx_i/dμ)·r_i/u_i² = 0.
-  const FrictionData d = Synthetic(LabScenes(), 0.008, 2e-5, 7);
-  const FitReport fit = FitFriction(d);
-  const double mu = fit.Parameter("mu").value;
-  long double information = 0, gradient = 0, scale = 0;
-  for (std::size_t i = 0; i < d.size(); ++i) {
-    const Rails& rails = d.scenes[i].rails();
-    const SpheroidOnLineRails<long double> path(kA, kB, rails.tan_theta, rails.tan_half_alpha);
-    const long double A2 = path.A() * path.A(), PA2 = path.P() * A2;
-    const long double K = rails.tan_theta + mu * (1 + A2);
-    const long double dx = path.x_max() * PA2 * (1 + A2) / std::pow(PA2 + K * K, 1.5L);
-    const long double r = d.y[i] - path.RestX(mu);
-    information += dx * dx / (static_cast<long double>(d.u_y[i]) * d.u_y[i]);
-    gradient += dx * r / (static_cast<long double>(d.u_y[i]) * d.u_y[i]);
-    scale += std::fabs(dx * d.y[i]) / (static_cast<long double>(d.u_y[i]) * d.u_y[i]);
+  // dx/dμ = x_max·PA²(1 + A²)/(PA² + K²)^(3/2). For Y = s·x_rest(μ) the Jacobian row is
+  // (s·dx/dμ, x_rest); the covariance is (Σ JᵢᵀJᵢ/u_i²)⁻¹, and at the optimum Σ Jᵢ·r_i/u_i² = 0.
+  for (const bool with_scale : {false, true}) {
+    SCOPED_TRACE(with_scale ? "mu and s" : "mu");
+    const FrictionData d = Synthetic(LabScenes(), 0.008, 2e-5, 7, with_scale ? 1.002 : 1.0);
+    FrictionOptions options;
+    options.fit_scale = with_scale;
+    const FitReport fit = FitFriction(d, options);
+    const long double mu = fit.Parameter("mu").value;
+    const long double s = with_scale ? fit.Parameter("s").value : 1.0;
+    long double h00 = 0, h01 = 0, h11 = 0, g0 = 0, g1 = 0, scale0 = 0, scale1 = 0;
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      const Rails& rails = d.scenes[i].rails();
+      const SpheroidOnLineRails<long double> path(kA, kB, rails.tan_theta, rails.tan_half_alpha);
+      const long double A2 = path.A() * path.A(), PA2 = path.P() * A2;
+      const long double K = rails.tan_theta + mu * (1 + A2);
+      const long double x = path.RestX(mu);
+      const long double j0 = s * path.x_max() * PA2 * (1 + A2) / std::pow(PA2 + K * K, 1.5L);
+      const long double j1 = x;
+      const long double w = 1.0L / (static_cast<long double>(d.u_y[i]) * d.u_y[i]);
+      const long double r = d.y[i] - s * x;
+      h00 += w * j0 * j0;
+      h01 += w * j0 * j1;
+      h11 += w * j1 * j1;
+      g0 += w * j0 * r;
+      g1 += w * j1 * r;
+      scale0 += w * std::fabs(j0 * d.y[i]);
+      scale1 += w * std::fabs(j1 * d.y[i]);
+    }
+    if (!with_scale) {
+      EXPECT_TRUE(RelNear(fit.covariance(0, 0), static_cast<double>(1.0L / h00), 1e-9));
+    } else {
+      const long double det = h00 * h11 - h01 * h01;
+      EXPECT_TRUE(RelNear(fit.covariance(0, 0), static_cast<double>(h11 / det), 1e-8));
+      EXPECT_TRUE(RelNear(fit.covariance(1, 1), static_cast<double>(h00 / det), 1e-8));
+      EXPECT_TRUE(RelNear(fit.covariance(0, 1), static_cast<double>(-h01 / det), 1e-8));
+      EXPECT_LT(std::fabs(g1), 1e-12 * scale1);
+    }
+    EXPECT_LT(std::fabs(g0), 1e-12 * scale0);
   }
-  EXPECT_TRUE(RelNear(fit.covariance(0, 0), static_cast<double>(1.0L / information), 1e-9));
-  EXPECT_LT(std::fabs(gradient), 1e-12 * scale);
 }
 
 TEST(Friction, MuAtItsBoundIsSaidSo) {
@@ -205,8 +259,8 @@ TEST(Friction, HardCasesAreRefusedClearly) {
   d.scenes[1] = LabScene(1165.0, 150.0, 0.0, Body::DoubleCone(0.03, 0.05));
   ExpectInputError([&] { FitFriction(d); }, "scene[1]");
   // One setting, repeated: μ and s cannot both be determined.
-  FrictionData same = Synthetic({LabScene(1165, 150), LabScene(1165, 150), LabScene(1165, 150)},
-                                0.008, 2e-5, 10);
+  FrictionData same =
+      Synthetic({LabScene(1165, 150), LabScene(1165, 150), LabScene(1165, 150)}, 0.008, 2e-5, 10);
   FrictionOptions with_scale;
   with_scale.fit_scale = true;
   ExpectInputError([&] { FitFriction(same, with_scale); }, "scenes");

@@ -6,11 +6,16 @@ namespace uphill {
 
 std::string MethodName(FitMethod method) {
   switch (method) {
-    case FitMethod::kOrdinaryLeastSquares: return "ols";
-    case FitMethod::kWeightedLeastSquares: return "wls";
-    case FitMethod::kErrorsInVariables: return "york";
-    case FitMethod::kRobust: return "robust";
-    case FitMethod::kFriction: return "friction";
+    case FitMethod::kOrdinaryLeastSquares:
+      return "ols";
+    case FitMethod::kWeightedLeastSquares:
+      return "wls";
+    case FitMethod::kErrorsInVariables:
+      return "york";
+    case FitMethod::kRobust:
+      return "robust";
+    case FitMethod::kFriction:
+      return "friction";
   }
   return "unknown";
 }
@@ -18,8 +23,8 @@ std::string MethodName(FitMethod method) {
 const ParameterEstimate& FitReport::Parameter(std::string_view name) const {
   for (const ParameterEstimate& p : parameters)
     if (p.name == name) return p;
-  throw std::out_of_range("fit " + MethodName(method) + " has no parameter '" +
-                          std::string(name) + "'");
+  throw std::out_of_range("fit " + MethodName(method) + " has no parameter '" + std::string(name) +
+                          "'");
 }
 
 std::optional<double> FitReport::StandardError(std::string_view name, ErrorScaling scaling) const {

@@ -54,13 +54,13 @@ struct ParameterEstimate {
 };
 
 struct RowResult {
-  std::size_t row = 0;        // index into the input
-  double fitted = 0.0;        // the model at this row (line: c + k·X_i)
-  double residual = 0.0;      // Y_i − fitted, computed from centred data (no cancellation)
-  double sigma = 0.0;         // the σ_i that normalises it (0 for an exact OLS fit)
-  double normalised = 0.0;    // residual/sigma (0 when sigma = 0)
-  double weight = 1.0;        // robust weight ρ'(s_i) (1 for non-robust fits)
-  bool outlier = false;       // |normalised| > outlier_threshold
+  std::size_t row = 0;      // index into the input
+  double fitted = 0.0;      // the model at this row (line: c + k·X_i)
+  double residual = 0.0;    // Y_i − fitted, computed from centred data (no cancellation)
+  double sigma = 0.0;       // the σ_i that normalises it (0 for an exact OLS fit)
+  double normalised = 0.0;  // residual/sigma (0 when sigma = 0)
+  double weight = 1.0;      // robust weight ρ'(s_i) (1 for non-robust fits)
+  bool outlier = false;     // |normalised| > outlier_threshold
 };
 
 // A row the robust fit trusts less than a plain least-squares fit would.
@@ -71,12 +71,12 @@ struct DownWeightedRow {
 };
 
 struct SolverInfo {
-  bool converged = false;        // Ceres terminated with CONVERGENCE
-  int iterations = 0;            // Ceres iterations (successful and unsuccessful steps)
+  bool converged = false;  // Ceres terminated with CONVERGENCE
+  int iterations = 0;      // Ceres iterations (successful and unsuccessful steps)
   bool seeded_with_closed_form = false;
-  int refinement_steps = 0;      // Gauss-Newton steps after Ceres (see FitOptions)
-  std::string termination;       // Ceres' termination type and message
-  double seconds = 0.0;          // Ceres' total time (solve only)
+  int refinement_steps = 0;  // Gauss-Newton steps after Ceres (see FitOptions)
+  std::string termination;   // Ceres' termination type and message
+  double seconds = 0.0;      // Ceres' total time (solve only)
 };
 
 struct FitReport {
@@ -86,7 +86,7 @@ struct FitReport {
   std::optional<Eigen::MatrixXd> covariance_scaled;  // × χ²/ν; absent when ν = 0
   Eigen::MatrixXd correlation;                       // the same for both conventions
   ErrorScaling primary_scaling = ErrorScaling::kUnscaled;
-  bool uses_stated_uncertainties = false;            // σ_i are the given u's (not estimated)
+  bool uses_stated_uncertainties = false;  // σ_i are the given u's (not estimated)
 
   std::size_t n = 0;  // rows
   int dof = 0;        // ν = n − number of parameters
@@ -99,9 +99,9 @@ struct FitReport {
 
   double outlier_threshold = 3.0;
   std::vector<RowResult> rows;
-  std::vector<std::size_t> outliers;           // rows with outlier = true, ascending
-  std::vector<DownWeightedRow> downweighted;   // robust fit only, ascending row
-  std::vector<std::string> notes;              // caveats in plain words (exact fit, bounds, ...)
+  std::vector<std::size_t> outliers;          // rows with outlier = true, ascending
+  std::vector<DownWeightedRow> downweighted;  // robust fit only, ascending row
+  std::vector<std::string> notes;             // caveats in plain words (exact fit, bounds, ...)
   SolverInfo solver;
 
   // The parameter called `name`; throws std::out_of_range if there is none.

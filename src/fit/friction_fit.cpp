@@ -88,10 +88,12 @@ void Validate(const FrictionData& data, std::size_t parameters) {
                                  " scenes, got " + std::to_string(data.u_y.size()) + ")");
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(data.y[i]))
-      throw InputError("Y[" + std::to_string(i) + "]", "must be finite (got " + Num(data.y[i]) + ")");
+      throw InputError("Y[" + std::to_string(i) + "]",
+                       "must be finite (got " + Num(data.y[i]) + ")");
     if (!data.u_y.empty() && !(std::isfinite(data.u_y[i]) && data.u_y[i] > 0.0))
-      throw InputError("u(Y)[" + std::to_string(i) + "]",
-                       "must be finite and > 0 for the friction fit (got " + Num(data.u_y[i]) + ")");
+      throw InputError(
+          "u(Y)[" + std::to_string(i) + "]",
+          "must be finite and > 0 for the friction fit (got " + Num(data.u_y[i]) + ")");
   }
 }
 
@@ -132,7 +134,8 @@ Rows Classify(const FrictionData& data) {
 // x_rest,i(μ) of row i from the fit's own geometry (what the cost functions evaluate).
 std::vector<double> FitRestX(const Rows& rows, std::size_t n, double mu) {
   std::vector<double> x(n);
-  for (std::size_t j = 0; j < rows.closed.size(); ++j) x[rows.closed_index[j]] = rows.closed[j].RestX(mu);
+  for (std::size_t j = 0; j < rows.closed.size(); ++j)
+    x[rows.closed_index[j]] = rows.closed[j].RestX(mu);
   for (std::size_t j = 0; j < rows.rods.size(); ++j) x[rows.rod_index[j]] = rows.rods[j].RestX(mu);
   return x;
 }
@@ -185,26 +188,31 @@ FitReport FitFrictionImpl(const FrictionData& data, const FrictionOptions& optio
     // The least-squares scale at μ0 (closed form), or 1.
     long double sxy = 0, sxx = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      const long double w = stated ? 1.0L / (static_cast<long double>(data.u_y[i]) * data.u_y[i]) : 1.0L;
+      const long double w =
+          stated ? 1.0L / (static_cast<long double>(data.u_y[i]) * data.u_y[i]) : 1.0L;
       sxy += w * x0[i] * data.y[i];
       sxx += w * x0[i] * x0[i];
     }
     theta[1] = fit.seed_with_closed_form && sxx > 0 ? static_cast<double>(sxy / sxx) : 1.0;
   }
 
-  ceres::Problem problem;
-  if (!rows.closed.empty())
-    problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<ClosedFormResiduals<P>, ceres::DYNAMIC, P>(
-            new ClosedFormResiduals<P>{&rows.closed, &rows.closed_y, &rows.closed_inv_sigma},
-            static_cast<int>(rows.closed.size())),
-        nullptr, theta.data());
-  if (!rows.rods.empty())
-    problem.AddResidualBlock(
+  ceres::Problem problem;  // owns the cost functions
+  std::vector<const ceres::CostFunction*> costs;
+  if (!rows.closed.empty()) {
+    auto* cost = new ceres::AutoDiffCostFunction<ClosedFormResiduals<P>, ceres::DYNAMIC, P>(
+        new ClosedFormResiduals<P>{&rows.closed, &rows.closed_y, &rows.closed_inv_sigma},
+        static_cast<int>(rows.closed.size()));
+    costs.push_back(cost);
+    problem.AddResidualBlock(cost, nullptr, theta.data());
+  }
+  if (!rows.rods.empty()) {
+    auto* cost =
         new ceres::NumericDiffCostFunction<RodResiduals<P>, ceres::CENTRAL, ceres::DYNAMIC, P>(
-            new RodResiduals<P>{&rows.rods, &rows.rod_y, &rows.rod_inv_sigma}, ceres::TAKE_OWNERSHIP,
-            static_cast<int>(rows.rods.size())),
-        nullptr, theta.data());
+            new RodResiduals<P>{&rows.rods, &rows.rod_y, &rows.rod_inv_sigma},
+            ceres::TAKE_OWNERSHIP, static_cast<int>(rows.rods.size()));
+    costs.push_back(cost);
+    problem.AddResidualBlock(cost, nullptr, theta.data());
+  }
   problem.SetParameterLowerBound(theta.data(), 0, 0.0);
 
   FitReport report;
@@ -213,8 +221,9 @@ FitReport FitFrictionImpl(const FrictionData& data, const FrictionOptions& optio
   report.uses_stated_uncertainties = stated;
   report.primary_scaling = stated ? ErrorScaling::kUnscaled : ErrorScaling::kScaled;
   report.outlier_threshold = fit.outlier_threshold;
-  report.solver = RunCeres(fit, fit.seed_with_closed_form || options.mu_start.has_value(), &problem);
-  report.solver.refinement_steps = RefineGaussNewton(&problem, theta.data(), P, 0.0);
+  report.solver =
+      RunCeres(fit, fit.seed_with_closed_form || options.mu_start.has_value(), &problem);
+  report.solver.refinement_steps = RefineGaussNewton(costs, theta.data(), P, 0.0);
 
   const auto covariance = CeresCovariance(&problem, theta.data(), P);
   if (!covariance)
@@ -254,12 +263,14 @@ FitReport FitFrictionImpl(const FrictionData& data, const FrictionOptions& optio
   Eigen::VectorXd values(P);
   values(0) = mu;
   if constexpr (P == 2) values(1) = scale;
-  FinishReport(report, P == 2 ? std::vector<std::string>{"mu", "s"} : std::vector<std::string>{"mu"},
+  FinishReport(report,
+               P == 2 ? std::vector<std::string>{"mu", "s"} : std::vector<std::string>{"mu"},
                values, stated);
   SetInformationCriteria(report, static_cast<double>(sum_log_sigma2));
   if (mu == 0.0)
-    report.notes.push_back("mu is at its bound 0: the covariance is that of the unconstrained "
-                           "problem; read the result as mu <= its standard error");
+    report.notes.push_back(
+        "mu is at its bound 0: the covariance is that of the unconstrained "
+        "problem; read the result as mu <= its standard error");
   if (!rows.rods.empty())
     report.notes.push_back(std::to_string(rows.rods.size()) +
                            " spheroid-on-rods rows use central numeric derivatives");

@@ -55,8 +55,8 @@ FitReport FitFriction(const FrictionData& data, const FrictionOptions& options =
 
 struct FrictionVersusLine {
   FitReport friction;
-  FitReport line;               // Y = k·x_eq + c on the same rows
-  ModelComparison comparison;   // first = line, second = friction
+  FitReport line;              // Y = k·x_eq + c on the same rows
+  ModelComparison comparison;  // first = line, second = friction
 };
 
 FrictionVersusLine CompareFrictionWithLine(const FrictionData& data,

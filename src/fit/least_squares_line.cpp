@@ -55,14 +55,13 @@ FitReport FitLeastSquares(const LineData& data, const FitOptions& options, bool 
     for (std::size_t i = 0; i < n; ++i) inv_sigma[i] = 1.0 / s.uy[i];
   }
 
-  Eigen::Vector2d theta = options.seed_with_closed_form ? ClosedFormLine(s, inv_sigma)
-                                                        : Eigen::Vector2d::Zero();
-  ceres::Problem problem;
-  problem.AddResidualBlock(
-      new ceres::AutoDiffCostFunction<LineResiduals, ceres::DYNAMIC, 2>(
-          new LineResiduals{s.x.data(), s.y.data(), weighted ? inv_sigma.data() : nullptr, n},
-          static_cast<int>(n)),
-      nullptr, theta.data());
+  Eigen::Vector2d theta =
+      options.seed_with_closed_form ? ClosedFormLine(s, inv_sigma) : Eigen::Vector2d::Zero();
+  ceres::Problem problem;  // owns the cost function
+  auto* cost = new ceres::AutoDiffCostFunction<LineResiduals, ceres::DYNAMIC, 2>(
+      new LineResiduals{s.x.data(), s.y.data(), weighted ? inv_sigma.data() : nullptr, n},
+      static_cast<int>(n));
+  problem.AddResidualBlock(cost, nullptr, theta.data());
 
   FitReport report;
   report.method = weighted ? FitMethod::kWeightedLeastSquares : FitMethod::kOrdinaryLeastSquares;
@@ -71,12 +70,13 @@ FitReport FitLeastSquares(const LineData& data, const FitOptions& options, bool 
   report.primary_scaling = weighted ? ErrorScaling::kUnscaled : ErrorScaling::kScaled;
   report.outlier_threshold = options.outlier_threshold;
   report.solver = RunCeres(options, options.seed_with_closed_form, &problem);
-  report.solver.refinement_steps = RefineGaussNewton(&problem, theta.data(), 2);
+  report.solver.refinement_steps = RefineGaussNewton({cost}, theta.data(), 2);
 
   const auto covariance_theta = CeresCovariance(&problem, theta.data(), 2);
   if (!covariance_theta)
-    throw InputError("X", "the values are too close together for a slope in binary64 "
-                          "(rank-deficient design)");
+    throw InputError("X",
+                     "the values are too close together for a slope in binary64 "
+                     "(rank-deficient design)");
   const LineParameters line = Unstandardise(s, theta, *covariance_theta);
   // Ceres' residuals are in units of sy for OLS; the unscaled OLS covariance means u(Y) = 1.
   report.covariance = weighted ? Eigen::MatrixXd(line.covariance)

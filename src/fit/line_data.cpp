@@ -16,7 +16,8 @@ std::string At(const std::string& column, std::size_t i) {
 
 void RequireFinite(const std::vector<double>& v, const std::string& column) {
   for (std::size_t i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v[i])) throw InputError(At(column, i), "must be finite (got " + Num(v[i]) + ")");
+    if (!std::isfinite(v[i]))
+      throw InputError(At(column, i), "must be finite (got " + Num(v[i]) + ")");
 }
 
 // The column must be present with one value per row, each finite and > 0 (or ≥ 0).
@@ -44,8 +45,8 @@ void ValidateLineData(const LineData& data, UncertaintyUse use, const std::strin
     throw InputError("Y", "must have one value per row of X (X has " + std::to_string(n) +
                               ", Y has " + std::to_string(data.y.size()) + ")");
   if (n < 2)
-    throw InputError("rows", "a straight-line fit needs at least 2 rows (got " +
-                                 std::to_string(n) + ")");
+    throw InputError("rows",
+                     "a straight-line fit needs at least 2 rows (got " + std::to_string(n) + ")");
   RequireFinite(data.x, "X");
   RequireFinite(data.y, "Y");
   bool all_equal = true;

@@ -30,7 +30,7 @@ struct LineData {
 
 // What a method requires of the uncertainty columns.
 enum class UncertaintyUse {
-  kNone,      // ignored (OLS)
+  kNone,       // ignored (OLS)
   kOptionalY,  // u(Y) used if given, then every u(Y_i) must be finite and > 0 (robust fit)
   kY,          // u(Y) required, finite and > 0 (WLS)
   kXY,         // u(Y) required, finite and > 0; u(X) required, finite and ≥ 0 (York)

@@ -29,15 +29,18 @@ void SetInformationCriteria(FitReport& report, double sum_log_sigma2) {
 
 ModelComparison CompareModels(const FitReport& first, const FitReport& second) {
   if (first.n != second.n)
-    throw InputError("fits", "compare fits of the same rows (" + std::to_string(first.n) +
-                                 " and " + std::to_string(second.n) + " rows)");
+    throw InputError("fits", "compare fits of the same rows (" + std::to_string(first.n) + " and " +
+                                 std::to_string(second.n) + " rows)");
   if (first.uses_stated_uncertainties != second.uses_stated_uncertainties)
-    throw InputError("fits", "compare fits that both use the stated u(Y) or both estimate the "
-                             "scatter (" + MethodName(first.method) + " and " +
-                             MethodName(second.method) + " differ)");
+    throw InputError("fits",
+                     "compare fits that both use the stated u(Y) or both estimate the "
+                     "scatter (" +
+                         MethodName(first.method) + " and " + MethodName(second.method) +
+                         " differ)");
   if (!first.aic || !first.bic || !second.aic || !second.bic)
-    throw InputError("fits", "AIC/BIC need a Gaussian likelihood with a non-zero scatter "
-                             "(not a robust fit, not an exact fit without stated u(Y))");
+    throw InputError("fits",
+                     "AIC/BIC need a Gaussian likelihood with a non-zero scatter "
+                     "(not a robust fit, not an exact fit without stated u(Y))");
   ModelComparison c;
   c.first = MethodName(first.method);
   c.second = MethodName(second.method);

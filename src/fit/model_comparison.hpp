@@ -26,7 +26,7 @@ struct ModelComparison {
   double delta_bic = 0.0;
   // exp(−ΔAIC/2)/(1 + exp(−ΔAIC/2)): the Akaike weight of the second model in the pair.
   double akaike_weight_second = 0.5;
-  std::string verdict;        // one line, e.g. "AIC and BIC prefer friction (ΔAIC = −12.3, ...)"
+  std::string verdict;  // one line, e.g. "AIC and BIC prefer friction (ΔAIC = −12.3, ...)"
 };
 
 // Throws InputError when the fits are not comparable (see above).

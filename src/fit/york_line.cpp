@@ -64,11 +64,10 @@ FitReport FitErrorsInVariables(const LineData& data, const FitOptions& options) 
       theta = ClosedFormLine(s, inv_sigma);
     }
   }
-  ceres::Problem problem;
-  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<YorkResiduals, ceres::DYNAMIC, 2>(
-                               new YorkResiduals{s.x.data(), s.y.data(), uy2.data(), ux2.data(), n},
-                               static_cast<int>(n)),
-                           nullptr, theta.data());
+  ceres::Problem problem;  // owns the cost function
+  auto* cost = new ceres::AutoDiffCostFunction<YorkResiduals, ceres::DYNAMIC, 2>(
+      new YorkResiduals{s.x.data(), s.y.data(), uy2.data(), ux2.data(), n}, static_cast<int>(n));
+  problem.AddResidualBlock(cost, nullptr, theta.data());
 
   FitReport report;
   report.method = FitMethod::kErrorsInVariables;
@@ -77,13 +76,14 @@ FitReport FitErrorsInVariables(const LineData& data, const FitOptions& options) 
   report.primary_scaling = ErrorScaling::kUnscaled;
   report.outlier_threshold = options.outlier_threshold;
   report.solver = RunCeres(options, options.seed_with_closed_form, &problem);
-  report.solver.refinement_steps = RefineGaussNewton(&problem, theta.data(), 2);
+  report.solver.refinement_steps = RefineGaussNewton({cost}, theta.data(), 2);
 
   // At the solution JᵀJ is York's information Σ W_i (ξ_i, 1)ᵀ(ξ_i, 1) (see the header).
   const auto covariance_theta = CeresCovariance(&problem, theta.data(), 2);
   if (!covariance_theta)
-    throw InputError("X", "the values are too close together for a slope in binary64 "
-                          "(rank-deficient design)");
+    throw InputError("X",
+                     "the values are too close together for a slope in binary64 "
+                     "(rank-deficient design)");
   const LineParameters line = Unstandardise(s, theta, *covariance_theta);
   report.covariance = line.covariance;
 

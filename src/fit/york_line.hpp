@@ -8,7 +8,9 @@
 // York's criterion; his iterative equations are its stationarity conditions. Ceres minimises S
 // as a sum of squares of r_i = (Y_i − c − k·X_i)/sqrt(u(Y_i)² + k²u(X_i)²) (AutoDiffCostFunction,
 // one block of N residuals: O(N) per iteration, no N×N matrix). Seed: weighted least squares
-// followed by two effective-variance iterations (closed forms, O(N)).
+// followed by two effective-variance iterations (closed forms, O(N)); after Ceres, Gauss-Newton
+// refinement on the same cost function (fit_options.hpp). The result agrees with York's own
+// iteration, carried out in long double, to 1e-13 (line) and 1e-12 (covariance) (tests).
 //
 // Standard errors. The Jacobian of r_i is −sqrt(W_i)·(ξ_i, 1), W_i = 1/(u(Y)² + k²u(X)²) and
 // ξ_i = X_i + k·u(X_i)²·W_i·(Y_i − c − k·X_i) the adjusted (least-squares estimate of the true)

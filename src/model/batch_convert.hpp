@@ -82,9 +82,10 @@ void DoubleConeBatch(std::size_t n, const double* R, const double* h, const doub
                      BatchKernel kernel = BatchKernel::kAuto);
 
 // The converter's common case in one pass: crossbar L, H, D (metres, horizontal convention) to
-// θ, α (rad) and X = x_eq (m) of one spheroid (semi-axes a, b, m) on line rails. Processes the
-// arrays in L1-sized blocks (the intermediates never leave the cache). Same numbers as
-// RailsFromApparatusBatch followed by SpheroidBatch. Outputs may be null.
+// θ, α (rad) and X = x_eq (m) of one spheroid (semi-axes a, b, m) on line rails. Outputs may be
+// null. kScalar: the model's expressions, bit for bit. kAvx2: the same quantities arranged for two
+// divisions per configuration (X = 2b·H·L/(D·sqrt((aD/2b)² + H²)), θ = atan(H·(1/L)), …), within
+// a few ulp of the model. This is the path `uphill bench convert` times.
 void ConvertApparatusBatch(std::size_t n, const double* L, const double* H, const double* D,
                            double a, double b, double* theta, double* alpha, double* x_eq,
                            BatchKernel kernel = BatchKernel::kAuto);

@@ -5,7 +5,11 @@
 // line z = A − B·x. The paper's forms are 0/0 at s = 1; these are identical and stable:
 //   A = R·(1 + tan²θ)/(sqrt(Q) + k·tanθ·tan(α/2))
 //   B = (k·T − tanθ)(k·T + tanθ)/(k·T·sqrt(Q) + tanθ),   T = tan(α/2)
-// Contact (double root of the paper's eq. 11): x_M = (x + tanθ·z − R·k·T)/Q; R* = R − k·T·x_M.
+// Contact (double root of the paper's eq. 11): x_M = (x + tanθ·z − R·k·T)/Q; R* = R − k·T·x_M,
+// evaluated as R* = k·T·(k·T + tanθ·√Q)·(x_fall − x)/(√Q·(k·T·√Q + tanθ)) (x_M is linear in x
+// and reaches h/T at x_fall; 1 − tanθ·B = √Q·(k·T + tanθ·√Q)/(k·T·√Q + tanθ)): a product of
+// positive factors, exactly 0 at x_fall and never negative on the path. (R − k·T·x_M cancels
+// there: it gave |R*(x_fall)| up to 3e-12·R, negative in a quarter of random cases.)
 // Critical inclination at fixed α: tanθ0 = k·T; it rolls up (centre descends as x grows)
 // iff θ < θ0 ⇔ B > 0. At fixed 3-D opening 2φ the critical inclination is asin(tanφ·k)
 // (the paper's tanθ0 = tanφ·tanψ/sqrt(1 − tan²φ·tan²ψ)), undefined when tanφ·k ≥ 1.
@@ -13,7 +17,8 @@
 // x_low = (R·k·T − tanθ·A)/(1 − tanθ·B) the cone rests on O.
 //
 // Accuracy: A, B, θ0 within a few ulp except where B itself is ill-conditioned (θ ≈ θ0:
-// relative error ≈ cond(B)·1e-16); R* loses digits only as the contact nears the apex.
+// relative error ≈ cond(B)·1e-16); R* within a few ulp relative up to the apex (x_fall − x is
+// exact near x_fall); x_M as written above, absolute error ~u·(|x| + tanθ·|z| + R·k·T)/Q.
 #pragma once
 
 #include <cmath>
@@ -34,6 +39,7 @@ class DoubleConeOnLineRails {
     B_ = (kT_ - tan_theta) * (kT_ + tan_theta) / (kT_ * sqrt_q + tan_theta);
     x_fall_ = h / T_;
     x_low_ = (R * kT_ - tan_theta * A_) / (1.0 - tan_theta * B_);
+    r_star_slope_ = kT_ * (kT_ + tan_theta * sqrt_q) / (sqrt_q * (kT_ * sqrt_q + tan_theta));
   }
 
   bool valid() const { return Q_ > 0.0; }  // otherwise the closed form does not apply
@@ -55,10 +61,10 @@ class DoubleConeOnLineRails {
   bool rolls_up() const { return B_ > 0.0; }
   T Z(const T& x) const { return A_ - B_ * x; }
   T ContactX(const T& x) const { return (x + tan_theta_ * Z(x) - R_ * kT_) / Q_; }
-  T RStar(const T& x) const { return R_ - kT_ * ContactX(x); }
+  T RStar(const T& x) const { return r_star_slope_ * (x_fall_ - x); }
 
  private:
-  T R_, tan_theta_, T_, k_, kT_, Q_, A_, B_, x_fall_, x_low_;
+  T R_, tan_theta_, T_, k_, kT_, Q_, A_, B_, x_fall_, x_low_, r_star_slope_;
 };
 
 }  // namespace uphill

@@ -179,12 +179,16 @@ void FirstOrder(const Problem& p, PropagatedValue (&out)[kOutCount]) {
   for (int i = 0; i < kNumInputs; ++i) x[i] = Jet(p.value[i], i);
   Jet y[kOutCount];
   ModelOutputs(p, x, y);
+  // The values from the same template on doubles: Jet division computes f·(1/g), an ulp away from
+  // f/g, and the reported value should be, to the bit, what the scalar model (Scene) gives.
+  double value[kOutCount];
+  ModelOutputs(p, p.value, value);
   for (int k = 0; k < kOutCount; ++k) {
     if (!HasOutput(p.body, k)) continue;
     PropagatedValue& v = out[k];
     v.name = kOutName[k];
     v.unit = kOutUnit[k];
-    v.value = y[k].a;
+    v.value = value[k];
     double sum = 0.0;
     for (int i = 0; i < kNumInputs; ++i) {
       if (!p.present[i]) continue;
@@ -202,9 +206,10 @@ void FirstOrder(const Problem& p, PropagatedValue (&out)[kOutCount]) {
 constexpr std::size_t kBlock = 1024;        // trials per block: the working set stays in L2
 constexpr std::uint64_t kPilot = 16 * kBlock;  // trials that place the coverage windows
 // Half-width of a coverage window in probability, in standard errors of the pilot's quantile
-// estimate (sqrt(p(1 − p)/pilot)): 6 makes a miss ≈ 2e-9 likely; a miss costs a rerun, not
-// accuracy.
-constexpr double kWindowSigmas = 6.0;
+// estimate (sqrt(p(1 − p)/pilot)): 4.5 makes a miss ≈ 7e-6 likely per window end, and a miss
+// costs a rerun (time), never accuracy; wider windows cost time on every run (~1 % of the values
+// are kept per window end).
+constexpr double kWindowSigmas = 4.5;
 
 // SplitMix64 (Steele, Lea, Flood 2014): decorrelated per-input seeds from one user seed.
 std::uint64_t SplitMix64(std::uint64_t z) {
@@ -248,25 +253,33 @@ void Neumaier(double* sum, double* comp, double x) {
   *sum = t;
 }
 
+// Two-lane vectors (GCC vector extensions: SSE2 on the baseline x86-64 target, generic code
+// elsewhere); lane-wise IEEE arithmetic, so the sums are the same on every machine.
+using V2d = double __attribute__((vector_size(16)));
+
 void AccumulateMoments(OutputStats& s, const double* y, std::size_t n) {
-  // Four independent partial sums in a fixed order (the same on every machine) that the
-  // compiler keeps in registers and vectorises.
-  const double shift = s.shift;
-  double a[4] = {0, 0, 0, 0}, b[4] = {0, 0, 0, 0};
+  // Four independent partial sums (two vectors of two) in a fixed order.
+  const V2d shift = {s.shift, s.shift};
+  V2d a0 = {0, 0}, a1 = {0, 0}, b0 = {0, 0}, b1 = {0, 0};
   std::size_t j = 0;
-  for (; j + 4 <= n; j += 4)
-    for (int l = 0; l < 4; ++l) {
-      const double d = y[j + l] - shift;
-      a[l] += d;
-      b[l] += d * d;
-    }
-  for (; j < n; ++j) {
-    const double d = y[j] - shift;
-    a[0] += d;
-    b[0] += d * d;
+  for (; j + 4 <= n; j += 4) {
+    V2d y0, y1;
+    std::memcpy(&y0, y + j, sizeof y0);
+    std::memcpy(&y1, y + j + 2, sizeof y1);
+    const V2d d0 = y0 - shift, d1 = y1 - shift;
+    a0 += d0;
+    a1 += d1;
+    b0 += d0 * d0;
+    b1 += d1 * d1;
   }
-  Neumaier(&s.sum, &s.sum_c, (a[0] + a[1]) + (a[2] + a[3]));
-  Neumaier(&s.sum2, &s.sum2_c, (b[0] + b[1]) + (b[2] + b[3]));
+  double a = (a0[0] + a0[1]) + (a1[0] + a1[1]), b = (b0[0] + b0[1]) + (b1[0] + b1[1]);
+  for (; j < n; ++j) {
+    const double d = y[j] - s.shift;
+    a += d;
+    b += d * d;
+  }
+  Neumaier(&s.sum, &s.sum_c, a);
+  Neumaier(&s.sum2, &s.sum2_c, b);
 }
 
 void Keep(Window (&w)[2], double v) {
@@ -294,23 +307,34 @@ void CountWindowsScalar(Window (&w)[2], const double* y, std::size_t n) {
 // AVX2 by pragma, not by a per-file -mavx2 (see batch_convert.cpp for why); reached only after
 // the run-time CPU check.
 #pragma GCC push_options
-#pragma GCC target("avx2,popcnt")
+#pragma GCC target("avx2")
 void CountWindowsAvx2(Window (&w)[2], const double* y, std::size_t n) {
+  // With ordered, disjoint windows lo0 ≤ hi0 < lo1 ≤ hi1 (always, but for a tiny pilot) four
+  // comparisons per value give everything: the region index g0 + g1 + g2 + g3 is odd inside a
+  // window, and #(y < lo) = n − #(y ≥ lo). Counts accumulate as -1 masks, 8 values per step.
+  if (!(w[0].hi < w[1].lo)) return CountWindowsScalar(w, y, n);
   const __m256d lo0 = _mm256_set1_pd(w[0].lo), hi0 = _mm256_set1_pd(w[0].hi);
   const __m256d lo1 = _mm256_set1_pd(w[1].lo), hi1 = _mm256_set1_pd(w[1].hi);
-  std::uint64_t below0 = 0, below1 = 0;
+  __m256i ge0 = _mm256_setzero_si256(), ge1 = _mm256_setzero_si256();
   std::size_t j = 0;
-  for (; j + 4 <= n; j += 4) {
-    const __m256d v = _mm256_loadu_pd(y + j);
-    below0 += static_cast<unsigned>(__builtin_popcount(_mm256_movemask_pd(_mm256_cmp_pd(v, lo0, _CMP_LT_OQ))));
-    below1 += static_cast<unsigned>(__builtin_popcount(_mm256_movemask_pd(_mm256_cmp_pd(v, lo1, _CMP_LT_OQ))));
-    const __m256d in0 = _mm256_and_pd(_mm256_cmp_pd(v, lo0, _CMP_GE_OQ), _mm256_cmp_pd(v, hi0, _CMP_LE_OQ));
-    const __m256d in1 = _mm256_and_pd(_mm256_cmp_pd(v, lo1, _CMP_GE_OQ), _mm256_cmp_pd(v, hi1, _CMP_LE_OQ));
-    if (_mm256_movemask_pd(_mm256_or_pd(in0, in1)) != 0) [[unlikely]]
-      for (std::size_t l = 0; l < 4; ++l) Keep(w, y[j + l]);
+  for (; j + 8 <= n; j += 8) {
+    const __m256d v = _mm256_loadu_pd(y + j), u = _mm256_loadu_pd(y + j + 4);
+    const __m256d gv0 = _mm256_cmp_pd(v, lo0, _CMP_GE_OQ), gu0 = _mm256_cmp_pd(u, lo0, _CMP_GE_OQ);
+    const __m256d gv2 = _mm256_cmp_pd(v, lo1, _CMP_GE_OQ), gu2 = _mm256_cmp_pd(u, lo1, _CMP_GE_OQ);
+    ge0 = _mm256_sub_epi64(ge0, _mm256_add_epi64(_mm256_castpd_si256(gv0), _mm256_castpd_si256(gu0)));
+    ge1 = _mm256_sub_epi64(ge1, _mm256_add_epi64(_mm256_castpd_si256(gv2), _mm256_castpd_si256(gu2)));
+    const __m256d in_v = _mm256_or_pd(_mm256_xor_pd(gv0, _mm256_cmp_pd(v, hi0, _CMP_GT_OQ)),
+                                      _mm256_xor_pd(gv2, _mm256_cmp_pd(v, hi1, _CMP_GT_OQ)));
+    const __m256d in_u = _mm256_or_pd(_mm256_xor_pd(gu0, _mm256_cmp_pd(u, hi0, _CMP_GT_OQ)),
+                                      _mm256_xor_pd(gu2, _mm256_cmp_pd(u, hi1, _CMP_GT_OQ)));
+    if (!_mm256_testz_pd(_mm256_or_pd(in_v, in_u), _mm256_or_pd(in_v, in_u))) [[unlikely]]
+      for (std::size_t l = 0; l < 8; ++l) Keep(w, y[j + l]);
   }
-  w[0].below += below0;
-  w[1].below += below1;
+  alignas(32) long long g0[4], g1[4];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(g0), ge0);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(g1), ge1);
+  w[0].below += j - static_cast<std::uint64_t>(g0[0] + g0[1] + g0[2] + g0[3]);
+  w[1].below += j - static_cast<std::uint64_t>(g1[0] + g1[1] + g1[2] + g1[3]);
   CountWindowsScalar(w, y + j, n - j);
 }
 #pragma GCC pop_options
@@ -320,7 +344,7 @@ void CountWindowsAvx2(Window (&w)[2], const double* y, std::size_t n) {
 
 void CountWindows(Window (&w)[2], const double* y, std::size_t n, BatchKernel kernel) {
 #if UPHILL_WINDOWS_AVX2
-  static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt");
+  static const bool avx2 = __builtin_cpu_supports("avx2");
   if (avx2 && kernel != BatchKernel::kScalar) return CountWindowsAvx2(w, y, n);
 #endif
   (void)kernel;
@@ -428,35 +452,56 @@ class MonteCarlo {
   }
   bool Uncertain(InputQuantity q) const { return p_.u[Index(q)] > 0.0; }
 
-  // Whether an output can vary between trials: θ and α depend on few inputs. Conservative
-  // (true when unsure): a constant output that is treated as varying costs time, not accuracy.
+  // Whether an output can vary between trials: whether any input it depends on is uncertain.
+  // An output that cannot vary gets u = 0 and the interval [y, y] without any statistics. (Were a
+  // constant output treated as varying, every value would land in its windows: slow, still exact.)
   bool Varies(int slot) const {
-    const bool along = p_.convention == LConvention::kAlongRail;
-    if (p_.given == UncertainRails::Given::kApparatus) {
-      if (slot == kOutTheta)
-        return Uncertain(InputQuantity::kL) || Uncertain(InputQuantity::kH) ||
-               (along && Uncertain(InputQuantity::kD));
-      if (slot == kOutAlpha)
-        return Uncertain(InputQuantity::kL) || Uncertain(InputQuantity::kD) ||
-               (along && Uncertain(InputQuantity::kH));
-    } else {
-      if (slot == kOutTheta) return Uncertain(InputQuantity::kTheta);
-      if (slot == kOutAlpha) return Uncertain(InputQuantity::kAlpha);
+    using Q = InputQuantity;
+    auto bit = [](Q q) { return 1u << Index(q); };
+    const bool apparatus = p_.given == UncertainRails::Given::kApparatus;
+    const bool along_rail = apparatus && p_.convention == LConvention::kAlongRail;
+    const unsigned lh = along_rail ? bit(Q::kL) | bit(Q::kH) | bit(Q::kD) : bit(Q::kL);
+    // B = tanθ and T = tan(α/2) depend on:
+    const unsigned slope_b = apparatus ? lh | bit(Q::kH) : bit(Q::kTheta);
+    const unsigned slope_t = apparatus ? lh | bit(Q::kD) : bit(Q::kAlpha);
+    const unsigned body = bit(Q::kAcross) | bit(Q::kAlong) | bit(Q::kRodRadius);
+    unsigned deps = 0;
+    switch (slot) {
+      case kOutTheta: deps = slope_b; break;
+      case kOutAlpha: deps = slope_t; break;
+      case kOutPhi: deps = slope_b | slope_t; break;
+      case kOutXEq: deps = slope_b | slope_t | body; break;
+      case kOutXMax:  // hypot(a, b/T) (+ r/sin(α/2)); the cone's x_fall = h/T
+        deps = p_.body == BodyKind::kDoubleCone ? slope_t | bit(Q::kAlong) : slope_t | body;
+        break;
+      case kOutTheta0: deps = slope_t | bit(Q::kAcross) | bit(Q::kAlong); break;
     }
     for (int i = 0; i < kNumInputs; ++i)
-      if (p_.u[i] > 0.0) return true;
+      if ((deps & (1u << i)) && p_.u[i] > 0.0) return true;
     return false;
   }
 
   // Screens the block's draws, evaluates the model, and compacts the outputs to the valid trials.
   std::size_t Evaluate(std::size_t n, RejectedTrials* rejected) {
+    // Reasons are assigned only once a draw fails: the common case is one vectorised count per
+    // uncertain input (the comparisons written with & so that there is no branch to vectorise).
     unsigned char reason[kBlock];
-    std::fill(reason, reason + n, kValid);
+    bool any_bad = false;
+    auto mark = [&](std::size_t j, Reason why) {
+      if (!any_bad) {
+        std::fill(reason, reason + n, kValid);
+        any_bad = true;
+      }
+      if (reason[j] == kValid) reason[j] = why;
+    };
     auto screen = [&](InputQuantity q, Reason why, auto ok) {
       if (!Uncertain(q)) return;  // the nominal value passed the model's checks
       const double* x = Input(Index(q));
+      std::size_t bad = 0;
+      for (std::size_t j = 0; j < n; ++j) bad += !ok(x[j]);
+      if (bad == 0) return;
       for (std::size_t j = 0; j < n; ++j)
-        if (reason[j] == kValid && !ok(x[j])) reason[j] = why;
+        if (!ok(x[j])) mark(j, why);
     };
     auto positive = [](double v) { return v > 0.0; };
     screen(InputQuantity::kL, kNonPositiveLength, positive);
@@ -466,9 +511,9 @@ class MonteCarlo {
     screen(InputQuantity::kRodRadius, kNonPositiveLength, positive);
     screen(InputQuantity::kH, kNegativeHeight, [](double v) { return v >= 0.0; });
     screen(InputQuantity::kTheta, kAngleOutOfRange,
-           [](double v) { return v >= 0.0 && v < std::numbers::pi / 2; });
+           [](double v) { return (v >= 0.0) & (v < std::numbers::pi / 2); });
     screen(InputQuantity::kAlpha, kAngleOutOfRange,
-           [](double v) { return v > 0.0 && v < std::numbers::pi; });
+           [](double v) { return (v > 0.0) & (v < std::numbers::pi); });
     const bool apparatus = p_.given == UncertainRails::Given::kApparatus;
     const double* L = Input(Index(InputQuantity::kL));
     const double* H = Input(Index(InputQuantity::kH));
@@ -476,7 +521,7 @@ class MonteCarlo {
     if (apparatus && p_.convention == LConvention::kAlongRail &&
         (Uncertain(InputQuantity::kL) || Uncertain(InputQuantity::kH) || Uncertain(InputQuantity::kD))) {
       for (std::size_t j = 0; j < n; ++j)
-        if (reason[j] == kValid && !(L[j] > std::hypot(H[j], D[j] / 2))) reason[j] = kImpossibleApparatus;
+        if (!(L[j] > std::hypot(H[j], D[j] / 2))) mark(j, kImpossibleApparatus);
     }
 
     double* B = Scratch(0);
@@ -516,14 +561,14 @@ class MonteCarlo {
         DoubleConeBatch(n, across, along, B, T, Output(kOutXMax), Output(kOutTheta0), q, o_.kernel);
         if (!streams_empty())
           for (std::size_t j = 0; j < n; ++j)
-            if (reason[j] == kValid && !(q[j] > 0.0)) reason[j] = kConeCannotRest;
+            if (!(q[j] > 0.0)) mark(j, kConeCannotRest);
         break;
       }
     }
 
+    if (!any_bad) return n;
     std::size_t bad = 0;
     for (std::size_t j = 0; j < n; ++j) bad += reason[j] != kValid;
-    if (bad == 0) return n;
     for (std::size_t j = 0; j < n; ++j) {
       switch (reason[j]) {
         case kValid: break;

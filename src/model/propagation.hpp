@@ -39,7 +39,7 @@
 // blocks of 1024 trials with no per-trial allocation and no virtual dispatch; the coverage
 // interval is found without sorting the M values: a pilot of 2^16 trials places a narrow window
 // around each quantile, later trials only count (below) or keep (inside) — exact, with an exact
-// rerun in the (≈ 1e-15 probable) case that a window misses. Memory: O(M·1 %) per output.
+// rerun in the (≈ 1e-4 probable) case that a window misses. Memory: ≈ 2 % of M per output.
 //
 // Errors: InputError (model/input_error.hpp) naming the quantity and the rule, for a bad value
 // (the model's own checks: e.g. "D: must be > 0 (got -0.003)"), a bad uncertainty

@@ -57,7 +57,7 @@ class SpheroidOnLineRails {
     a_sqrt_p_ = A_ * sqrt_p;
     x_max_ = hypot(a, b / tan_half_alpha);
     const T hypot_ab = hypot(A_, B_);
-    z_eq_ = a * hypot_ab / A_;
+    z_eq_ = a * (hypot_ab / A_);  // = a exactly at θ = 0
     x_eq_ = a * B_ / (A_ * hypot_ab);
     const T h = hypot(a_sqrt_p_, B_);
     cos_psi0_ = a_sqrt_p_ / h;

@@ -73,6 +73,19 @@ SpheroidOnRods::SpheroidOnRods(double a, double b, double tan_theta, double tan_
     }
     x_prev = xb;
   }
+  // The fall-off expansion x_max − x(β) = k0·β² + k1·β³ + O(β⁴): k(β) = (x_max − x(β))/β² at
+  // β = β1, 2β1, 3β1 (β1 = 1e-3·β_low), extrapolated to β = 0 by the quadratic through them
+  // (error ~6·β1³ ≈ 6e-9 relative from the next term, ~7·2u/β1² ≈ 2e-9 from the cancellation).
+  const double beta1 = 1e-3 * beta_low_;
+  double k[3];
+  for (int i = 0; i < 3; ++i) {
+    const double beta = (i + 1) * beta1;
+    double xb, zb;
+    CentreAtNormalAngle(beta, &xb, &zb);
+    k[i] = (x_max_ - xb) / (beta * beta);
+  }
+  fall_k0_ = 3 * k[0] - 3 * k[1] + k[2];
+  fall_k1_ = (-5 * k[0] + 8 * k[1] - 3 * k[2]) / (2 * beta1);
   double z_unused;
   if (beta_low_ == beta_n) {
     // The contact at t = 0: the normal with n_y = 0, n·d = 0 is ∝ (tanθ, 0, −1), taken exactly
@@ -104,6 +117,15 @@ double SpheroidOnRods::RestX(double mu) const {
   return x;
 }
 
+double SpheroidOnRods::FallOffBeta(double x) const {
+  // x_max − x = k0·β² + k1·β³, by fixed-point iteration from β = sqrt((x_max − x)/k0); the
+  // neglected k2·β⁴ is ≲ β² ≲ 1e-9 relative where this is used.
+  const double d = x_max_ - x;  // exact near x_max (Sterbenz)
+  double beta = std::sqrt(d / fall_k0_);
+  for (int i = 0; i < 3; ++i) beta = std::sqrt(d / (fall_k0_ + fall_k1_ * beta));
+  return beta;
+}
+
 double SpheroidOnRods::BetaOf(double x) const {
   if (x >= x_max_) return 0.0;
   using Jet = ceres::Jet<double, 1>;
@@ -111,13 +133,9 @@ double SpheroidOnRods::BetaOf(double x) const {
     const auto c = ContactAtAngle(Jet(beta, 0), a_, b_, B_, T_, r_);
     return std::make_pair(c.x.a - x, c.x.v[0]);
   };
-  // Near the fall-off x(β) ≈ x_max − c·β², so start from that parabola (c from the curvature
-  // at a small β) and let Newton, kept inside the bracket, polish to full precision.
-  const double probe = 1e-3 * beta_low_;
-  double xp, zp;
-  CentreAtNormalAngle(probe, &xp, &zp);
-  const double c = (x_max_ - xp) / (probe * probe);
-  double guess = std::sqrt((x_max_ - x) / c);
+  // Start from the fall-off expansion and let Newton, kept inside the bracket, polish to full
+  // precision.
+  double guess = FallOffBeta(x);
   if (!(guess < beta_low_)) guess = 0.5 * beta_low_;
   std::uintmax_t iterations = 200;
   return boost::math::tools::newton_raphson_iterate(f, guess, 0.0, beta_low_,
@@ -126,11 +144,19 @@ double SpheroidOnRods::BetaOf(double x) const {
 }
 
 SpheroidPathPoint<double> SpheroidOnRods::At(double x) const {
-  const auto c = ContactAtAngle(BetaOf(x), a_, b_, B_, T_, r_);
+  // Within 1e-9·x_max of the fall-off x(β) = x_max − k·β² is flat: its rounding (ulps of x_max,
+  // and its β = 0 value differs from the closed-form x_max by ulps) makes Newton's β noise of
+  // relative size ulp(x_max)/(x_max − x), and the first-order carry below a step in β that is
+  // not small (z'·(x − x(β)) with z' ~ 1e14 once gave z wrong by 18 % at the last double below
+  // x_max). There β comes from the expansion about the closed-form x_max (x_max − x exact, to
+  // ~1e-8 relative in β), and z, z' are those of β itself.
+  const bool near_fall_off = x < x_max_ && x_max_ - x <= 1e-9 * x_max_;
+  const auto c = ContactAtAngle(near_fall_off ? FallOffBeta(x) : BetaOf(x), a_, b_, B_, T_, r_);
   SpheroidPathPoint<double> p;
   p.dzdx = c.nz == 0.0 ? -std::numeric_limits<double>::infinity() : -c.nx / c.nz;
-  // The solved β reproduces x to about an ulp; carry z to the requested x to first order.
-  p.z = std::isfinite(p.dzdx) ? c.z + p.dzdx * (x - c.x) : c.z;
+  // Elsewhere the solved β reproduces x to about an ulp; carry z to the requested x to first
+  // order.
+  p.z = std::isfinite(p.dzdx) && !near_fall_off ? c.z + p.dzdx * (x - c.x) : c.z;
   p.r_star = std::hypot(c.sx, c.sz);
   p.x_contact = x + c.sx;
   return p;

@@ -16,7 +16,11 @@
 // x(β) = x (Newton with bracketing, Boost.Math, derivative by ceres::Jet).
 //
 // Accuracy: x_eq, x_max, x_rest within a few ulp; At(x) to the solver's full precision (a few
-// ulp in β, amplified only by the conditioning of the value itself, e.g. near x_max).
+// ulp in β, amplified only by the conditioning of the value itself, e.g. near x_max). Within
+// 1e-9·x_max of x_max, where x(β) is flat and Newton's β would be rounding noise, β comes from
+// the expansion x_max − x(β) = k0·β² + k1·β³ instead (~1e-8 relative in β): z' keeps its
+// magnitude ~ 1/sqrt(x_max − x) up to the last double below x_max, and z its conditioning-level
+// error (tests/model_property_test.cpp compares with the sphere-on-rods closed form there).
 // Tested against the 60-digit reference and, for r → 0, against SpheroidOnLineRails.
 #pragma once
 
@@ -45,9 +49,12 @@ class SpheroidOnRods {
   // Centre for a given (not necessarily unit) normal with n·d = 0.
   void CentreForNormal(double nx, double ny, double nz, double* x, double* z) const;
   double BetaOf(double x) const;
+  // β of a point near the fall-off from the expansion x_max − x(β) = k0·β² + k1·β³.
+  double FallOffBeta(double x) const;
 
   double a_, b_, B_, T_, r_;
   double x_max_, x_eq_, z_eq_, x_low_, beta_low_;
+  double fall_k0_, fall_k1_;  // x_max − x(β) = k0·β² + k1·β³ + O(β⁴) at the fall-off
 };
 
 }  // namespace uphill

@@ -1,10 +1,371 @@
-// `uphill bench convert` (being written).
+// `uphill bench convert`: throughput of the conversion and of the Monte Carlo propagation on one
+// core, each row with the accuracy it reached, and the same work in NumPy when /usr/bin/python3
+// has it (tools/bench/numpy_convert.py, run as a subprocess; inputs and outputs go through .npy
+// files in a temporary directory so that both sides compute on the very same numbers).
+//
+// Times are thread CPU time (CLOCK_THREAD_CPUTIME_ID here, time.thread_time() in Python), best
+// of --repeats: the throughput of one core, and not skewed by other load on the machine.
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <boost/random/mersenne_twister.hpp>
+#include <boost/random/uniform_real_distribution.hpp>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
 #include "commands.hpp"
+#include "model/batch_convert.hpp"
+#include "model/input_error.hpp"
+#include "model/propagation.hpp"
 
 namespace uphill::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BenchFlags {
+  std::uint64_t configurations = 10'000'000;
+  std::uint64_t trials = 1'000'000;
+  std::uint64_t seed = 1;
+  int repeats = 3;
+  std::string python = "/usr/bin/python3";
+  std::string script;     // default: tools/bench/numpy_convert.py found upward
+  std::string reference;  // default: tests/data/physics_reference.json found upward
+  bool no_numpy = false;
+};
+
+// The lab's spheroid and Experiment 2 with plausible measurement uncertainties (metres): the
+// Monte Carlo case of both sides (passed to the NumPy script, so the two cannot drift apart).
+struct LabInput {
+  const char* name;
+  double value, u;
+};
+constexpr std::array<LabInput, 5> kLab = {{{"L", 1.165, 0.002},
+                                           {"H", 0.300, 0.001},
+                                           {"D", 0.045, 0.0005},
+                                           {"a", 0.015875, 2e-5},
+                                           {"b", 0.0254, 2e-5}}};
+constexpr double kA = 0.015875, kB = 0.0254;
+
+double CpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+template <typename F>
+double BestOf(int repeats, F&& f) {
+  double best = INFINITY;
+  for (int r = 0; r < repeats; ++r) {
+    const double t0 = CpuSeconds();
+    f();
+    best = std::min(best, CpuSeconds() - t0);
+  }
+  return best;
+}
+
+// A file found by walking up from the executable's directory and from the working directory.
+std::string FindUpward(const std::string& relative) {
+  std::vector<fs::path> starts;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) starts.push_back(exe.parent_path());
+  starts.push_back(fs::current_path(ec));
+  for (fs::path dir : starts) {
+    for (int up = 0; up < 8 && !dir.empty(); ++up) {
+      if (fs::exists(dir / relative, ec)) return (dir / relative).string();
+      if (dir == dir.parent_path()) break;
+      dir = dir.parent_path();
+    }
+  }
+  return "";
+}
+
+std::string Quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// Runs a shell command and returns its standard output; false if it failed.
+bool Capture(const std::string& command, std::string* out) {
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return false;
+  char buf[4096];
+  std::size_t got;
+  while ((got = std::fread(buf, 1, sizeof buf, pipe)) > 0) out->append(buf, got);
+  return pclose(pipe) == 0;
+}
+
+// --- .npy (format 1.0: magic, version, little-endian header length, a Python dict literal) ---
+
+void WriteNpy(const fs::path& path, const std::vector<const std::vector<double>*>& rows) {
+  const std::size_t n = rows.front()->size();
+  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" +
+                       std::to_string(rows.size()) + ", " + std::to_string(n) + "), }";
+  const std::size_t unpadded = 10 + header.size() + 1;
+  header.append((64 - unpadded % 64) % 64, ' ');
+  header += '\n';
+  std::ofstream out(path, std::ios::binary);
+  const unsigned char prefix[8] = {0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0};
+  out.write(reinterpret_cast<const char*>(prefix), 8);
+  const unsigned char len[2] = {static_cast<unsigned char>(header.size() & 0xFF),
+                                static_cast<unsigned char>(header.size() >> 8)};
+  out.write(reinterpret_cast<const char*>(len), 2);
+  out << header;
+  for (const auto* row : rows)
+    out.write(reinterpret_cast<const char*>(row->data()), static_cast<std::streamsize>(n * sizeof(double)));
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+}
+
+// Reads a C-order float64 array of shape (rows, n) written by np.save.
+std::vector<std::vector<double>> ReadNpy(const fs::path& path, std::size_t rows, std::size_t n) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[8];
+  in.read(magic, 8);
+  if (!in || std::memcmp(magic, "\x93NUMPY", 6) != 0) throw std::runtime_error("not .npy: " + path.string());
+  std::size_t header_len = 0;
+  if (magic[6] == 1) {
+    unsigned char b[2];
+    in.read(reinterpret_cast<char*>(b), 2);
+    header_len = b[0] | (static_cast<std::size_t>(b[1]) << 8);
+  } else {
+    unsigned char b[4];
+    in.read(reinterpret_cast<char*>(b), 4);
+    header_len = b[0] | (static_cast<std::size_t>(b[1]) << 8) | (static_cast<std::size_t>(b[2]) << 16) |
+                 (static_cast<std::size_t>(b[3]) << 24);
+  }
+  std::string header(header_len, '\0');
+  in.read(header.data(), static_cast<std::streamsize>(header_len));
+  const std::string shape = "(" + std::to_string(rows) + ", " + std::to_string(n) + ")";
+  if (header.find("'<f8'") == std::string::npos || header.find("False") == std::string::npos ||
+      header.find(shape) == std::string::npos)
+    throw std::runtime_error("unexpected .npy header in " + path.string() + ": " + header);
+  std::vector<std::vector<double>> out(rows, std::vector<double>(n));
+  for (auto& row : out)
+    in.read(reinterpret_cast<char*>(row.data()), static_cast<std::streamsize>(n * sizeof(double)));
+  if (!in) throw std::runtime_error("short .npy file " + path.string());
+  return out;
+}
+
+// --- accuracy against the 60-digit references ----------------------------------------------------
+
+struct Accuracy {
+  double max_rel = 0.0;
+  int values = 0;
+};
+
+// θ, α, x_eq of the spheroid apparatus cases and the FIG. 5/6 sweeps on line rails, through the
+// timed code path (ConvertApparatusBatch). Sweeps give angles: L = 1, H = tanθ, D = 2·tan(α/2).
+Accuracy AgainstReferences(const std::string& path, BatchKernel kernel) {
+  std::ifstream in(path);
+  const nlohmann::json file = nlohmann::json::parse(in);
+  auto ref = [](const nlohmann::json& v) {
+    return v.is_number() ? v.get<double>() : std::strtod(v.get<std::string>().c_str(), nullptr);
+  };
+  Accuracy acc;
+  for (const auto& c : file.at("cases")) {
+    const bool rods = c.contains("rod_radius") && c.at("rod_radius").is_number() &&
+                      c.at("rod_radius").get<double>() > 0;
+    if (c.at("body").at("type") != "spheroid" || rods) continue;
+    const double a = c.at("body").at("a"), b = c.at("body").at("b");
+    std::vector<std::pair<std::array<double, 3>, const nlohmann::json*>> rows;
+    if (c.at("rails").contains("apparatus")) {
+      const auto& app = c.at("rails").at("apparatus");
+      rows.push_back({{app.at("L"), app.at("H"), app.at("D")}, &c.at("outputs")});
+    } else if (c.at("rails").contains("sweep")) {
+      for (const auto& row : c.at("outputs").at("sweep"))
+        rows.push_back({{1.0, std::tan(row.at("theta").get<double>()),
+                         2 * std::tan(row.at("alpha").get<double>() / 2)},
+                        &row});
+    }
+    for (const auto& [x, out] : rows) {
+      double y[3];
+      ConvertApparatusBatch(1, &x[0], &x[1], &x[2], a, b, &y[0], &y[1], &y[2], kernel);
+      const char* keys[3] = {"theta", "alpha", "x_eq"};
+      for (int k = 0; k < 3; ++k) {
+        const double r = ref(out->at(keys[k]));
+        acc.max_rel = std::max(acc.max_rel, std::abs(y[k] - r) / std::abs(r));
+        ++acc.values;
+      }
+    }
+  }
+  return acc;
+}
+
+// --- table -----------------------------------------------------------------------------------
+
+std::string Fmt(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+std::string Rate(double per_second) {
+  if (per_second >= 1e9) return Fmt("%.2f G/s", per_second / 1e9);
+  if (per_second >= 1e6) return Fmt("%.1f M/s", per_second / 1e6);
+  return Fmt("%.0f k/s", per_second / 1e3);
+}
+
+void Row(const std::string& what, std::uint64_t n, double seconds, const std::string& accuracy) {
+  const double per = seconds / static_cast<double>(n);
+  std::printf("%-44s %9.3g %10s %11s  %s\n", what.c_str(), static_cast<double>(n),
+              (per < 1e-6 ? Fmt("%.2f ns", per * 1e9) : Fmt("%.2f us", per * 1e6)).c_str(),
+              Rate(1.0 / per).c_str(), accuracy.c_str());
+}
+
+void Run(const BenchFlags& f) {
+  if (f.configurations < 1000) throw InputError("--configurations", "must be at least 1000");
+  if (f.trials < 100) throw InputError("--trials", "must be at least 100");
+  if (f.repeats < 1) throw InputError("--repeats", "must be at least 1");
+  const std::string reference = f.reference.empty() ? FindUpward("tests/data/physics_reference.json") : f.reference;
+  const BatchKernel kernel = BatchKernel::kAuto;
+  std::printf("uphill bench convert: one core, thread CPU time, best of %d; batch kernel %s\n\n",
+              f.repeats, BatchKernelName(kernel));
+  std::printf("%-44s %9s %10s %11s  %s\n", "workload", "n", "time/item", "rate", "accuracy");
+
+  // Random configurations over the apparatus' range (metres).
+  const std::size_t n = static_cast<std::size_t>(f.configurations);
+  std::vector<double> L(n), H(n), D(n);
+  {
+    boost::random::mt19937_64 engine(f.seed);
+    boost::random::uniform_real_distribution<double> uL(0.5, 2.0), uH(0.05, 0.5), uD(0.02, 0.25);
+    for (std::size_t i = 0; i < n; ++i) {
+      L[i] = uL(engine);
+      H[i] = uH(engine);
+      D[i] = uD(engine);
+    }
+  }
+  std::vector<double> theta(n), alpha(n), x_eq(n);
+  auto convert = [&](BatchKernel k) {
+    ConvertApparatusBatch(n, L.data(), H.data(), D.data(), kA, kB, theta.data(), alpha.data(),
+                          x_eq.data(), k);
+  };
+  auto accuracy = [&](BatchKernel k) {
+    if (reference.empty()) return std::string("(tests/data/physics_reference.json not found)");
+    const Accuracy acc = AgainstReferences(reference, k);
+    return Fmt("max rel err %.2g", acc.max_rel) + " vs 60-digit refs (θ, α, X: " +
+           std::to_string(acc.values) + " values)";
+  };
+  convert(kernel);  // first touch of the output pages outside the timing
+  const double t_scalar_model = BestOf(1, [&] { convert(BatchKernel::kScalar); });
+  std::vector<double> scalar_x_eq = x_eq;
+  const double t_convert = BestOf(f.repeats, [&] { convert(kernel); });
+  Row(std::string("convert L,H,D -> θ,α,X (") + (BatchKernelAvailable(BatchKernel::kAvx2) ? "avx2" : "scalar") +
+          " batch)",
+      n, t_convert, accuracy(kernel));
+  Row("convert, scalar model (libm atan2, hypot)", n, t_scalar_model, accuracy(BatchKernel::kScalar));
+
+  // Monte Carlo: the lab case, all five inputs uncertain.
+  const auto rails = UncertainRails::Apparatus({kLab[0].value, kLab[0].u}, {kLab[1].value, kLab[1].u},
+                                               {kLab[2].value, kLab[2].u});
+  const auto body = UncertainBody::Spheroid({kLab[3].value, kLab[3].u}, {kLab[4].value, kLab[4].u});
+  PropagationOptions options;
+  options.trials = f.trials;
+  options.seed = f.seed;
+  PropagationResult mc;
+  const double t_mc = BestOf(f.repeats, [&] { mc = Propagate(rails, body, {}, options); });
+  double worst_fo = 0.0;
+  for (const PropagatedValue* y : mc.Outputs())
+    worst_fo = std::max(worst_fo, std::abs(y->u_monte_carlo / y->u_first_order - 1));
+  const double se_u = 1.0 / std::sqrt(2.0 * static_cast<double>(mc.valid_trials - 1));
+  Row("Monte Carlo, lab case: 5 inputs -> 5 outputs", f.trials, t_mc,
+      Fmt("u to ±%.2f %% (1/sqrt(2M))", 100 * se_u) + Fmt("; |u_MC/u_1st - 1| <= %.2f %%", 100 * worst_fo));
+
+  // NumPy.
+  std::string script = f.script.empty() ? FindUpward("tools/bench/numpy_convert.py") : f.script;
+  std::string why_not;
+  if (f.no_numpy) why_not = "--no-numpy";
+  else if (access(f.python.c_str(), X_OK) != 0) why_not = f.python + " not found";
+  else if (script.empty()) why_not = "tools/bench/numpy_convert.py not found (use --numpy-script)";
+  else if (std::system((Quote(f.python) + " -c 'import numpy' > /dev/null 2>&1").c_str()) != 0)
+    why_not = f.python + " has no NumPy (bash scripts/install-deps.sh --bench)";
+  if (!why_not.empty()) {
+    std::printf("\nNumPy comparison skipped: %s\n", why_not.c_str());
+    return;
+  }
+  char dir_template[] = "/tmp/uphill-bench-XXXXXX";
+  if (!mkdtemp(dir_template)) throw std::runtime_error("cannot create a temporary directory");
+  const fs::path dir = dir_template;
+  struct Cleanup {
+    fs::path dir;
+    ~Cleanup() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } cleanup{dir};
+  WriteNpy(dir / "in.npy", {&L, &H, &D});
+  std::string out;
+  const std::string reps = " --repeats " + std::to_string(f.repeats);
+  if (!Capture(Quote(f.python) + " " + Quote(script) + " convert " + Quote((dir / "in.npy").string()) + " " +
+                   Quote((dir / "out.npy").string()) + reps,
+               &out))
+    throw std::runtime_error("the NumPy script failed: " + script);
+  const nlohmann::json np_convert = nlohmann::json::parse(out);
+  const auto np = ReadNpy(dir / "out.npy", 3, n);
+  double diff = 0.0;
+  const std::vector<double>* ours[3] = {&theta, &alpha, &x_eq};
+  for (int k = 0; k < 3; ++k)
+    for (std::size_t i = 0; i < n; ++i)
+      diff = std::max(diff, std::abs((*ours[k])[i] - np[k][i]) / std::abs(np[k][i]));
+  const double t_np = np_convert.at("seconds");
+  Row("NumPy " + np_convert.at("numpy").get<std::string>() + " convert (same inputs)", n, t_np,
+      Fmt("max rel diff vs uphill %.2g", diff));
+
+  nlohmann::json lab_case;
+  for (const LabInput& x : kLab) lab_case[x.name] = {x.value, x.u};
+  out.clear();
+  if (!Capture(Quote(f.python) + " " + Quote(script) + " mc --trials " + std::to_string(f.trials) +
+                   " --seed " + std::to_string(f.seed) + " --case " + Quote(lab_case.dump()) + reps,
+               &out))
+    throw std::runtime_error("the NumPy script failed: " + script);
+  const nlohmann::json np_mc = nlohmann::json::parse(out);
+  double worst_np = 0.0;
+  for (const PropagatedValue* y : mc.Outputs())
+    worst_np = std::max(worst_np, std::abs(np_mc.at("stats").at(y->name).at("u").get<double>() / y->u_monte_carlo - 1));
+  const double t_np_mc = np_mc.at("seconds");
+  Row("NumPy Monte Carlo, same case (own RNG)", f.trials, t_np_mc,
+      Fmt("|u_NumPy/u_uphill - 1| <= %.2f %% (statistical)", 100 * worst_np));
+
+  const double speed_convert = t_np / t_convert, speed_mc = t_np_mc / t_mc;
+  std::printf("\nuphill vs NumPy per core: convert %.1fx (goal >= 10x, rel diff %.2g, goal <= 1e-14): %s\n",
+              speed_convert, diff, speed_convert >= 10 && diff <= 1e-14 ? "met" : "NOT met");
+  std::printf("                          Monte Carlo %.1fx (goal >= 10x): %s\n", speed_mc,
+              speed_mc >= 10 ? "met" : "NOT met");
+  std::printf("NumPy per configuration %.1f ns, per Monte Carlo trial %.1f ns\n", 1e9 * t_np / static_cast<double>(n),
+              1e9 * t_np_mc / static_cast<double>(f.trials));
+  (void)scalar_x_eq;
+}
+
+}  // namespace
 
 void AddBenchConvert(CLI::App& bench) {
-  bench.add_subcommand("convert", "Conversion throughput and accuracy against NumPy");
+  auto flags = std::make_shared<BenchFlags>();
+  CLI::App* cmd = bench.add_subcommand(
+      "convert", "Conversion and Monte Carlo throughput per core, with accuracy, against NumPy");
+  cmd->add_option("--configurations", flags->configurations, "random configurations to convert")
+      ->capture_default_str();
+  cmd->add_option("--trials", flags->trials, "Monte Carlo trials")->capture_default_str();
+  cmd->add_option("--seed", flags->seed, "seed of the configurations and of the Monte Carlo")
+      ->capture_default_str();
+  cmd->add_option("--repeats", flags->repeats, "timed repeats per row (the best counts)")
+      ->capture_default_str();
+  cmd->add_option("--python", flags->python, "Python with NumPy for the comparison")->capture_default_str();
+  cmd->add_option("--numpy-script", flags->script, "path of tools/bench/numpy_convert.py");
+  cmd->add_option("--reference", flags->reference, "path of tests/data/physics_reference.json");
+  cmd->add_flag("--no-numpy", flags->no_numpy, "skip the NumPy comparison");
+  cmd->callback([flags] { Run(*flags); });
 }
 
 }  // namespace uphill::cli

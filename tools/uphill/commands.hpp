@@ -14,6 +14,8 @@ int& ExitStatus();
 
 void AddConvertCommand(CLI::App& app);
 void AddBenchCommand(CLI::App& app);
+// `fit` and `report` (fit_command.cpp).
+void AddFitCommand(CLI::App& app);
 
 // `uphill bench <what>`: each benchmark adds itself to the bench subcommand.
 void AddBenchConvert(CLI::App& bench);

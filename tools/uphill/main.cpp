@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "uphill 0.1.0");
   uphill::cli::AddConvertCommand(app);
+  uphill::cli::AddFitCommand(app);
   uphill::cli::AddBenchCommand(app);
   try {
     app.parse(argc, argv);
@@ -25,6 +26,10 @@ int main(int argc, char** argv) {
   } catch (const uphill::InputError& e) {
     std::cerr << "uphill: " << e.what() << "\n";
     return 2;
+  } catch (const std::runtime_error& e) {
+    // Environment problems (a file that cannot be written, gnuplot missing): not a bug.
+    std::cerr << "uphill: " << e.what() << "\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "uphill: internal error: " << e.what() << "\n";
     return 1;

@@ -1,0 +1,124 @@
+#include "report/analysis.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "fit/least_squares_line.hpp"
+#include "fit/robust_line.hpp"
+#include "fit/york_line.hpp"
+#include "model/input_error.hpp"
+#include "model/propagation.hpp"
+
+namespace uphill::report {
+namespace {
+
+std::string Mm(double metres) {
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "%.1f mm", metres * 1e3);
+  return buffer;
+}
+
+template <typename Fit>
+FitOutcome TryFit(const std::string& method, const std::string& title, Fit fit) {
+  FitOutcome outcome{method, title, std::nullopt, ""};
+  try {
+    outcome.report = fit();
+  } catch (const InputError& e) {
+    outcome.unavailable = e.what();
+  }
+  return outcome;
+}
+
+AnalysedRow AnalyseRow(const io::ExperimentRow& row, const AnalysisOptions& options) {
+  const io::Configuration& c = *row.configuration;
+  const Scene scene = c.MakeScene();
+  AnalysedRow r;
+  r.source = &row;
+  r.theta = scene.rails().theta;
+  r.alpha = scene.rails().alpha;
+  r.x_max = scene.x_max();
+  r.y = row.Y.value;
+  r.u_y = row.Y.u;
+  if (!scene.x_eq()) throw InputError("body", "a double cone has no equilibrium X to fit Y against");
+  r.x_eq = *scene.x_eq();
+  PropagationOptions p;
+  p.trials = options.mc_trials;
+  p.seed = options.seed;
+  const PropagationResult propagated = Propagate(c.MakeUncertainRails(), c.MakeUncertainBody(), c.rod_radius, p);
+  r.u_x_eq = propagated.x_eq->u_first_order;
+  r.u_x_eq_mc = options.mc_trials > 0 ? propagated.x_eq->u_monte_carlo : 0.0;
+  r.u_disagrees = propagated.x_eq->disagrees;
+  if (const auto crossbar = c.CrossbarDistance(); crossbar && r.x_eq > *crossbar)
+    r.flags.push_back("X beyond the crossbar (" + Mm(*crossbar) + ")");
+  // Measured values scatter: flag only departures beyond two combined standard uncertainties.
+  const double u = 2 * std::hypot(r.u_y, r.u_x_eq);
+  if (r.y > r.x_max + u) r.flags.push_back("Y beyond the fall-off x_max = " + Mm(r.x_max) + " (by > 2u): impossible");
+  if (r.y < r.x_eq - u) r.flags.push_back("Y below X by > 2u: the body cannot rest there");
+  if (r.u_disagrees) r.flags.push_back("u(X): first order and Monte Carlo differ by > 5 %");
+  return r;
+}
+
+}  // namespace
+
+const FitOutcome* ExperimentAnalysis::Fit(const std::string& method) const {
+  for (const auto& f : fits)
+    if (f.method == method) return &f;
+  return nullptr;
+}
+
+ExperimentAnalysis AnalyseExperiment(const io::Experiment& experiment, const AnalysisOptions& options) {
+  ExperimentAnalysis a;
+  a.experiment = &experiment;
+  a.row_errors = experiment.Errors();
+  for (const io::ExperimentRow* row : experiment.UsableRows()) {
+    try {
+      a.rows.push_back(AnalyseRow(*row, options));
+    } catch (const InputError& e) {
+      a.row_errors.push_back(experiment.directory + "/measurements.csv, row " + std::to_string(row->row) +
+                             ": " + e.what());
+    }
+  }
+  if (a.rows.empty())
+    throw InputError(experiment.directory, "no usable rows to analyse (" +
+                                               std::to_string(a.row_errors.size()) + " rows with errors)");
+  LineData line;
+  FrictionData friction;
+  bool all_u_y = true, all_u_x = true;
+  for (const AnalysedRow& r : a.rows) {
+    line.x.push_back(r.x_eq);
+    line.y.push_back(r.y);
+    line.u_x.push_back(r.u_x_eq);
+    line.u_y.push_back(r.u_y);
+    all_u_y &= r.u_y > 0;
+    all_u_x &= r.u_x_eq > 0;
+    friction.scenes.push_back(r.source->configuration->MakeScene());
+    friction.y.push_back(r.y);
+    friction.u_y.push_back(r.u_y);
+  }
+  if (!all_u_y) friction.u_y.clear();
+  FitOptions fit_options;
+  fit_options.outlier_threshold = options.outlier_threshold;
+  a.fits.push_back(TryFit("ols", "Ordinary least squares (the paper's fit)",
+                          [&] { return FitOrdinaryLeastSquares(line, fit_options); }));
+  a.fits.push_back(TryFit("wls", "Weighted least squares with u(Y)",
+                          [&] { return FitWeightedLeastSquares(line, fit_options); }));
+  a.fits.push_back(TryFit("york", "Errors in both variables (York 2004), u(X) and u(Y)",
+                          [&] { return FitErrorsInVariables(line, fit_options); }));
+  RobustOptions robust;
+  robust.fit = fit_options;
+  a.fits.push_back(TryFit("robust", "Robust straight line (Huber loss)", [&] { return FitRobust(line, robust); }));
+  FrictionOptions friction_options;
+  friction_options.fit = fit_options;
+  try {
+    const FrictionVersusLine both = CompareFrictionWithLine(friction, friction_options);
+    a.fits.push_back(FitOutcome{"friction", "Friction model Y = x_rest(mu)", both.friction, ""});
+    a.friction_vs_line = both.comparison;
+  } catch (const InputError& e) {
+    a.fits.push_back(FitOutcome{"friction", "Friction model Y = x_rest(mu)", std::nullopt, e.what()});
+  }
+  if (!all_u_x) a.notes.push_back("Some rows have u(X) = 0 (no input uncertainties): the York fit needs u(X) > 0.");
+  if (a.friction_vs_line) a.notes.push_back(a.friction_vs_line->verdict);
+  return a;
+}
+
+}  // namespace uphill::report

@@ -1,0 +1,60 @@
+// ExperimentAnalysis: everything `uphill fit` prints and `uphill report` writes, computed once.
+//
+// For each usable row of an experiment: the rails' angles, the theoretical equilibrium X with its
+// standard uncertainty (first order and Monte Carlo, model/propagation.hpp), the measured Y ± u(Y),
+// and plain-language flags. Then the fits of Y against X (fit/): ordinary least squares (the
+// paper's), weighted least squares with u(Y), errors in both variables (York) with u(X) and u(Y),
+// a robust Huber fit, and the physical friction model Y = x_rest(μ) compared with the straight
+// line by χ², AIC and BIC. A fit that cannot be made (too few rows, all X equal, missing
+// uncertainties) is kept with the reason instead of its report.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fit/fit_report.hpp"
+#include "fit/friction_fit.hpp"
+#include "io/experiment.hpp"
+
+namespace uphill::report {
+
+struct AnalysisOptions {
+  std::uint64_t mc_trials = 100000;  // per row, for u(X) by Monte Carlo
+  std::uint64_t seed = 1;
+  double outlier_threshold = 3.0;
+};
+
+struct AnalysedRow {
+  const io::ExperimentRow* source = nullptr;
+  double theta = 0, alpha = 0;              // rad
+  double x_eq = 0, u_x_eq = 0, u_x_eq_mc = 0;  // m; u first order and Monte Carlo
+  bool u_disagrees = false;                  // first order and MC differ by > 5 %
+  double x_max = 0;                          // m
+  double y = 0, u_y = 0;                     // m
+  std::vector<std::string> flags;            // e.g. "X beyond the crossbar", "Y > x_max"
+};
+
+// One fit: its report, or why it could not be made.
+struct FitOutcome {
+  std::string method;   // "ols", "wls", "york", "robust", "friction"
+  std::string title;    // "Ordinary least squares (the paper's fit)" etc.
+  std::optional<FitReport> report;
+  std::string unavailable;  // non-empty when report is empty
+};
+
+struct ExperimentAnalysis {
+  const io::Experiment* experiment = nullptr;
+  std::vector<AnalysedRow> rows;            // the usable rows, in file order
+  std::vector<std::string> row_errors;      // rows left out, with file, row, column, rule
+  std::vector<FitOutcome> fits;             // ols, wls, york, robust, friction, in this order
+  std::optional<ModelComparison> friction_vs_line;
+  std::vector<std::string> notes;           // findings in plain words
+
+  const FitOutcome* Fit(const std::string& method) const;
+};
+
+// Throws InputError when no row is usable (nothing to analyse).
+ExperimentAnalysis AnalyseExperiment(const io::Experiment& experiment, const AnalysisOptions& options = {});
+
+}  // namespace uphill::report

@@ -1,0 +1,150 @@
+#include "report/analysis_figures.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <sstream>
+
+namespace uphill::report {
+namespace {
+
+std::string Num(double v) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.10g", v);
+  return buffer;
+}
+
+// Indices of the analysis rows in increasing X.
+std::vector<size_t> ByX(const ExperimentAnalysis& a) {
+  std::vector<size_t> order(a.rows.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t i, size_t j) { return a.rows[i].x_eq < a.rows[j].x_eq; });
+  return order;
+}
+
+// "k_ols = …; c_ols = …" in mm for a line fit that succeeded, or "".
+std::string LineParameters(const ExperimentAnalysis& a, const std::string& method) {
+  const FitOutcome* f = a.Fit(method);
+  if (!f || !f->report) return "";
+  return "k_" + method + " = " + Num(f->report->slope()) + "; c_" + method + " = " +
+         Num(f->report->intercept() * 1e3) + "\n";
+}
+
+GnuplotFigure YAgainstX(const ExperimentAnalysis& a) {
+  GnuplotFigure f;
+  f.name = "fit_y_vs_x";
+  f.title = "Measured Y against theoretical X";
+  f.caption = "Each point is one trial: X from the converter with its first-order standard uncertainty, "
+              "Y as measured with u(Y). The dashed line is y = x (no friction); the straight lines are "
+              "the OLS and York fits; the friction model is Y = x_rest(mu) at each trial's setting.";
+  std::ostringstream data;
+  data << "# X_mm Y_mm uX_mm uY_mm (one line per trial)\n";
+  for (const auto& r : a.rows)
+    data << Num(r.x_eq * 1e3) << " " << Num(r.y * 1e3) << " " << Num(r.u_x_eq * 1e3) << " " << Num(r.u_y * 1e3) << "\n";
+  const FitOutcome* friction = a.Fit("friction");
+  data << "\n\n# X_mm Y_friction_mm (friction model at each trial's setting, increasing X)\n";
+  if (friction && friction->report)
+    for (size_t i : ByX(a)) data << Num(a.rows[i].x_eq * 1e3) << " " << Num(friction->report->rows[i].fitted * 1e3) << "\n";
+  f.data = data.str();
+  std::ostringstream plot;
+  plot << LineParameters(a, "ols") << LineParameters(a, "york");
+  plot << "set xlabel 'X, theoretical equilibrium (mm)'\n"
+       << "set ylabel 'Y, measured farthest rest position (mm)'\n"
+       << "set offsets graph 0.04, graph 0.04, graph 0.06, graph 0.04\n"
+       << "plot '" << f.name << ".dat' index 0 using 1:2:3:4 with xyerrorbars pt 7 ps 0.7 lc rgb '#1f4e79' "
+       << "title 'trials: Y ± u(Y), X ± u(X)', \\\n"
+       << "  x with lines dt 2 lw 1.5 lc rgb '#777777' title 'y = x'";
+  if (a.Fit("ols")->report)
+    plot << ", \\\n  k_ols*x + c_ols with lines lw 2 lc rgb '#d62728' "
+         << "title sprintf('OLS: Y = %.4f X %+.2f mm', k_ols, c_ols)";
+  if (a.Fit("york")->report)
+    plot << ", \\\n  k_york*x + c_york with lines lw 2 dt 4 lc rgb '#2ca02c' "
+         << "title sprintf('York: Y = %.4f X %+.2f mm', k_york, c_york)";
+  if (friction && friction->report)
+    plot << ", \\\n  '" << f.name << ".dat' index 1 using 1:2 with linespoints pt 6 ps 0.6 lw 2 lc rgb '#ff7f0e' "
+         << "title sprintf('friction model, mu = %.4f', " << Num(friction->report->Parameter("mu").value) << ")";
+  f.plot = plot.str();
+  return f;
+}
+
+// The offset Y − X carries the physics (friction, and anything the model misses); on a Y-against-X
+// plot it is a few millimetres on a scale of hundreds and cannot be seen.
+GnuplotFigure OffsetAgainstX(const ExperimentAnalysis& a) {
+  GnuplotFigure f;
+  f.name = "fit_offset";
+  f.title = "Offset Y - X against X";
+  f.caption = "The measured offset of the farthest rest position from the theoretical equilibrium, with "
+              "sqrt(u(X)^2 + u(Y)^2) error bars. Zero is the frictionless model; the straight-line fits "
+              "appear as (k - 1)X + c; the friction model predicts x_rest(mu) - X at each trial's setting.";
+  std::ostringstream data;
+  data << "# X_mm (Y-X)_mm u_mm (one line per trial)\n";
+  for (const auto& r : a.rows)
+    data << Num(r.x_eq * 1e3) << " " << Num((r.y - r.x_eq) * 1e3) << " " << Num(std::hypot(r.u_x_eq, r.u_y) * 1e3)
+         << "\n";
+  const FitOutcome* friction = a.Fit("friction");
+  data << "\n\n# X_mm (x_rest(mu)-X)_mm (friction model, increasing X)\n";
+  if (friction && friction->report)
+    for (size_t i : ByX(a))
+      data << Num(a.rows[i].x_eq * 1e3) << " " << Num((friction->report->rows[i].fitted - a.rows[i].x_eq) * 1e3) << "\n";
+  f.data = data.str();
+  std::ostringstream plot;
+  plot << LineParameters(a, "ols") << LineParameters(a, "york");
+  plot << "set xlabel 'X, theoretical equilibrium (mm)'\n"
+       << "set ylabel 'Y - X (mm)'\n"
+       << "set offsets graph 0.04, graph 0.04, graph 0.1, graph 0.1\n"
+       << "plot '" << f.name << ".dat' index 0 using 1:2:3 with yerrorbars pt 7 ps 0.7 lc rgb '#1f4e79' "
+       << "title 'trials: Y - X'";
+  plot << ", \\\n  0 with lines dt 2 lw 1.5 lc rgb '#777777' title 'no friction'";
+  if (a.Fit("ols")->report)
+    plot << ", \\\n  (k_ols - 1)*x + c_ols with lines lw 2 lc rgb '#d62728' title 'OLS line'";
+  if (a.Fit("york")->report)
+    plot << ", \\\n  (k_york - 1)*x + c_york with lines lw 2 dt 4 lc rgb '#2ca02c' title 'York line'";
+  if (friction && friction->report)
+    plot << ", \\\n  '" << f.name << ".dat' index 1 using 1:2 with linespoints pt 6 ps 0.6 lw 2 lc rgb '#ff7f0e' "
+         << "title sprintf('friction model, mu = %.4f', " << Num(friction->report->Parameter("mu").value) << ")";
+  f.plot = plot.str();
+  return f;
+}
+
+GnuplotFigure Residuals(const ExperimentAnalysis& a) {
+  GnuplotFigure f;
+  f.name = "fit_residuals";
+  f.title = "Residuals against X";
+  f.caption = "Y minus the fitted value for the OLS straight line (with u(Y) error bars) and for the "
+              "friction model. Structure here (a trend or a curve) means the model misses something.";
+  const FitOutcome* ols = a.Fit("ols");
+  const FitOutcome* friction = a.Fit("friction");
+  std::ostringstream data;
+  data << "# X_mm residual_OLS_mm uY_mm\n";
+  if (ols->report)
+    for (size_t i = 0; i < a.rows.size(); ++i)
+      data << Num(a.rows[i].x_eq * 1e3) << " " << Num(ols->report->rows[i].residual * 1e3) << " "
+           << Num(a.rows[i].u_y * 1e3) << "\n";
+  data << "\n\n# X_mm residual_friction_mm\n";
+  if (friction && friction->report)
+    for (size_t i = 0; i < a.rows.size(); ++i)
+      data << Num(a.rows[i].x_eq * 1e3) << " " << Num(friction->report->rows[i].residual * 1e3) << "\n";
+  f.data = data.str();
+  std::ostringstream plot;
+  plot << "set xlabel 'X, theoretical equilibrium (mm)'\n"
+       << "set ylabel 'residual Y - fit (mm)'\n"
+       << "set offsets graph 0.04, graph 0.04, graph 0.1, graph 0.1\n"
+       << "plot 0 with lines lc rgb '#777777' notitle";
+  if (ols->report)
+    plot << ", \\\n  '" << f.name << ".dat' index 0 using 1:2:3 with yerrorbars pt 7 ps 0.7 lc rgb '#d62728' "
+         << "title 'OLS straight line'";
+  if (friction && friction->report)
+    plot << ", \\\n  '" << f.name << ".dat' index 1 using 1:2 with points pt 6 ps 1 lw 1.5 lc rgb '#ff7f0e' "
+         << "title 'friction model'";
+  f.plot = plot.str();
+  return f;
+}
+
+}  // namespace
+
+std::vector<GnuplotFigure> AnalysisFigures(const ExperimentAnalysis& analysis) {
+  return {YAgainstX(analysis), OffsetAgainstX(analysis), Residuals(analysis)};
+}
+
+}  // namespace uphill::report

@@ -1,0 +1,144 @@
+#include "report/document.hpp"
+
+#include <boost/archive/iterators/base64_from_binary.hpp>
+#include <boost/archive/iterators/transform_width.hpp>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace uphill::report {
+namespace {
+
+const char* kCss = R"(body{font-family:'DejaVu Sans',Helvetica,Arial,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222;line-height:1.45}
+h1{font-size:1.7em;border-bottom:2px solid #1f4e79;padding-bottom:.2em}h2{font-size:1.3em;color:#1f4e79;margin-top:1.6em}
+table{border-collapse:collapse;margin:.6em 0 1.2em;font-size:.88em}th,td{border:1px solid #ccc;padding:.25em .55em;text-align:right;vertical-align:top}
+th{background:#eef3f8}td:first-child,th:first-child{text-align:left}tr:nth-child(even) td{background:#fafafa}
+figure{margin:1em 0 1.6em}figure img{width:100%;max-width:900px;border:1px solid #ddd}figcaption{font-size:.9em;color:#555;max-width:900px}
+.note{color:#555;font-size:.9em})";
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot be read to embed it in the report");
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string MarkdownCell(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '|') out += "\\|";
+    else if (c == '\n') out += "<br>";
+    else out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+void Document::Heading(const std::string& text) { blocks.push_back({Block::Kind::kHeading, text, {}, {}, "", ""}); }
+void Document::Paragraph(const std::string& text) { blocks.push_back({Block::Kind::kParagraph, text, {}, {}, "", ""}); }
+void Document::List(const std::vector<std::string>& items) {
+  if (!items.empty()) blocks.push_back({Block::Kind::kList, "", items, {}, "", ""});
+}
+void Document::AddTable(const Table& table) { blocks.push_back({Block::Kind::kTable, "", {}, table, "", ""}); }
+void Document::Figure(const std::string& stem, const std::string& title, const std::string& caption) {
+  blocks.push_back({Block::Kind::kFigure, title, {}, {}, stem, caption});
+}
+
+std::string HtmlEscape(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::string Base64(const std::string& bytes) {
+  using namespace boost::archive::iterators;
+  using Encoder = base64_from_binary<transform_width<std::string::const_iterator, 6, 8>>;
+  std::string out(Encoder(bytes.begin()), Encoder(bytes.end()));
+  out.append((3 - bytes.size() % 3) % 3, '=');
+  return out;
+}
+
+std::string RenderHtml(const Document& d, const std::string& directory) {
+  std::ostringstream o;
+  o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" << HtmlEscape(d.title)
+    << "</title>\n<style>\n" << kCss << "\n</style>\n</head>\n<body>\n<h1>" << HtmlEscape(d.title) << "</h1>\n";
+  for (const Block& b : d.blocks) {
+    switch (b.kind) {
+      case Block::Kind::kHeading: o << "<h2>" << HtmlEscape(b.text) << "</h2>\n"; break;
+      case Block::Kind::kParagraph: o << "<p>" << HtmlEscape(b.text) << "</p>\n"; break;
+      case Block::Kind::kList:
+        o << "<ul>\n";
+        for (const auto& item : b.items) o << "<li>" << HtmlEscape(item) << "</li>\n";
+        o << "</ul>\n";
+        break;
+      case Block::Kind::kTable:
+        o << "<table>\n<tr>";
+        for (const auto& h : b.table.header) o << "<th>" << HtmlEscape(h) << "</th>";
+        o << "</tr>\n";
+        for (const auto& row : b.table.rows) {
+          o << "<tr>";
+          for (const auto& cell : row) o << "<td>" << HtmlEscape(cell) << "</td>";
+          o << "</tr>\n";
+        }
+        o << "</table>\n";
+        break;
+      case Block::Kind::kFigure: {
+        const std::string svg = Slurp((std::filesystem::path(directory) / (b.figure_stem + ".svg")).string());
+        o << "<figure>\n<img alt=\"" << HtmlEscape(b.text) << "\" src=\"data:image/svg+xml;base64," << Base64(svg)
+          << "\">\n<figcaption><b>" << HtmlEscape(b.text) << ".</b> " << HtmlEscape(b.caption) << " (files: "
+          << HtmlEscape(b.figure_stem) << ".svg, .png, .gp, .dat)</figcaption>\n</figure>\n";
+        break;
+      }
+    }
+  }
+  o << "</body>\n</html>\n";
+  return o.str();
+}
+
+std::string RenderMarkdown(const Document& d) {
+  std::ostringstream o;
+  o << "# " << d.title << "\n\n";
+  for (const Block& b : d.blocks) {
+    switch (b.kind) {
+      case Block::Kind::kHeading: o << "## " << b.text << "\n\n"; break;
+      case Block::Kind::kParagraph: o << b.text << "\n\n"; break;
+      case Block::Kind::kList:
+        for (const auto& item : b.items) o << "- " << item << "\n";
+        o << "\n";
+        break;
+      case Block::Kind::kTable:
+        o << "|";
+        for (const auto& h : b.table.header) o << " " << MarkdownCell(h) << " |";
+        o << "\n|";
+        for (size_t i = 0; i < b.table.header.size(); ++i) o << (i == 0 ? "---|" : "---:|");
+        o << "\n";
+        for (const auto& row : b.table.rows) {
+          o << "|";
+          for (const auto& cell : row) o << " " << MarkdownCell(cell) << " |";
+          o << "\n";
+        }
+        o << "\n";
+        break;
+      case Block::Kind::kFigure:
+        o << "![" << b.text << "](" << b.figure_stem << ".png)\n\n*" << b.text << ".* " << b.caption << " (`"
+          << b.figure_stem << ".svg`, script `" << b.figure_stem << ".gp`)\n\n";
+        break;
+    }
+  }
+  return o.str();
+}
+
+}  // namespace uphill::report

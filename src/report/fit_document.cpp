@@ -1,0 +1,221 @@
+#include "report/fit_document.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <numbers>
+#include <sstream>
+
+#include "io/atomic_file.hpp"
+#include "report/analysis_figures.hpp"
+#include "report/fit_json.hpp"
+#include "report/gnuplot_figure.hpp"
+
+namespace uphill::report {
+namespace {
+
+std::string Fmt(const char* format, double v) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, v);
+  return buffer;
+}
+std::string Mm(double m, const char* format = "%.2f") { return Fmt(format, m * 1e3); }
+std::string Deg(double rad) { return Fmt("%.3f", rad * 180.0 / std::numbers::pi); }
+std::string Opt(const std::optional<double>& v, const char* format) { return v ? Fmt(format, *v) : "-"; }
+
+// {"a": "15.875 mm", "type": "spheroid"} -> "type = spheroid, a = 15.875 mm" (type first).
+std::string KeyValues(const nlohmann::json& object) {
+  std::string out;
+  const auto add = [&](const std::string& key, const nlohmann::json& v) {
+    out += (out.empty() ? "" : ", ") + key + " = " + (v.is_string() ? v.get<std::string>() : v.dump());
+  };
+  if (object.contains("type")) add("type", object.at("type"));
+  for (const auto& [key, v] : object.items())
+    if (key != "type") add(key, v);
+  return out;
+}
+
+std::string ParameterText(const FitReport& r, const ParameterEstimate& p) {
+  const bool length = p.name == "c";
+  const auto show = [&](double v) { return length ? Mm(v, "%.3f") + " mm" : Fmt("%.6g", v); };
+  const auto primary = r.StandardError(p.name, r.primary_scaling);
+  return p.name + " = " + show(p.value) + (primary ? " ± " + show(*primary) : " (no uncertainty: exact fit)");
+}
+
+Table FitTable(const ExperimentAnalysis& a) {
+  Table t;
+  t.header = {"fit", "parameters (± standard error)", "s.e. convention", "chi2", "dof", "chi2/dof", "p-value",
+              "AIC", "BIC", "flagged rows"};
+  for (const FitOutcome& f : a.fits) {
+    if (!f.report) {
+      t.rows.push_back({f.title, "not available: " + f.unavailable, "", "", "", "", "", "", "", ""});
+      continue;
+    }
+    const FitReport& r = *f.report;
+    std::string params;
+    for (const auto& p : r.parameters) params += (params.empty() ? "" : "; ") + ParameterText(r, p);
+    std::string flagged;
+    for (size_t i : r.outliers) flagged += (flagged.empty() ? "outliers: " : ", ") + a.rows[i].source->trial;
+    for (const auto& d : r.downweighted)
+      flagged += std::string(flagged.empty() ? "" : "; ") + "down-weighted " + a.rows[d.row].source->trial +
+                 " (w = " + Fmt("%.2f", d.weight) + ")";
+    const bool scaled = r.primary_scaling == ErrorScaling::kScaled;
+    // OLS has no stated uncertainties: its chi2 is the residual sum of squares, in m² → mm².
+    const bool ols = r.method == FitMethod::kOrdinaryLeastSquares;
+    const std::string chi2 = ols ? "RSS " + Fmt("%.4g", r.chi2 * 1e6) + " mm^2" : Fmt("%.4g", r.chi2);
+    const std::string reduced = ols ? (r.reduced_chi2 ? "s^2 " + Fmt("%.3g", *r.reduced_chi2 * 1e6) + " mm^2" : "-")
+                                    : Opt(r.reduced_chi2, "%.3g");
+    t.rows.push_back({f.title, params, scaled ? "scaled by sqrt(chi2/dof)" : "unscaled (stated u)",
+                      chi2, std::to_string(r.dof), reduced,
+                      Opt(r.p_value, "%.3g"), Opt(r.aic, "%.2f"), Opt(r.bic, "%.2f"), flagged});
+  }
+  return t;
+}
+
+Table RowTable(const ExperimentAnalysis& a) {
+  Table t;
+  t.header = {"trial", "series", "theta (deg)", "alpha (deg)", "X (mm)", "u(X) 1st (mm)", "u(X) MC (mm)",
+              "Y (mm)", "u(Y) (mm)", "Y - X (mm)"};
+  const FitOutcome* ols = a.Fit("ols");
+  const FitOutcome* york = a.Fit("york");
+  if (ols && ols->report) t.header.push_back("OLS residual (mm)");
+  if (york && york->report) t.header.push_back("York norm. residual");
+  t.header.push_back("flags");
+  for (size_t i = 0; i < a.rows.size(); ++i) {
+    const AnalysedRow& r = a.rows[i];
+    std::vector<std::string> row = {r.source->trial, r.source->series, Deg(r.theta), Deg(r.alpha), Mm(r.x_eq),
+                                    Mm(r.u_x_eq, "%.3f"), Mm(r.u_x_eq_mc, "%.3f"), Mm(r.y), Mm(r.u_y, "%.3f"),
+                                    Mm(r.y - r.x_eq)};
+    std::string flags;
+    for (const auto& f : r.flags) flags += (flags.empty() ? "" : "; ") + f;
+    if (ols && ols->report) {
+      row.push_back(Mm(ols->report->rows[i].residual));
+      if (ols->report->rows[i].outlier) flags += std::string(flags.empty() ? "" : "; ") + "OLS outlier";
+    }
+    if (york && york->report) {
+      row.push_back(Fmt("%.2f", york->report->rows[i].normalised));
+      if (york->report->rows[i].outlier) flags += std::string(flags.empty() ? "" : "; ") + "York outlier";
+    }
+    row.push_back(flags);
+    t.rows.push_back(row);
+  }
+  return t;
+}
+
+std::string Summary(const ExperimentAnalysis& a) {
+  std::ostringstream s;
+  s << a.rows.size() << " trials analysed";
+  if (!a.row_errors.empty()) s << " (" << a.row_errors.size() << " rows left out, listed below)";
+  s << ". ";
+  if (const FitOutcome* ols = a.Fit("ols"); ols && ols->report) {
+    const FitReport& r = *ols->report;
+    s << "The paper's fit (OLS) gives Y = " << Fmt("%.4f", r.slope()) << "·X " << (r.intercept() < 0 ? "- " : "+ ")
+      << Mm(std::abs(r.intercept())) << " mm";
+    if (const auto se = r.StandardError("k", r.primary_scaling)) s << " (slope ± " << Fmt("%.4f", *se) << ")";
+    s << ". ";
+  }
+  if (const FitOutcome* york = a.Fit("york"); york && york->report) {
+    const FitReport& r = *york->report;
+    s << "With the uncertainties of both X and Y (York): slope " << Fmt("%.4f", r.slope()) << ", intercept "
+      << Mm(r.intercept()) << " mm, chi2/dof = " << Opt(r.reduced_chi2, "%.2f") << ". ";
+  }
+  if (const FitOutcome* fr = a.Fit("friction"); fr && fr->report) {
+    const FitReport& r = *fr->report;
+    s << "The friction model (rest where |dz/dx| <= mu) fits mu = " << Fmt("%.5f", r.Parameter("mu").value);
+    if (const auto se = r.StandardError("mu", r.primary_scaling)) s << " ± " << Fmt("%.5f", *se);
+    s << ". ";
+  }
+  if (a.friction_vs_line) s << a.friction_vs_line->verdict;
+  return s.str();
+}
+
+}  // namespace
+
+Document FitDocument(const ExperimentAnalysis& a, bool with_figures) {
+  const io::Experiment& e = *a.experiment;
+  Document d;
+  d.title = "Fit report: " + (e.title.empty() ? e.directory : e.title);
+  d.Paragraph(Summary(a));
+  d.Heading("Setup");
+  std::vector<std::string> setup = {"Experiment folder: " + e.directory};
+  if (!e.operator_name.empty()) setup.push_back("Operator: " + e.operator_name);
+  if (!e.date.empty()) setup.push_back("Date: " + e.date);
+  const auto& meta = e.metadata;
+  setup.push_back("Body: " + KeyValues(meta.at("body")));
+  if (meta.contains("apparatus")) setup.push_back("Apparatus constants: " + KeyValues(meta.at("apparatus")));
+  if (meta.contains("uncertainties"))
+    setup.push_back("Default standard uncertainties: " + KeyValues(meta.at("uncertainties")));
+  setup.push_back("Conventions: x horizontal from O (the rails' meeting point); tan(theta) = H/L and "
+                  "tan(alpha/2) = D/(2L) with L horizontal unless the L convention says along-rail. "
+                  "X is the theoretical unstable equilibrium, Y the measured farthest rest position.");
+  d.List(setup);
+  if (!e.notes.empty()) {
+    d.Heading("Notes");
+    std::istringstream notes(e.notes);
+    for (std::string line; std::getline(notes, line);) d.Paragraph(line);
+  }
+  if (with_figures) {
+    d.Heading("Figures");
+    for (const GnuplotFigure& f : AnalysisFigures(a)) d.Figure(f.name, f.title, f.caption);
+  }
+  d.Heading("Fits of Y against X");
+  d.AddTable(FitTable(a));
+  d.Paragraph("Standard errors: 'unscaled' come from the stated uncertainties alone; 'scaled' are multiplied by "
+              "sqrt(chi2/dof) (fit.json has both for every fit). The p-value is the probability of a chi2 at "
+              "least this large if the model and the stated uncertainties are right.");
+  d.List(a.notes);
+  for (const FitOutcome& f : a.fits)
+    if (f.report)
+      for (const auto& note : f.report->notes) d.List({f.method + ": " + note});
+  d.Heading("Trials");
+  d.AddTable(RowTable(a));
+  if (!a.row_errors.empty()) {
+    d.Heading("Rows left out");
+    d.List(a.row_errors);
+  }
+  return d;
+}
+
+std::string RenderText(const Document& d) {
+  std::ostringstream o;
+  o << d.title << "\n" << std::string(d.title.size(), '=') << "\n\n";
+  for (const Block& b : d.blocks) {
+    switch (b.kind) {
+      case Block::Kind::kHeading: o << b.text << "\n" << std::string(b.text.size(), '-') << "\n"; break;
+      case Block::Kind::kParagraph: o << b.text << "\n\n"; break;
+      case Block::Kind::kList:
+        for (const auto& item : b.items) o << "  * " << item << "\n";
+        o << "\n";
+        break;
+      case Block::Kind::kFigure: break;
+      case Block::Kind::kTable: {
+        std::vector<size_t> width(b.table.header.size());
+        for (size_t i = 0; i < width.size(); ++i) width[i] = b.table.header[i].size();
+        for (const auto& row : b.table.rows)
+          for (size_t i = 0; i < row.size() && i < width.size(); ++i) width[i] = std::max(width[i], row[i].size());
+        const auto print = [&](const std::vector<std::string>& row) {
+          for (size_t i = 0; i < row.size(); ++i)
+            o << (i ? "  " : "") << row[i] << (i + 1 < row.size() ? std::string(width[i] - row[i].size(), ' ') : "");
+          o << "\n";
+        };
+        print(b.table.header);
+        for (const auto& row : b.table.rows) print(row);
+        o << "\n";
+        break;
+      }
+    }
+  }
+  return o.str();
+}
+
+void WriteFitReport(const ExperimentAnalysis& a, const std::string& directory) {
+  namespace fs = std::filesystem;
+  fs::create_directories(directory);
+  for (const GnuplotFigure& f : AnalysisFigures(a)) RenderFigure(f, directory);
+  const Document d = FitDocument(a, true);
+  io::WriteFileAtomically((fs::path(directory) / "fit.json").string(), AnalysisToJson(a).dump(2) + "\n");
+  io::WriteFileAtomically((fs::path(directory) / "report.md").string(), RenderMarkdown(d));
+  io::WriteFileAtomically((fs::path(directory) / "report.html").string(), RenderHtml(d, directory));
+}
+
+}  // namespace uphill::report
