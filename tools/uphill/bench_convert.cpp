@@ -231,8 +231,11 @@ void Run(const BenchFlags& f) {
   if (f.repeats < 1) throw InputError("--repeats", "must be at least 1");
   const std::string reference = f.reference.empty() ? FindUpward("tests/data/physics_reference.json") : f.reference;
   const BatchKernel kernel = BatchKernel::kAuto;
-  std::printf("uphill bench convert: one core, thread CPU time, best of %d; batch kernel %s\n\n",
+  std::printf("uphill bench convert: one core, thread CPU time, best of %d; batch kernel %s\n",
               f.repeats, BatchKernelName(kernel));
+  std::printf("Monte Carlo case (the lab spheroid, metres):");
+  for (const LabInput& x : kLab) std::printf(" %s = %g ± %g", x.name, x.value, x.u);
+  std::printf("\n\n");
   std::printf("%-44s %9s %10s %11s  %s\n", "workload", "n", "time/item", "rate", "accuracy");
 
   // Random configurations over the apparatus' range (metres).
@@ -255,17 +258,16 @@ void Run(const BenchFlags& f) {
   auto accuracy = [&](BatchKernel k) {
     if (reference.empty()) return std::string("(tests/data/physics_reference.json not found)");
     const Accuracy acc = AgainstReferences(reference, k);
-    return Fmt("max rel err %.2g", acc.max_rel) + " vs 60-digit refs (θ, α, X: " +
+    return Fmt("max rel err %.2g", acc.max_rel) + " vs 60-digit refs (theta, alpha, X: " +
            std::to_string(acc.values) + " values)";
   };
   convert(kernel);  // first touch of the output pages outside the timing
   const double t_scalar_model = BestOf(1, [&] { convert(BatchKernel::kScalar); });
-  std::vector<double> scalar_x_eq = x_eq;
   const double t_convert = BestOf(f.repeats, [&] { convert(kernel); });
-  Row(std::string("convert L,H,D -> θ,α,X (") + (BatchKernelAvailable(BatchKernel::kAvx2) ? "avx2" : "scalar") +
-          " batch)",
+  Row(std::string("convert L,H,D -> theta,alpha,X (") +
+          (BatchKernelAvailable(BatchKernel::kAvx2) ? "avx2" : "scalar") + ")",
       n, t_convert, accuracy(kernel));
-  Row("convert, scalar model (libm atan2, hypot)", n, t_scalar_model, accuracy(BatchKernel::kScalar));
+  Row("convert, scalar = the model (libm atan2)", n, t_scalar_model, accuracy(BatchKernel::kScalar));
 
   // Monte Carlo: the lab case, all five inputs uncertain.
   const auto rails = UncertainRails::Apparatus({kLab[0].value, kLab[0].u}, {kLab[1].value, kLab[1].u},
@@ -280,7 +282,7 @@ void Run(const BenchFlags& f) {
   for (const PropagatedValue* y : mc.Outputs())
     worst_fo = std::max(worst_fo, std::abs(y->u_monte_carlo / y->u_first_order - 1));
   const double se_u = 1.0 / std::sqrt(2.0 * static_cast<double>(mc.valid_trials - 1));
-  Row("Monte Carlo, lab case: 5 inputs -> 5 outputs", f.trials, t_mc,
+  Row("Monte Carlo (Propagate), 5 inputs, 5 outputs", f.trials, t_mc,
       Fmt("u to ±%.2f %% (1/sqrt(2M))", 100 * se_u) + Fmt("; |u_MC/u_1st - 1| <= %.2f %%", 100 * worst_fo));
 
   // NumPy.
@@ -320,7 +322,7 @@ void Run(const BenchFlags& f) {
     for (std::size_t i = 0; i < n; ++i)
       diff = std::max(diff, std::abs((*ours[k])[i] - np[k][i]) / std::abs(np[k][i]));
   const double t_np = np_convert.at("seconds");
-  Row("NumPy " + np_convert.at("numpy").get<std::string>() + " convert (same inputs)", n, t_np,
+  Row("NumPy " + np_convert.at("numpy").get<std::string>() + " convert, same inputs", n, t_np,
       Fmt("max rel diff vs uphill %.2g", diff));
 
   nlohmann::json lab_case;
@@ -335,7 +337,7 @@ void Run(const BenchFlags& f) {
   for (const PropagatedValue* y : mc.Outputs())
     worst_np = std::max(worst_np, std::abs(np_mc.at("stats").at(y->name).at("u").get<double>() / y->u_monte_carlo - 1));
   const double t_np_mc = np_mc.at("seconds");
-  Row("NumPy Monte Carlo, same case (own RNG)", f.trials, t_np_mc,
+  Row("NumPy Monte Carlo, same case, own RNG", f.trials, t_np_mc,
       Fmt("|u_NumPy/u_uphill - 1| <= %.2f %% (statistical)", 100 * worst_np));
 
   const double speed_convert = t_np / t_convert, speed_mc = t_np_mc / t_mc;
@@ -345,7 +347,6 @@ void Run(const BenchFlags& f) {
               speed_mc >= 10 ? "met" : "NOT met");
   std::printf("NumPy per configuration %.1f ns, per Monte Carlo trial %.1f ns\n", 1e9 * t_np / static_cast<double>(n),
               1e9 * t_np_mc / static_cast<double>(f.trials));
-  (void)scalar_x_eq;
 }
 
 }  // namespace

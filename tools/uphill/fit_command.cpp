@@ -2,14 +2,13 @@
 //   uphill fit EXP [--json]                       an experiment folder (data/README.md)
 //   uphill fit --xy FILE.csv [--method M] [--json]  arbitrary X-Y data, header X,Y[,uX,uY]
 // `uphill report EXP -o DIR`: the full report (HTML, Markdown, fit.json, figures).
-#include <charconv>
 #include <iostream>
 
 #include "commands.hpp"
 #include "fit/least_squares_line.hpp"
 #include "fit/robust_line.hpp"
 #include "fit/york_line.hpp"
-#include "io/csv_table.hpp"
+#include "io/xy_table.hpp"
 #include "model/input_error.hpp"
 #include "report/fit_document.hpp"
 #include "report/fit_json.hpp"
@@ -26,45 +25,18 @@ struct FitFlags {
   std::string output;
 };
 
-double Cell(const io::CsvTable& table, const io::CsvRow& row, int column) {
-  const std::string& text = row.cells[column];
-  double v = 0;
-  const char* begin = text.data();
-  const char* end = begin + text.size();
-  while (begin < end && *begin == ' ') ++begin;
-  if (begin < end && *begin == '+') ++begin;
-  const auto [ptr, ec] = std::from_chars(begin, end, v);
-  const std::string where = io::CellContext(table, row.row, table.header[column]);
-  if (ec != std::errc() || ptr == begin) throw InputError(where, "'" + text + "' is not a number");
-  for (const char* p = ptr; p < end; ++p)
-    if (*p != ' ') throw InputError(where, "'" + text + "' is not a plain number");
-  if (!std::isfinite(v)) throw InputError(where, "'" + text + "' is not a finite number");
-  return v;
-}
-
-// Reads X,Y[,uX,uY]; rows that cannot be read are reported on stderr and left out.
+// Reads X,Y[,uX,uY] (io/xy_table.hpp); rows that cannot be read are reported on stderr and left out.
 LineData ReadXy(const std::string& path) {
-  const io::CsvTable table = io::ReadCsvFile(path);
-  for (const auto& name : table.header)
-    if (name != "X" && name != "Y" && name != "uX" && name != "uY")
-      throw InputError(io::CellContext(table, 1, name), "unknown column (expected X, Y and optionally uX, uY)");
-  const int cx = table.Column("X"), cy = table.Column("Y"), cux = table.Column("uX"), cuy = table.Column("uY");
-  if (cx < 0 || cy < 0) throw InputError(table.source + ", row 1", "the header must have columns X and Y");
-  LineData data;
-  for (const io::CsvRow& row : table.rows) {
-    try {
-      if (!row.error.empty()) throw InputError(table.source + ", row " + std::to_string(row.row), row.error);
-      const double x = Cell(table, row, cx), y = Cell(table, row, cy);
-      const double ux = cux >= 0 ? Cell(table, row, cux) : 0.0, uy = cuy >= 0 ? Cell(table, row, cuy) : 0.0;
-      data.x.push_back(x);
-      data.y.push_back(y);
-      if (cux >= 0) data.u_x.push_back(ux);
-      if (cuy >= 0) data.u_y.push_back(uy);
-    } catch (const InputError& e) {
-      std::cerr << "uphill: " << e.what() << " (row left out)\n";
-      ExitStatus() = 2;
-    }
+  io::XyTable table = io::ReadXyFile(path);
+  for (const std::string& error : table.row_errors) {
+    std::cerr << "uphill: " << error << " (row left out)\n";
+    ExitStatus() = 2;
   }
+  LineData data;
+  data.x = std::move(table.x);
+  data.y = std::move(table.y);
+  data.u_x = std::move(table.u_x);
+  data.u_y = std::move(table.u_y);
   return data;
 }
 

@@ -1,0 +1,66 @@
+// Fuzz target: io::LoadExperiment (experiment.json + measurements.csv, data/README.md) and, when
+// rows are usable, report::AnalyseExperiment without Monte Carlo (mc_trials = 0) and its JSON
+// (what `uphill fit EXP --json` prints). Input: experiment.json, a NUL byte, measurements.csv
+// (no NUL: measurements.csv is absent). The files go to a per-process temporary folder.
+// Only uphill::InputError may escape; anything else (a crash, a sanitizer report, another
+// exception) is a bug.
+#include <unistd.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+
+#include "io/experiment.hpp"
+#include "model/input_error.hpp"
+#include "report/analysis.hpp"
+#include "report/fit_json.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace uphill;
+
+const fs::path& Folder() {
+  static const fs::path folder = [] {
+    fs::path p = fs::temp_directory_path() / ("uphill_fuzz_experiment_" + std::to_string(getpid()));
+    fs::create_directories(p);
+    std::atexit([] { std::error_code ec; fs::remove_all(Folder(), ec); });
+    return p;
+  }();
+  return folder;
+}
+
+void Write(const fs::path& path, std::string_view text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view input(reinterpret_cast<const char*>(data), size);
+  const size_t nul = input.find('\0');
+  const fs::path& folder = Folder();
+  Write(folder / "experiment.json", input.substr(0, nul));
+  if (nul == std::string_view::npos) {
+    std::error_code ec;
+    fs::remove(folder / "measurements.csv", ec);
+  } else {
+    Write(folder / "measurements.csv", input.substr(nul + 1));
+  }
+  try {
+    const io::Experiment experiment = io::LoadExperiment(folder.string());
+    if (experiment.UsableRows().empty() || experiment.UsableRows().size() > 32) return 0;
+    report::AnalysisOptions options;
+    options.mc_trials = 0;  // first-order u(X) only: Monte Carlo is the model's, not the reader's
+    const report::ExperimentAnalysis analysis = report::AnalyseExperiment(experiment, options);
+    (void)report::AnalysisToJson(analysis).dump();
+  } catch (const InputError&) {
+    // The documented refusal.
+  }
+  return 0;
+}
