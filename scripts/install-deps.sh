@@ -9,7 +9,14 @@ packages=(
   g++ cmake ninja-build ccache pkg-config
   libeigen3-dev libceres-dev nlohmann-json3-dev libgtest-dev libcli11-dev libboost-dev
   libcsv-dev gnuplot-nox
+  libcpp-httplib-dev chromium
 )
+# The browser test of `uphill serve` (tests/e2e) runs on node + npm and Debian's chromium. A
+# machine that already has Node (e.g. a newer one from elsewhere) keeps it: Debian's npm would
+# conflict with it.
+if ! command -v node > /dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
 if [[ "${1:-}" == "--bench" ]]; then
   packages+=(python3-numpy python3-scipy)
 fi

@@ -119,6 +119,12 @@ TEST(FitCli, HardCasesGiveClearErrorsOrNotes) {
   EXPECT_TRUE(j.at("exact"));
   EXPECT_TRUE(j.at("u_slope").is_null());  // no scatter, no uncertainty
   EXPECT_FALSE(j.at("notes").empty());
+  // Found by fuzzing: an uncertainty near the largest double made Ceres' residuals overflow.
+  const auto huge = RunUphill("fit --xy - --method york",
+                              "X,Y,uX,uY\n0.3,0.59,0.001,2\n0.3,0.59,0.001,0.002\n0.4,0.8,0.001e+308,0.002\n");
+  EXPECT_EQ(huge.status, 2);
+  EXPECT_EQ(huge.err, "uphill: <stdin>, row 4, column uX: must lie in [1e-100, 1e100] (got "
+                      "9.9999999999999994e+304): its square or inverse square would overflow a double\n");
   const auto method = RunUphill("fit --xy - --method odr", "X,Y\n1,2\n2,3\n3,5\n");
   EXPECT_EQ(method.status, 2);
   EXPECT_EQ(method.err, "uphill: --method: must be ols, wls, york or robust (got 'odr')\n");

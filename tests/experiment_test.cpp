@@ -111,5 +111,34 @@ TEST(Experiment, UnitsMustMatchTheQuantity) {
                                  "(accepted: mm, cm, m, km, um, in)");
 }
 
+// Regression tests for what fuzzing the readers found (tests/fuzz, scripts/fuzz.sh).
+
+TEST(FuzzRegression, BodyWithoutTypeIsAnInputError) {
+  // nlohmann::json's out_of_range ("key 'type' not found") escaped: `uphill fit` ended as an
+  // internal error.
+  const std::string dir = MakeExperiment(
+      "notype", R"({"format": "uphill-experiment/1", "body": {"R": "12.7 mm"}, "apparatus": {"H": "300 mm"}})",
+      "trial,L_mm,D_mm,Y_mm\nt1,1165,150,390\n");
+  EXPECT_EQ(LoadError(dir), dir + "/experiment.json: body.type: is missing (sphere, spheroid or double-cone)");
+}
+
+TEST(FuzzRegression, DeeplyNestedJsonValuesAreRefusedWithoutRecursion) {
+  // A value nested 10^5 deep was dumped into the error message, once per level: stack overflow.
+  // Values of body, apparatus and uncertainties must be strings even when no row uses them, as
+  // the metadata is copied (recursively) into fit.json.
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  std::string dir = MakeExperiment(
+      "deep_notes", R"({"format": "uphill-experiment/1", "notes": [)" + deep + R"(], "body": {"type": "sphere", "R": "1 mm"}})",
+      "trial,Y_mm\nt,5\n");
+  EXPECT_EQ(LoadError(dir), dir + "/experiment.json: notes: must be a string with a unit, e.g. \"300 mm\" (got an array)");
+  dir = MakeExperiment("deep_format", R"({"format": )" + deep + "}", "trial,Y_mm\nt,5\n");
+  EXPECT_EQ(LoadError(dir), dir + "/experiment.json: format: must be \"uphill-experiment/1\" (got an array)");
+  dir = MakeExperiment("deep_unused", std::string(R"({"format": "uphill-experiment/1", "body": {"type": "spheroid",)") +
+                                          R"( "a": "15.875 mm", "b": "25.4 mm"}, "apparatus": {"H": "300 mm"},)" +
+                                          R"( "uncertainties": {"h": )" + deep + "}}",
+                       "trial,L_mm,D_mm,Y_mm\nt1,1165,150,390\n");
+  EXPECT_EQ(LoadError(dir), dir + "/experiment.json: uncertainties.h: must be a string with a unit, e.g. \"300 mm\" (got an array)");
+}
+
 }  // namespace
 }  // namespace uphill::io

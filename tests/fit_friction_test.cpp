@@ -11,6 +11,7 @@
 
 #include "fit/friction_fit.hpp"
 #include "model/input_error.hpp"
+#include "model/propagation.hpp"
 #include "model/spheroid_on_line_rails.hpp"
 
 namespace uphill {
@@ -272,6 +273,148 @@ TEST(Friction, HardCasesAreRefusedClearly) {
   EXPECT_TRUE(one.exact);
   EXPECT_TRUE(RelNear(one.Parameter("mu").value, 0.008, 1e-10));
   EXPECT_TRUE(HasNote(one, "exact fit"));
+}
+
+
+// ---------------------------------------------------------------------------------------------
+// Errors in the model value (FrictionData::u_model): the recorded L and D carry measurement
+// errors, so each row's x_rest is computed from a slightly wrong setting.
+
+constexpr double kUL = 1e-3, kUD = 2e-4;  // the sample experiments' u(L) = 1 mm, u(D) = 0.2 mm
+
+struct NoisyInputs {
+  FrictionData data;
+  std::vector<double> u_x;  // u(x_eq) per row, first order
+};
+
+// One trial per setting (so the rows' model errors are independent): true L, D on the lab grid;
+// Y = x_rest(μ) of the true setting + N(0, u_y²); the scene and u_model from the recorded
+// L + N(0, u_L²), D + N(0, u_D²). u_model = u(X) = u(x_eq) from Propagate at the recorded values,
+// as report::AnalyseExperiment passes it.
+NoisyInputs NoisyLab(double mu, double u_y, std::uint64_t seed, bool with_u_model = true) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal;
+  NoisyInputs out;
+  PropagationOptions first_order;
+  first_order.trials = 0;
+  for (double L : {1.140, 1.165, 1.190})
+    for (double D : {0.100, 0.125, 0.150, 0.175, 0.200}) {
+      const Scene truth(Body::Spheroid(kA, kB),
+                        Rails::FromApparatus(L, kH, D, LConvention::kHorizontal));
+      const double y = truth.Rest(mu)->high + u_y * normal(rng);
+      const double L_rec = L + kUL * normal(rng), D_rec = D + kUD * normal(rng);
+      out.data.scenes.emplace_back(Body::Spheroid(kA, kB),
+                                   Rails::FromApparatus(L_rec, kH, D_rec, LConvention::kHorizontal));
+      out.data.y.push_back(y);
+      out.data.u_y.push_back(u_y);
+      const PropagationResult p =
+          Propagate(UncertainRails::Apparatus({L_rec, kUL}, {kH, 0.0}, {D_rec, kUD}),
+                    UncertainBody::Spheroid({kA, 0.0}, {kB, 0.0}), {}, first_order);
+      out.u_x.push_back(p.x_eq->u_first_order);
+    }
+  if (with_u_model) out.data.u_model = out.u_x;
+  return out;
+}
+
+struct PullStats {
+  double mean = 0, sd = 0, mean_reduced_chi2 = 0;
+};
+
+PullStats Pulls(double mu, double u_y, bool with_u_model, int trials) {
+  double sum = 0, sum2 = 0, chi = 0;
+  for (int t = 0; t < trials; ++t) {
+    const FitReport f = FitFriction(NoisyLab(mu, u_y, 5000 + t, with_u_model).data);
+    const double pull = (f.Parameter("mu").value - mu) / f.Parameter("mu").se_unscaled;
+    sum += pull;
+    sum2 += pull * pull;
+    chi += *f.reduced_chi2;
+  }
+  PullStats s;
+  s.mean = sum / trials;
+  s.sd = std::sqrt(sum2 / trials - s.mean * s.mean);
+  s.mean_reduced_chi2 = chi / trials;
+  return s;
+}
+
+TEST(FrictionModelUncertainty, NoisyLAndDGivePullsOfUnitWidth) {
+  // 200 seeded trials of 15 rows each, u(L) = 1 mm, u(D) = 0.2 mm, u(Y) = 0.1 mm (so that the
+  // model's scatter, u(X) ≈ 0.2-1 mm, dominates). Bands: for 200 standard-normal pulls the mean
+  // has SE 1/sqrt(200) = 0.071 and the SD has SE 1/sqrt(400) = 0.05; the mean of 200 χ²/ν with
+  // ν = 14 has SE sqrt(2/14)/sqrt(200) = 0.027. Allowed: ±0.25 (3.5 SE) on the mean pull, ±0.15
+  // (3 SE) on its SD and ±0.1 on χ²/ν (3.7 SE) - on top of which u_model = u(x_eq) is only an
+  // approximation of u(x_rest(μ)) (friction_fit.hpp), tested here at the samples' μ = 0.05, where
+  // it is poorest, and at the lab's μ = 0.008.
+  const int trials = 200;
+  for (const double mu : {0.008, 0.05}) {
+    SCOPED_TRACE("mu = " + std::to_string(mu));
+    const PullStats with = Pulls(mu, 1e-4, true, trials);
+    const PullStats without = Pulls(mu, 1e-4, false, trials);
+    std::printf("  mu = %.3f: with u_model pulls mean %.3f SD %.3f, chi2/nu %.3f; "
+                "without: SD %.3f, chi2/nu %.3f\n",
+                mu, with.mean, with.sd, with.mean_reduced_chi2, without.sd,
+                without.mean_reduced_chi2);
+    EXPECT_NEAR(with.mean, 0.0, 0.25);
+    EXPECT_NEAR(with.sd, 1.0, 0.15);
+    EXPECT_NEAR(with.mean_reduced_chi2, 1.0, 0.1);
+    // Without the model's uncertainty the same data are grossly over-confident.
+    EXPECT_GT(without.sd, 2.0);
+    EXPECT_GT(without.mean_reduced_chi2, 4.0);
+  }
+}
+
+TEST(FrictionModelUncertainty, EffectiveVarianceIsUsedPerRow) {
+  const NoisyInputs in = NoisyLab(0.05, 1e-4, 42);
+  const FitReport fit = FitFriction(in.data);
+  EXPECT_TRUE(HasNote(fit, "u_model"));
+  long double chi2 = 0;
+  for (const RowResult& row : fit.rows) {
+    EXPECT_DOUBLE_EQ(row.sigma, std::hypot(in.data.u_y[row.row], in.data.u_model[row.row]));
+    chi2 += static_cast<long double>(row.normalised) * row.normalised;
+  }
+  EXPECT_TRUE(RelNear(fit.chi2, static_cast<double>(chi2), 1e-12));
+  // All u_model = 0 is the fit without it.
+  FrictionData zero = in.data;
+  zero.u_model.assign(zero.size(), 0.0);
+  FrictionData none = in.data;
+  none.u_model.clear();
+  EXPECT_TRUE(RelNear(FitFriction(zero).Parameter("mu").value,
+                      FitFriction(none).Parameter("mu").value, 1e-12));
+}
+
+TEST(FrictionModelUncertainty, LineComparisonUsesYorkWithTheSameUncertainties) {
+  const NoisyInputs in = NoisyLab(0.05, 1e-4, 43);
+  const FrictionVersusLine both = CompareFrictionWithLine(in.data);
+  EXPECT_EQ(both.comparison.first, "york");
+  EXPECT_EQ(both.comparison.second, "friction");
+  // York's σ_i² = u(Y)² + k²u(X)²: the friction fit's σ_i at k = 1, and close to it at the
+  // fitted k (the line through x_rest against x_eq has a slope near 1).
+  const double k = both.line.slope();
+  EXPECT_NEAR(k, 1.0, 0.2);
+  for (std::size_t i = 0; i < in.data.size(); ++i)
+    EXPECT_TRUE(RelNear(both.line.rows[i].sigma,
+                        std::hypot(in.data.u_y[i], k * in.data.u_model[i]), 1e-12));
+  std::printf("  York line chi2 %.4g, friction chi2 %.4g; %s\n", both.line.chi2,
+              both.friction.chi2, both.comparison.verdict.c_str());
+  // Without u_model: unchanged behaviour (WLS).
+  FrictionData plain = in.data;
+  plain.u_model.clear();
+  EXPECT_EQ(CompareFrictionWithLine(plain).comparison.first, "wls");
+}
+
+TEST(FrictionModelUncertainty, BadModelUncertaintiesAreRefused) {
+  const FrictionData good = NoisyLab(0.05, 1e-4, 44).data;
+  FrictionData d = good;
+  d.u_model.pop_back();
+  ExpectInputError([&] { FitFriction(d); }, "u_model");
+  d = good;
+  d.u_model[2] = -1e-4;
+  ExpectInputError([&] { FitFriction(d); }, "u_model[2]");
+  d = good;
+  d.u_model[4] = std::nan("");
+  ExpectInputError([&] { FitFriction(d); }, "u_model[4]");
+  d = good;
+  d.u_y.clear();
+  ExpectInputError([&] { FitFriction(d); }, "u_model");
 }
 
 }  // namespace

@@ -187,5 +187,50 @@ TEST(AtomicFile, ReplacesContentAndLeavesNoTemporary) {
   std::filesystem::remove_all(dir);
 }
 
+// Regression tests for what fuzzing the readers found (tests/fuzz, scripts/fuzz.sh).
+
+TEST(FuzzRegression, QuantityThatOverflowsInSIIsRefused) {
+  // fuzz_units: "1e307 km" is a finite number but 1e310 m, which was returned as +inf.
+  const auto error = [](const std::string& text, Dimension dimension) {
+    try {
+      ParseQuantity(text, dimension, "--L");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(error("1e307 km", Dimension::kLength), "--L: '1e307 km' is out of the range of a double");
+  EXPECT_EQ(error("-1e306km", Dimension::kLength), "--L: '-1e306km' is out of the range of a double");
+  EXPECT_DOUBLE_EQ(ParseQuantity("-1e308in", Dimension::kLength, "--L"), -1e308 * 0.0254);  // shrinks
+  EXPECT_DOUBLE_EQ(ParseQuantity("1e300 km", Dimension::kLength, "--L"), 1e303);
+  // One sign only: "+-5 mm" was read as -5 mm.
+  EXPECT_EQ(error("+-5 mm", Dimension::kLength), "--L: '+-5 mm' is not a number");
+  EXPECT_EQ(error("++5", Dimension::kDimensionless), "--L: '++5' is not a number");
+  EXPECT_DOUBLE_EQ(ParseQuantity("+5 mm", Dimension::kLength, "--L"), 0.005);
+}
+
+TEST(FuzzRegression, CsvCellsThatAreNotUtf8AreRefusedPerRow) {
+  // fuzz_csv_convert: a label in Latin-1 (a spreadsheet export) reached the JSON output of
+  // `uphill convert --batch --json`, where nlohmann::json threw type_error 316 (exit 1, "internal
+  // error"). Now the row is refused with its column and the other rows are kept.
+  std::istringstream in("label,body,R_mm\ncaf\xE9,sphere,12.7\n"
+                        "ok \xC2\xB5m \xE2\x82\xAC \xF0\x9F\x98\x80,sphere,1\n"
+                        "\xC0\xAF,sphere,1\n\xED\xA0\x80,sphere,1\nx,sphere,\xE2\x82\n");
+  const CsvTable t = ReadCsv(in, "runs.csv");
+  ASSERT_EQ(t.rows.size(), 5u);
+  EXPECT_EQ(t.rows[0].error, "column label: is not valid UTF-8 (save the file as UTF-8)");
+  EXPECT_EQ(t.rows[1].error, "");  // well-formed 2-, 3- and 4-byte sequences
+  EXPECT_EQ(t.rows[2].error, "column label: is not valid UTF-8 (save the file as UTF-8)");  // overlong
+  EXPECT_EQ(t.rows[3].error, "column label: is not valid UTF-8 (save the file as UTF-8)");  // surrogate
+  EXPECT_EQ(t.rows[4].error, "column R_mm: is not valid UTF-8 (save the file as UTF-8)");  // truncated
+  std::istringstream header("L,\xFF\n1,2\n");
+  try {
+    ReadCsv(header, "x.csv");
+    ADD_FAILURE() << "accepted a header that is not UTF-8";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "x.csv: row 1 (header), column 2: is not valid UTF-8 (save the file as UTF-8)");
+  }
+}
+
 }  // namespace
 }  // namespace uphill::io

@@ -243,7 +243,7 @@ TEST(MonteCarlo, LabCaseWithOneMillimetreOnDAgrees) {
 }
 
 // Strongly nonlinear: u(D) = 7 mm (16 % of D). X ∝ 1/D is convex; its spread is ≈ 10 % wider
-// than first order says (by series: Var(1/(1 + δz)) = δ² + 8δ⁴ + 69δ⁶ + …, δ = u/D), the interval
+// than first order says (asymptotic series: Var(1/(1 + δz)) ≈ δ² + 8δ⁴ + 69δ⁶, δ = u/D), the interval
 // is skewed upward, and the flag is raised on X and x_max, not on the angles (α, φ are nearly
 // linear in D).
 TEST(MonteCarlo, StronglyNonlinearCaseIsFlagged) {

@@ -7,6 +7,7 @@
 
 #include "fit/internal/line_problem.hpp"
 #include "fit/least_squares_line.hpp"
+#include "fit/york_line.hpp"
 #include "model/input_error.hpp"
 #include "model/spheroid_on_line_rails.hpp"
 #include "model/spheroid_on_rods.hpp"
@@ -86,7 +87,17 @@ void Validate(const FrictionData& data, std::size_t parameters) {
   if (!data.u_y.empty() && data.u_y.size() != n)
     throw InputError("u(Y)", "must have one value per scene (" + std::to_string(n) +
                                  " scenes, got " + std::to_string(data.u_y.size()) + ")");
+  if (!data.u_model.empty()) {
+    if (data.u_model.size() != n)
+      throw InputError("u_model", "must have one value per scene (" + std::to_string(n) +
+                                      " scenes, got " + std::to_string(data.u_model.size()) + ")");
+    if (data.u_y.empty())
+      throw InputError("u_model", "needs u(Y) (the effective variance is u(Y)^2 + u_model^2)");
+  }
   for (std::size_t i = 0; i < n; ++i) {
+    if (!data.u_model.empty() && !(std::isfinite(data.u_model[i]) && data.u_model[i] >= 0.0))
+      throw InputError("u_model[" + std::to_string(i) + "]",
+                       "must be finite and >= 0 (got " + Num(data.u_model[i]) + ")");
     if (!std::isfinite(data.y[i]))
       throw InputError("Y[" + std::to_string(i) + "]",
                        "must be finite (got " + Num(data.y[i]) + ")");
@@ -97,6 +108,13 @@ void Validate(const FrictionData& data, std::size_t parameters) {
   }
 }
 
+// σ_i of row i: u(Y_i), combined with u_model,i when given (effective variance; see the
+// header); 1 without stated uncertainties. hypot: no overflow or underflow in the squares.
+double Sigma(const FrictionData& data, std::size_t i) {
+  if (data.u_y.empty()) return 1.0;
+  return data.u_model.empty() ? data.u_y[i] : std::hypot(data.u_y[i], data.u_model[i]);
+}
+
 Rows Classify(const FrictionData& data) {
   Rows rows;
   for (std::size_t i = 0; i < data.size(); ++i) {
@@ -104,7 +122,7 @@ Rows Classify(const FrictionData& data) {
     const Body& body = scene.body();
     const double r = scene.rod_radius();
     const double B = scene.rails().tan_theta, T = scene.rails().tan_half_alpha;
-    const double inv_sigma = data.u_y.empty() ? 1.0 : 1.0 / data.u_y[i];
+    const double inv_sigma = 1.0 / Sigma(data, i);
     switch (body.kind) {
       case BodyKind::kDoubleCone:
         throw InputError("scene[" + std::to_string(i) + "]",
@@ -188,8 +206,8 @@ FitReport FitFrictionImpl(const FrictionData& data, const FrictionOptions& optio
     // The least-squares scale at μ0 (closed form), or 1.
     long double sxy = 0, sxx = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      const long double w =
-          stated ? 1.0L / (static_cast<long double>(data.u_y[i]) * data.u_y[i]) : 1.0L;
+      const long double sigma = Sigma(data, i);
+      const long double w = 1.0L / (sigma * sigma);
       sxy += w * x0[i] * data.y[i];
       sxx += w * x0[i] * x0[i];
     }
@@ -244,7 +262,7 @@ FitReport FitFrictionImpl(const FrictionData& data, const FrictionOptions& optio
     row.fitted = scale * data.scenes[i].Rest(mu)->high;
     row.residual = data.y[i] - row.fitted;
     if (stated) {
-      row.sigma = data.u_y[i];
+      row.sigma = Sigma(data, i);
       row.normalised = row.residual / row.sigma;
       chi2 += static_cast<long double>(row.normalised) * row.normalised;
       sum_log_sigma2 += 2.0L * std::log(static_cast<long double>(row.sigma));
@@ -271,6 +289,10 @@ FitReport FitFrictionImpl(const FrictionData& data, const FrictionOptions& optio
     report.notes.push_back(
         "mu is at its bound 0: the covariance is that of the unconstrained "
         "problem; read the result as mu <= its standard error");
+  if (!data.u_model.empty())
+    report.notes.push_back(
+        "sigma_i^2 = u(Y)^2 + u_model^2: the model value's uncertainty (from the inputs') is "
+        "included");
   if (!rows.rods.empty())
     report.notes.push_back(std::to_string(rows.rods.size()) +
                            " spheroid-on-rods rows use central numeric derivatives");
@@ -292,8 +314,16 @@ FrictionVersusLine CompareFrictionWithLine(const FrictionData& data,
   for (const Scene& scene : data.scenes) line.x.push_back(*scene.x_eq());
   line.y = data.y;
   line.u_y = data.u_y;
-  result.line = data.u_y.empty() ? FitOrdinaryLeastSquares(line, options.fit)
-                                 : FitWeightedLeastSquares(line, options.fit);
+  // The line sees the uncertainties the friction fit sees: with u_model, York's line with
+  // u(X) = u_model (σ_i² = u(Y)² + k²u_model², the friction fit's at k = 1); WLS against
+  // u(Y) alone would charge the line with the model's scatter and favour friction unfairly.
+  if (!data.u_model.empty()) {
+    line.u_x = data.u_model;
+    result.line = FitErrorsInVariables(line, options.fit);
+  } else {
+    result.line = data.u_y.empty() ? FitOrdinaryLeastSquares(line, options.fit)
+                                   : FitWeightedLeastSquares(line, options.fit);
+  }
   result.comparison = CompareModels(result.line, result.friction);
   return result;
 }

@@ -14,10 +14,18 @@ std::string At(const std::string& column, std::size_t i) {
   return column + "[" + std::to_string(i) + "]";
 }
 
+// Squares, products and inverse squares of the data must stay finite and normal in binary64
+// (weights are 1/u², York's use u² + k²·u(X)²): beyond these bounds Ceres' residuals overflow.
+constexpr double kLargest = 1e100, kSmallestUncertainty = 1e-100;
+
 void RequireFinite(const std::vector<double>& v, const std::string& column) {
-  for (std::size_t i = 0; i < v.size(); ++i)
+  for (std::size_t i = 0; i < v.size(); ++i) {
     if (!std::isfinite(v[i]))
       throw InputError(At(column, i), "must be finite (got " + Num(v[i]) + ")");
+    if (std::abs(v[i]) > kLargest)
+      throw InputError(At(column, i), "must be at most 1e100 in magnitude (got " + Num(v[i]) +
+                                          "): its square would overflow a double");
+  }
 }
 
 // The column must be present with one value per row, each finite and > 0 (or ≥ 0).
@@ -34,6 +42,9 @@ void RequireUncertainties(const std::vector<double>& u, std::size_t n, const std
       throw InputError(At(column, i), std::string("must be finite and ") +
                                           (zero_allowed ? ">= 0" : "> 0") + " for " + method +
                                           " (got " + Num(u[i]) + ")");
+    if (u[i] > kLargest || (u[i] != 0.0 && u[i] < kSmallestUncertainty))
+      throw InputError(At(column, i), "must lie in [1e-100, 1e100] (got " + Num(u[i]) +
+                                          "): its square or inverse square would overflow a double");
   }
 }
 

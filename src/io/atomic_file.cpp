@@ -22,7 +22,10 @@ namespace {
 void WriteFileAtomically(const std::string& path, std::string_view content) {
   const std::filesystem::path target(path);
   const std::filesystem::path dir = target.has_parent_path() ? target.parent_path() : ".";
-  std::string pattern = (dir / ("." + target.filename().string() + ".tmp-XXXXXX")).string();
+  // Built by append: GCC 12 warns falsely (-Wrestrict) on "." + std::string + "…".
+  std::string stem = ".";
+  stem.append(target.filename().string()).append(".tmp-XXXXXX");
+  const std::string pattern = (dir / stem).string();
   std::vector<char> name(pattern.begin(), pattern.end());
   name.push_back('\0');
   const int fd = mkstemp(name.data());

@@ -6,21 +6,17 @@
 
 #include "io/units.hpp"
 #include "model/input_error.hpp"
+#include "model/number_text.hpp"
 
 namespace uphill::io {
 namespace {
 
-std::string Fmt(const char* format, double v) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, v);
-  return buffer;
-}
 
 std::string Length(double metres, const std::string& unit) {
-  return Fmt("%.6g", ToUnit(metres, Dimension::kLength, unit)) + " " + unit;
+  return Printf("%.6g", ToUnit(metres, Dimension::kLength, unit)) + " " + unit;
 }
 
-std::string Degrees(double radians) { return Fmt("%.4f", radians * 180.0 / std::numbers::pi) + " deg"; }
+std::string Degrees(double radians) { return Printf("%.4f", radians * 180.0 / std::numbers::pi) + " deg"; }
 
 std::vector<std::string> Verdict(const ConversionResult& r, const ConversionOptions& options) {
   const std::string& unit = options.length_unit;
@@ -41,9 +37,9 @@ std::vector<std::string> Verdict(const ConversionResult& r, const ConversionOpti
     if (options.mu) {
       const double slope = std::abs(cone->B());
       out.push_back(s.RestsEverywhere(*options.mu)
-                        ? "With mu = " + Fmt("%g", *options.mu) + " (>= |dz/dx| = " + Fmt("%.4g", slope) +
+                        ? "With mu = " + Printf("%g", *options.mu) + " (>= |dz/dx| = " + Printf("%.4g", slope) +
                               ") it stays at rest wherever it is placed."
-                        : "With mu = " + Fmt("%g", *options.mu) + " (< |dz/dx| = " + Fmt("%.4g", slope) +
+                        : "With mu = " + Printf("%g", *options.mu) + " (< |dz/dx| = " + Printf("%.4g", slope) +
                               ") it cannot rest anywhere on the rails.");
     }
     return out;
@@ -67,7 +63,7 @@ std::vector<std::string> Verdict(const ConversionResult& r, const ConversionOpti
   if (r.rest) {
     const std::string from = r.rest->low <= 0.0 ? "O (the band reaches the rails' meeting point)"
                                                 : Length(r.rest->low, unit);
-    out.push_back("With mu = " + Fmt("%g", *options.mu) + " it stays at rest from " + from + " to " +
+    out.push_back("With mu = " + Printf("%g", *options.mu) + " it stays at rest from " + from + " to " +
                   Length(r.rest->high, unit) + " (Y, the farthest rest position).");
   }
   return out;

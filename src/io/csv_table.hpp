@@ -5,8 +5,8 @@
 // Conventions: the first record is the header; header names are trimmed, must be non-empty and
 // unique. Blank lines are skipped. Row numbers are spreadsheet rows: the header is row 1, the
 // first data record row 2 (a quoted field spanning lines counts as one row). A record with a
-// different number of fields than the header is kept with `error` set, so that the other rows
-// can still be processed.
+// different number of fields than the header, or with a cell that is not valid UTF-8, is kept
+// with `error` set, so that the other rows can still be processed.
 #pragma once
 
 #include <istream>
@@ -18,7 +18,7 @@ namespace uphill::io {
 struct CsvRow {
   int row = 0;                      // spreadsheet row number (header = 1)
   std::vector<std::string> cells;   // one per header column when error is empty
-  std::string error;                // non-empty: the record is malformed (field count)
+  std::string error;                // non-empty: the record is malformed (field count, UTF-8)
 };
 
 struct CsvTable {
@@ -31,7 +31,7 @@ struct CsvTable {
 };
 
 // Throws InputError("<source>", rule) when the input is empty, has no header, a malformed
-// quote, or an empty or duplicate header name.
+// quote, or an empty, duplicate or not UTF-8 header name.
 CsvTable ReadCsv(std::istream& in, const std::string& source);
 // Opens `path` ("-" reads stdin); throws InputError naming the file when it cannot be read.
 CsvTable ReadCsvFile(const std::string& path);

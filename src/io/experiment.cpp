@@ -23,9 +23,16 @@ const std::set<std::string> kUncertaintyKeys = {"L", "H", "D", "Y", "R", "a", "b
 const std::set<std::string> kColumns = {"trial", "series", "note", "L", "H", "D", "Y",
                                         "u_L", "u_H", "u_D", "u_Y"};
 
+// A JSON value for a message: scalars as written, arrays and objects by their type only. Dumping
+// them recursed once per nesting level: a value nested 2·10^5 deep (a 400 KB file) overflowed
+// the stack (tests/fuzz/fuzz_experiment runs on a small stack to catch this).
+std::string Shown(const json& j) {
+  return j.is_structured() ? std::string("an ") + j.type_name() : j.dump();
+}
+
 std::string Text(const json& j, const std::string& context) {
   if (j.is_string()) return j.get<std::string>();
-  throw InputError(context, "must be a string with a unit, e.g. \"300 mm\" (got " + j.dump() + ")");
+  throw InputError(context, "must be a string with a unit, e.g. \"300 mm\" (got " + Shown(j) + ")");
 }
 
 json ReadJson(const std::string& path) {
@@ -85,7 +92,7 @@ Experiment LoadExperiment(const std::string& directory) {
   if (!meta.contains("format") || meta.at("format") != kExperimentFormat)
     throw InputError(json_path + ": format",
                      std::string("must be \"") + kExperimentFormat + "\" (got " +
-                         (meta.contains("format") ? meta.at("format").dump() : "nothing") + ")");
+                         (meta.contains("format") ? Shown(meta.at("format")) : "nothing") + ")");
   e.title = OptionalString(meta, "title", json_path);
   e.operator_name = OptionalString(meta, "operator", json_path);
   e.date = OptionalString(meta, "date", json_path);
@@ -93,10 +100,22 @@ Experiment LoadExperiment(const std::string& directory) {
   if (!meta.contains("body")) throw InputError(json_path + ": body", "is missing");
   const json& body = meta.at("body");
   CheckKeys(body, {"type", "R", "a", "b", "h"}, json_path + ": body");
-  const json apparatus = meta.value("apparatus", json::object());
+  // Without this check body.at("type") below threw json::out_of_range (found by fuzzing).
+  if (!body.contains("type"))
+    throw InputError(json_path + ": body.type", "is missing (sphere, spheroid or double-cone)");
+  // References, not copies (meta.value() copied): copying a json value recurses once per
+  // nesting level.
+  static const json kNone = json::object();
+  const json& apparatus = meta.contains("apparatus") ? meta.at("apparatus") : kNone;
   CheckKeys(apparatus, kApparatusKeys, json_path + ": apparatus");
-  const json defaults = meta.value("uncertainties", json::object());
+  const json& defaults = meta.contains("uncertainties") ? meta.at("uncertainties") : kNone;
   CheckKeys(defaults, kUncertaintyKeys, json_path + ": uncertainties");
+  // Every value of these objects is a string, checked now and not only when a row looks it up:
+  // an unused value stays in `metadata`, which fit.json copies and dumps, recursively (a deeply
+  // nested value overflowed the stack).
+  for (const auto& [object, name] : {std::pair<const json*, const char*>{&body, "body"},
+                                     {&apparatus, "apparatus"}, {&defaults, "uncertainties"}})
+    for (const auto& [key, value] : object->items()) Text(value, json_path + ": " + name + "." + key);
 
   const CsvTable table = ReadCsvFile(csv_path);
   std::map<std::string, int> column;  // quantity -> column index

@@ -18,7 +18,7 @@ struct UnitEntry {
 
 constexpr double kPi = 3.14159265358979323846;
 
-constexpr std::array<UnitEntry, 14> kUnits{{
+constexpr std::array<UnitEntry, 20> kUnits{{
     {Dimension::kLength, "mm", 1e-3, true},
     {Dimension::kLength, "cm", 1e-2, true},
     {Dimension::kLength, "m", 1.0, true},
@@ -33,6 +33,12 @@ constexpr std::array<UnitEntry, 14> kUnits{{
     {Dimension::kAcceleration, "m/s^2", 1.0, false},
     {Dimension::kAcceleration, "mm/s2", 1e-3, false},
     {Dimension::kAcceleration, "mm/s^2", 1e-3, false},
+    {Dimension::kTime, "s", 1.0, true},
+    {Dimension::kTime, "ms", 1e-3, true},
+    {Dimension::kTime, "min", 60.0, false},
+    {Dimension::kVelocity, "m/s", 1.0, true},
+    {Dimension::kVelocity, "mm/s", 1e-3, true},
+    {Dimension::kVelocity, "cm/s", 1e-2, true},
 }};
 
 std::string_view Trim(std::string_view s) {
@@ -67,8 +73,13 @@ double ParseQuantity(std::string_view text, Dimension dimension, const std::stri
   double number = 0.0;
   const char* begin = trimmed.data();
   const char* end = begin + trimmed.size();
-  // A leading '+' is allowed (spreadsheets write it); from_chars does not accept it.
-  if (*begin == '+') ++begin;
+  // A leading '+' is allowed (spreadsheets write it); from_chars does not accept it. Only one
+  // sign, though: without this check "+-5 mm" was read as -5 mm (checked by tests/fuzz).
+  if (*begin == '+') {
+    ++begin;
+    if (begin < end && (*begin == '-' || *begin == '+'))
+      throw InputError(quantity, "'" + std::string(trimmed) + "' is not a number");
+  }
   const auto [ptr, ec] = std::from_chars(begin, end, number);
   if (ec == std::errc::result_out_of_range)
     throw InputError(quantity, "'" + std::string(trimmed) + "' is out of the range of a double");
@@ -90,7 +101,11 @@ double ParseQuantity(std::string_view text, Dimension dimension, const std::stri
   if (factor == 0.0)
     throw InputError(quantity, "unit '" + std::string(used) + "' is not accepted here (accepted: " +
                                    AcceptedUnits(dimension) + ")");
-  return number * factor;
+  // The number is finite, but in SI it can overflow ("1e307 km" is 1e310 m; found by fuzzing).
+  const double si = number * factor;
+  if (!std::isfinite(si))
+    throw InputError(quantity, "'" + std::string(trimmed) + "' is out of the range of a double");
+  return si;
 }
 
 double ToUnit(double value_si, Dimension dimension, std::string_view unit) {

@@ -8,6 +8,8 @@
 //   length        m, cm, mm, um (also µm), km, in (also inch)
 //   angle         deg, rad
 //   acceleration  m/s2 (also m/s^2)
+//   time          s, ms (also min)
+//   velocity      m/s, mm/s, cm/s
 //   dimensionless a plain number (e.g. a coefficient μ); a unit is then refused
 #pragma once
 
@@ -16,7 +18,7 @@
 
 namespace uphill::io {
 
-enum class Dimension { kLength, kAngle, kAcceleration, kDimensionless };
+enum class Dimension { kLength, kAngle, kAcceleration, kDimensionless, kTime, kVelocity };
 
 // "mm, cm, m, km, um, in" etc.: the accepted unit names of a dimension, for messages.
 std::string AcceptedUnits(Dimension dimension);

@@ -32,6 +32,7 @@ XyTable FromTable(const CsvTable& table) {
   const int cx = table.Column("X"), cy = table.Column("Y"), cux = table.Column("uX"), cuy = table.Column("uY");
   if (cx < 0 || cy < 0) throw InputError(table.source + ", row 1", "the header must have columns X and Y");
   XyTable data;
+  data.source = table.source;
   for (const CsvRow& row : table.rows) {
     try {
       if (!row.error.empty()) throw InputError(table.source + ", row " + std::to_string(row.row), row.error);
@@ -41,6 +42,7 @@ XyTable FromTable(const CsvTable& table) {
       data.y.push_back(y);
       if (cux >= 0) data.u_x.push_back(ux);
       if (cuy >= 0) data.u_y.push_back(uy);
+      data.rows.push_back(row.row);
     } catch (const InputError& e) {
       data.row_errors.push_back(e.what());
     }
@@ -53,5 +55,21 @@ XyTable FromTable(const CsvTable& table) {
 XyTable ReadXy(std::istream& in, const std::string& source) { return FromTable(ReadCsv(in, source)); }
 
 XyTable ReadXyFile(const std::string& path) { return FromTable(ReadCsvFile(path)); }
+
+std::string XyTable::Locate(const std::string& quantity) const {
+  // The fit layer names a value "X[i]", "Y[i]", "u(X)[i]" or "u(Y)[i]" (i counts read rows).
+  const auto open = quantity.find('[');
+  if (open == std::string::npos || quantity.back() != ']') return quantity;
+  const std::string name = quantity.substr(0, open);
+  const std::string column = name == "u(X)" ? "uX" : name == "u(Y)" ? "uY" : name;
+  std::size_t i = 0;
+  try {
+    i = std::stoul(quantity.substr(open + 1));
+  } catch (const std::exception&) {
+    return quantity;
+  }
+  if (i >= rows.size()) return quantity;
+  return source + ", row " + std::to_string(rows[i]) + ", column " + column;
+}
 
 }  // namespace uphill::io

@@ -13,9 +13,14 @@
 namespace uphill::io {
 
 struct XyTable {
+  std::string source;                   // file name or "<stdin>"
+  std::vector<int> rows;                // spreadsheet row of each read row
   std::vector<double> x, y;
   std::vector<double> u_x, u_y;         // one per read row when the column exists, else empty
   std::vector<std::string> row_errors;  // rows left out, one line each
+
+  // "file, row 4, column uX" for the fit layer's name of a value, "u(X)[2]"; other names as given.
+  std::string Locate(const std::string& quantity) const;
 };
 
 // Throws InputError naming the file for malformed CSV, an unknown column (anything but X, Y, uX,

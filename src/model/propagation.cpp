@@ -1,18 +1,21 @@
 #include "model/propagation.hpp"
 
 #include <ceres/jet.h>
+#if defined(__x86_64__)
 #include <immintrin.h>
+#endif
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <numbers>
-#include <sstream>
 #include <string>
 
 #include "model/double_cone_on_line_rails.hpp"
 #include "model/input_error.hpp"
+#include "model/number_text.hpp"
 #include "model/scene.hpp"
 #include "model/spheroid_on_line_rails.hpp"
 #include "model/spheroid_on_rods_closed_forms.hpp"
@@ -23,12 +26,8 @@ namespace {
 constexpr int kNumInputs = kInputQuantityCount;
 constexpr int Index(InputQuantity q) { return static_cast<int>(q); }
 
-std::string Num(double v) {
-  std::ostringstream out;
-  out.precision(17);
-  out << v;
-  return out.str();
-}
+// Numbers in messages exactly as stored (as the model's own messages print them).
+std::string Num(double v) { return ExactText(v); }
 
 // ---------------------------------------------------------------------------------------------
 // The scene in a form both propagation methods read: which inputs exist, their values and u.
@@ -231,11 +230,45 @@ enum Reason : unsigned char {
 // Running statistics of one output: shifted sums for mean and variance (no cancellation: the
 // shift is a sample of the same output), and for each end of the coverage interval a window
 // [lo, hi]: values below it are only counted, values inside are kept.
+//
+// The kept values live in a plain growable array rather than a std::vector so that the AVX2 path
+// can store four candidates unconditionally and advance by the number that qualified (branch-
+// free), without zero-filling the slack as vector::resize would.
+class Kept {
+ public:
+  std::size_t size() const { return size_; }
+  double* begin() { return data_.get(); }
+  double* end() { return data_.get() + size_; }
+  // Room for `extra` more values (plus slack for a full vector store).
+  void Reserve(std::size_t extra) {
+    if (size_ + extra + 4 <= capacity_) return;
+    const std::size_t capacity = std::max(2 * capacity_, size_ + extra + 4);
+    std::unique_ptr<double[]> data(new double[capacity]);
+    std::copy(begin(), end(), data.get());
+    data_ = std::move(data);
+    capacity_ = capacity;
+  }
+  void Push(double v) {
+    Reserve(1);
+    data_[size_++] = v;
+  }
+  void Append(const double* y, std::size_t n) {
+    Reserve(n);
+    std::copy(y, y + n, end());
+    size_ += n;
+  }
+  void SetEnd(double* end) { size_ = static_cast<std::size_t>(end - data_.get()); }
+
+ private:
+  std::unique_ptr<double[]> data_;
+  std::size_t size_ = 0, capacity_ = 0;
+};
+
 struct Window {
   double lo = -std::numeric_limits<double>::infinity();
   double hi = std::numeric_limits<double>::infinity();
-  std::uint64_t below = 0;   // y < lo
-  std::vector<double> kept;  // lo <= y <= hi
+  std::uint64_t below = 0;  // y < lo
+  Kept kept;                // lo <= y <= hi
 };
 
 struct OutputStats {
@@ -256,6 +289,7 @@ void Neumaier(double* sum, double* comp, double x) {
 // Two-lane vectors (GCC vector extensions: SSE2 on the baseline x86-64 target, generic code
 // elsewhere); lane-wise IEEE arithmetic, so the sums are the same on every machine.
 using V2d = double __attribute__((vector_size(16)));
+using V2i = long __attribute__((vector_size(16)));  // what comparing two V2d gives
 
 void AccumulateMoments(OutputStats& s, const double* y, std::size_t n) {
   // Four independent partial sums (two vectors of two) in a fixed order.
@@ -284,7 +318,7 @@ void AccumulateMoments(OutputStats& s, const double* y, std::size_t n) {
 
 void Keep(Window (&w)[2], double v) {
   for (Window& x : w)
-    if (v >= x.lo && v <= x.hi) x.kept.push_back(v);
+    if (v >= x.lo && v <= x.hi) x.kept.Push(v);
 }
 
 // Counts and keeps one block's values for both windows of an output. Counts are exact integers
@@ -302,39 +336,70 @@ void CountWindowsScalar(Window (&w)[2], const double* y, std::size_t n) {
   w[1].below += below1;
 }
 
-#if defined(__x86_64__) && defined(__GNUC__)
+#if defined(__x86_64__) && defined(__GNUC__)  // the pragma and __builtin_cpu_supports
 #define UPHILL_WINDOWS_AVX2 1
 // AVX2 by pragma, not by a per-file -mavx2 (see batch_convert.cpp for why); reached only after
 // the run-time CPU check.
 #pragma GCC push_options
 #pragma GCC target("avx2")
+// Left-packing permutations: for a 4-bit lane mask, the 32-bit lane indices that move the selected
+// doubles to the front, in order.
+struct PackTable {
+  alignas(32) int idx[16][8];
+  int count[16];
+  constexpr PackTable() : idx(), count() {
+    for (int m = 0; m < 16; ++m) {
+      int k = 0;
+      for (int lane = 0; lane < 4; ++lane)
+        if (m & (1 << lane)) {
+          idx[m][2 * k] = 2 * lane;
+          idx[m][2 * k + 1] = 2 * lane + 1;
+          ++k;
+        }
+      count[m] = k;
+      for (; k < 4; ++k) idx[m][2 * k] = idx[m][2 * k + 1] = 0;
+    }
+  }
+};
+constexpr PackTable kPack;
+
 void CountWindowsAvx2(Window (&w)[2], const double* y, std::size_t n) {
   // With ordered, disjoint windows lo0 ≤ hi0 < lo1 ≤ hi1 (always, but for a tiny pilot) four
-  // comparisons per value give everything: the region index g0 + g1 + g2 + g3 is odd inside a
-  // window, and #(y < lo) = n − #(y ≥ lo). Counts accumulate as -1 masks, 8 values per step.
+  // comparisons per value give everything: y is in window 0 iff y ≥ lo0 and not y > hi0, and
+  // #(y < lo) = n − #(y ≥ lo), counted as -1 masks. Every step stores its four values, left-
+  // packed, at each window's end and advances by the number that qualified: no branch on data.
   if (!(w[0].hi < w[1].lo)) return CountWindowsScalar(w, y, n);
   const __m256d lo0 = _mm256_set1_pd(w[0].lo), hi0 = _mm256_set1_pd(w[0].hi);
   const __m256d lo1 = _mm256_set1_pd(w[1].lo), hi1 = _mm256_set1_pd(w[1].hi);
+  w[0].kept.Reserve(n);
+  w[1].kept.Reserve(n);
+  double* end0 = w[0].kept.end();
+  double* end1 = w[1].kept.end();
   __m256i ge0 = _mm256_setzero_si256(), ge1 = _mm256_setzero_si256();
   std::size_t j = 0;
-  for (; j + 8 <= n; j += 8) {
-    const __m256d v = _mm256_loadu_pd(y + j), u = _mm256_loadu_pd(y + j + 4);
-    const __m256d gv0 = _mm256_cmp_pd(v, lo0, _CMP_GE_OQ), gu0 = _mm256_cmp_pd(u, lo0, _CMP_GE_OQ);
-    const __m256d gv2 = _mm256_cmp_pd(v, lo1, _CMP_GE_OQ), gu2 = _mm256_cmp_pd(u, lo1, _CMP_GE_OQ);
-    ge0 = _mm256_sub_epi64(ge0, _mm256_add_epi64(_mm256_castpd_si256(gv0), _mm256_castpd_si256(gu0)));
-    ge1 = _mm256_sub_epi64(ge1, _mm256_add_epi64(_mm256_castpd_si256(gv2), _mm256_castpd_si256(gu2)));
-    const __m256d in_v = _mm256_or_pd(_mm256_xor_pd(gv0, _mm256_cmp_pd(v, hi0, _CMP_GT_OQ)),
-                                      _mm256_xor_pd(gv2, _mm256_cmp_pd(v, hi1, _CMP_GT_OQ)));
-    const __m256d in_u = _mm256_or_pd(_mm256_xor_pd(gu0, _mm256_cmp_pd(u, hi0, _CMP_GT_OQ)),
-                                      _mm256_xor_pd(gu2, _mm256_cmp_pd(u, hi1, _CMP_GT_OQ)));
-    if (!_mm256_testz_pd(_mm256_or_pd(in_v, in_u), _mm256_or_pd(in_v, in_u))) [[unlikely]]
-      for (std::size_t l = 0; l < 8; ++l) Keep(w, y[j + l]);
+  for (; j + 4 <= n; j += 4) {
+    const __m256d v = _mm256_loadu_pd(y + j);
+    const __m256d g0 = _mm256_cmp_pd(v, lo0, _CMP_GE_OQ), g1 = _mm256_cmp_pd(v, hi0, _CMP_GT_OQ);
+    const __m256d g2 = _mm256_cmp_pd(v, lo1, _CMP_GE_OQ), g3 = _mm256_cmp_pd(v, hi1, _CMP_GT_OQ);
+    ge0 = _mm256_sub_epi64(ge0, _mm256_castpd_si256(g0));
+    ge1 = _mm256_sub_epi64(ge1, _mm256_castpd_si256(g2));
+    const int m0 = _mm256_movemask_pd(_mm256_andnot_pd(g1, g0));
+    const int m1 = _mm256_movemask_pd(_mm256_andnot_pd(g3, g2));
+    const __m256i vi = _mm256_castpd_si256(v);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(end0),
+                        _mm256_permutevar8x32_epi32(vi, _mm256_load_si256(reinterpret_cast<const __m256i*>(kPack.idx[m0]))));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(end1),
+                        _mm256_permutevar8x32_epi32(vi, _mm256_load_si256(reinterpret_cast<const __m256i*>(kPack.idx[m1]))));
+    end0 += kPack.count[m0];
+    end1 += kPack.count[m1];
   }
-  alignas(32) long long g0[4], g1[4];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(g0), ge0);
-  _mm256_store_si256(reinterpret_cast<__m256i*>(g1), ge1);
-  w[0].below += j - static_cast<std::uint64_t>(g0[0] + g0[1] + g0[2] + g0[3]);
-  w[1].below += j - static_cast<std::uint64_t>(g1[0] + g1[1] + g1[2] + g1[3]);
+  w[0].kept.SetEnd(end0);
+  w[1].kept.SetEnd(end1);
+  alignas(32) long long c0[4], c1[4];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(c0), ge0);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(c1), ge1);
+  w[0].below += j - static_cast<std::uint64_t>(c0[0] + c0[1] + c0[2] + c0[3]);
+  w[1].below += j - static_cast<std::uint64_t>(c1[0] + c1[1] + c1[2] + c1[3]);
   CountWindowsScalar(w, y + j, n - j);
 }
 #pragma GCC pop_options
@@ -366,7 +431,7 @@ void CoverageRanks(std::uint64_t m, double p, std::uint64_t* low, std::uint64_t*
 // The k-th smallest (1-based) value, or nullopt when the window does not hold it.
 std::optional<double> Select(Window& w, std::uint64_t k) {
   if (k <= w.below || k - w.below > w.kept.size()) return std::nullopt;
-  const auto it = w.kept.begin() + static_cast<std::ptrdiff_t>(k - w.below - 1);
+  double* const it = w.kept.begin() + (k - w.below - 1);
   std::nth_element(w.kept.begin(), it, w.kept.end());
   return *it;
 }
@@ -402,6 +467,7 @@ class MonteCarlo {
       GaussianStream gauss;
     };
     std::vector<Stream> streams;
+    streams.reserve(kNumInputs);
     for (int i = 0; i < kNumInputs; ++i)
       if (p_.present[i] && p_.u[i] > 0.0)
         streams.push_back({i, GaussianStream(SplitMix64(o_.seed + SplitMix64(i)))});
@@ -429,7 +495,7 @@ class MonteCarlo {
         if (!s.varies) continue;
         AccumulateMoments(s, y, valid);
         if (!windows) {  // one window holding everything serves both ends
-          s.window[0].kept.insert(s.window[0].kept.end(), y, y + valid);
+          s.window[0].kept.Append(y, valid);
         } else if (done < kPilot) {
           pilot[k].insert(pilot[k].end(), y, y + valid);
         } else {
@@ -494,26 +560,35 @@ class MonteCarlo {
       }
       if (reason[j] == kValid) reason[j] = why;
     };
-    auto screen = [&](InputQuantity q, Reason why, auto ok) {
+    // `bad` is generic: on a double it gives a bool, on a V2d a lane mask (-1 or 0) to count with.
+    // Draws are finite (value + u·z), so the comparisons need no NaN care.
+    auto screen = [&](InputQuantity q, Reason why, auto bad) {
       if (!Uncertain(q)) return;  // the nominal value passed the model's checks
       const double* x = Input(Index(q));
-      std::size_t bad = 0;
-      for (std::size_t j = 0; j < n; ++j) bad += !ok(x[j]);
-      if (bad == 0) return;
-      for (std::size_t j = 0; j < n; ++j)
-        if (!ok(x[j])) mark(j, why);
+      V2i count = {0, 0};
+      std::size_t j = 0;
+      for (; j + 2 <= n; j += 2) {
+        V2d v;
+        std::memcpy(&v, x + j, sizeof v);
+        count -= bad(v);
+      }
+      bool any = count[0] != 0 || count[1] != 0;
+      for (; j < n; ++j) any |= bad(x[j]);
+      if (!any) return;
+      for (j = 0; j < n; ++j)
+        if (bad(x[j])) mark(j, why);
     };
-    auto positive = [](double v) { return v > 0.0; };
-    screen(InputQuantity::kL, kNonPositiveLength, positive);
-    screen(InputQuantity::kD, kNonPositiveLength, positive);
-    screen(InputQuantity::kAcross, kNonPositiveLength, positive);
-    screen(InputQuantity::kAlong, kNonPositiveLength, positive);
-    screen(InputQuantity::kRodRadius, kNonPositiveLength, positive);
-    screen(InputQuantity::kH, kNegativeHeight, [](double v) { return v >= 0.0; });
+    auto non_positive = [](auto v) { return v <= 0.0; };
+    screen(InputQuantity::kL, kNonPositiveLength, non_positive);
+    screen(InputQuantity::kD, kNonPositiveLength, non_positive);
+    screen(InputQuantity::kAcross, kNonPositiveLength, non_positive);
+    screen(InputQuantity::kAlong, kNonPositiveLength, non_positive);
+    screen(InputQuantity::kRodRadius, kNonPositiveLength, non_positive);
+    screen(InputQuantity::kH, kNegativeHeight, [](auto v) { return v < 0.0; });
     screen(InputQuantity::kTheta, kAngleOutOfRange,
-           [](double v) { return (v >= 0.0) & (v < std::numbers::pi / 2); });
+           [](auto v) { return (v < 0.0) | (v >= std::numbers::pi / 2); });
     screen(InputQuantity::kAlpha, kAngleOutOfRange,
-           [](double v) { return (v > 0.0) & (v < std::numbers::pi); });
+           [](auto v) { return (v <= 0.0) | (v >= std::numbers::pi); });
     const bool apparatus = p_.given == UncertainRails::Given::kApparatus;
     const double* L = Input(Index(InputQuantity::kL));
     const double* H = Input(Index(InputQuantity::kH));
@@ -618,7 +693,7 @@ class MonteCarlo {
           std::nth_element(v.begin(), it, v.end());
           w.hi = *it;
         }
-        w.kept.reserve(static_cast<std::size_t>(2.5 * half * static_cast<double>(o_.trials)) + 64);
+        w.kept.Reserve(static_cast<std::size_t>(2.5 * half * static_cast<double>(o_.trials)) + 64);
       }
       CountWindows(s.window, v.data(), v.size(), o_.kernel);
       std::vector<double>().swap(v);

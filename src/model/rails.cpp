@@ -1,20 +1,15 @@
 #include "model/rails.hpp"
 
 #include <numbers>
-#include <sstream>
+
+#include "model/number_text.hpp"
 
 namespace uphill {
 namespace {
 
-std::string Num(double v) {
-  std::ostringstream out;
-  out.precision(17);
-  out << v;
-  return out.str();
-}
 
 void RequireFinite(const char* quantity, double v) {
-  if (!std::isfinite(v)) throw InputError(quantity, "must be a finite number (got " + Num(v) + ")");
+  if (!std::isfinite(v)) throw InputError(quantity, "must be a finite number (got " + ExactText(v) + ")");
 }
 
 }  // namespace
@@ -23,9 +18,9 @@ Rails Rails::FromAngles(double theta, double alpha) {
   RequireFinite("theta", theta);
   RequireFinite("alpha", alpha);
   if (theta < 0.0 || theta >= std::numbers::pi / 2)
-    throw InputError("theta", "must lie in [0, 90) deg (got " + Num(theta) + " rad)");
+    throw InputError("theta", "must lie in [0, 90) deg (got " + ExactText(theta) + " rad)");
   if (alpha <= 0.0 || alpha >= std::numbers::pi)
-    throw InputError("alpha", "must lie in (0, 180) deg (got " + Num(alpha) + " rad)");
+    throw InputError("alpha", "must lie in (0, 180) deg (got " + ExactText(alpha) + " rad)");
   return Rails{theta, alpha, std::tan(theta), std::tan(alpha / 2)};
 }
 
@@ -33,10 +28,10 @@ Rails Rails::FromApparatus(double L, double H, double D, LConvention convention)
   RequirePositiveFinite("L", L);
   RequirePositiveFinite("D", D);
   RequireFinite("H", H);
-  if (H < 0.0) throw InputError("H", "must be >= 0 (got " + Num(H) + ")");
+  if (H < 0.0) throw InputError("H", "must be >= 0 (got " + ExactText(H) + ")");
   if (convention == LConvention::kAlongRail && !(L > std::hypot(H, D / 2)))
     throw InputError("L", "measured along a rail must exceed sqrt(H^2 + D^2/4) = " +
-                              Num(std::hypot(H, D / 2)) + " m (got " + Num(L) + " m)");
+                              ExactText(std::hypot(H, D / 2)) + " m (got " + ExactText(L) + " m)");
   const double horizontal = HorizontalDistance(L, H, D, convention);
   Rails rails;
   rails.tan_theta = H / horizontal;

@@ -1,7 +1,8 @@
 #include "model/scene.hpp"
 
 #include <cmath>
-#include <sstream>
+
+#include "model/number_text.hpp"
 
 namespace uphill {
 namespace {
@@ -13,12 +14,6 @@ struct Overloaded : F... {
 template <class... F>
 Overloaded(F...) -> Overloaded<F...>;
 
-std::string Num(double v) {
-  std::ostringstream out;
-  out.precision(17);
-  out << v;
-  return out.str();
-}
 
 PathPoint FromSpheroid(double x, const SpheroidPathPoint<double>& p) {
   return PathPoint{x, p.z, p.dzdx, p.r_star, p.x_contact};
@@ -29,7 +24,7 @@ PathPoint FromSpheroid(double x, const SpheroidPathPoint<double>& p) {
 Scene::Path Scene::MakePath(const Body& body, const Rails& rails, double rod_radius) {
   const double B = rails.tan_theta, T = rails.tan_half_alpha;
   if (!(rod_radius >= 0.0) || !std::isfinite(rod_radius))
-    throw InputError("rod radius", "must be a finite number >= 0 (got " + Num(rod_radius) + ")");
+    throw InputError("rod radius", "must be a finite number >= 0 (got " + ExactText(rod_radius) + ")");
   switch (body.kind) {
     case BodyKind::kSphere:
       if (rod_radius == 0.0) return SpheroidOnLineRails<double>(body.across, body.across, B, T);
@@ -47,7 +42,7 @@ Scene::Path Scene::MakePath(const Body& body, const Rails& rails, double rod_rad
       if (!cone.valid())
         throw InputError("body",
                          "the double cone cannot rest on both rails: 1 + tan^2(theta) - "
-                         "(R/h)^2 tan^2(alpha/2) = " + Num(cone.Q()) + " <= 0");
+                         "(R/h)^2 tan^2(alpha/2) = " + ExactText(cone.Q()) + " <= 0");
       return cone;
     }
   }
@@ -108,8 +103,8 @@ bool Scene::rolls_up() const {
 
 PathPoint Scene::At(double x) const {
   if (!std::isfinite(x) || x < x_low() || x > x_max())
-    throw InputError("x", "must lie on the path, in [" + Num(x_low()) + ", " + Num(x_max()) +
-                              "] m (got " + Num(x) + " m)");
+    throw InputError("x", "must lie on the path, in [" + ExactText(x_low()) + ", " + ExactText(x_max()) +
+                              "] m (got " + ExactText(x) + " m)");
   return std::visit(
       Overloaded{[x](const SpheroidOnLineRails<double>& p) { return FromSpheroid(x, p.At(x)); },
                  [x](const SphereOnRods& p) {
@@ -127,7 +122,7 @@ PathPoint Scene::At(double x) const {
 
 std::optional<RestBand> Scene::Rest(double mu) const {
   if (!(mu >= 0.0) || !std::isfinite(mu))
-    throw InputError("mu", "must be a finite number >= 0 (got " + Num(mu) + ")");
+    throw InputError("mu", "must be a finite number >= 0 (got " + ExactText(mu) + ")");
   return std::visit(
       Overloaded{[mu](const SpheroidOnLineRails<double>& p) -> std::optional<RestBand> {
                    return RestBand{p.RestX(-mu), p.RestX(mu)};

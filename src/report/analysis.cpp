@@ -94,8 +94,14 @@ ExperimentAnalysis AnalyseExperiment(const io::Experiment& experiment, const Ana
     friction.scenes.push_back(r.source->configuration->MakeScene());
     friction.y.push_back(r.y);
     friction.u_y.push_back(r.u_y);
+    // The model value's own uncertainty, from the inputs' (u(X) approximates u(x_rest(mu)):
+    // fit/friction_fit.hpp); without it the friction fit's chi2/nu carries the inputs' scatter.
+    friction.u_model.push_back(r.u_x_eq);
   }
-  if (!all_u_y) friction.u_y.clear();
+  if (!all_u_y) {
+    friction.u_y.clear();
+    friction.u_model.clear();  // the effective variance needs u(Y)
+  }
   FitOptions fit_options;
   fit_options.outlier_threshold = options.outlier_threshold;
   a.fits.push_back(TryFit("ols", "Ordinary least squares (the paper's fit)",

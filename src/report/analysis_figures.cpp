@@ -1,5 +1,7 @@
 #include "report/analysis_figures.hpp"
 
+#include "model/number_text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,11 +11,7 @@
 namespace uphill::report {
 namespace {
 
-std::string Num(double v) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.10g", v);
-  return buffer;
-}
+std::string Num(double v) { return Printf("%.10g", v); }
 
 // Indices of the analysis rows in increasing X.
 std::vector<size_t> ByX(const ExperimentAnalysis& a) {

@@ -2,6 +2,7 @@
 
 #include <boost/archive/iterators/base64_from_binary.hpp>
 #include <boost/archive/iterators/transform_width.hpp>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -13,7 +14,7 @@ namespace {
 const char* kCss = R"(body{font-family:'DejaVu Sans',Helvetica,Arial,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222;line-height:1.45}
 h1{font-size:1.7em;border-bottom:2px solid #1f4e79;padding-bottom:.2em}h2{font-size:1.3em;color:#1f4e79;margin-top:1.6em}
 table{border-collapse:collapse;margin:.6em 0 1.2em;font-size:.88em}th,td{border:1px solid #ccc;padding:.25em .55em;text-align:right;vertical-align:top}
-th{background:#eef3f8}td:first-child,th:first-child{text-align:left}tr:nth-child(even) td{background:#fafafa}
+th{background:#eef3f8}td.n{white-space:nowrap}td.t,th:first-child{text-align:left}tr:nth-child(even) td{background:#fafafa}
 figure{margin:1em 0 1.6em}figure img{width:100%;max-width:900px;border:1px solid #ddd}figcaption{font-size:.9em;color:#555;max-width:900px}
 .note{color:#555;font-size:.9em})";
 
@@ -23,6 +24,14 @@ std::string Slurp(const std::string& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// Numbers (and "-") are right-aligned and never wrapped; text is left-aligned and wraps.
+bool LooksNumeric(const std::string& s) {
+  if (s.empty() || s == "-") return true;
+  char* end = nullptr;
+  std::strtod(s.c_str(), &end);
+  return end != s.c_str() && *end == '\0';
 }
 
 std::string MarkdownCell(const std::string& s) {
@@ -90,7 +99,8 @@ std::string RenderHtml(const Document& d, const std::string& directory) {
         o << "</tr>\n";
         for (const auto& row : b.table.rows) {
           o << "<tr>";
-          for (const auto& cell : row) o << "<td>" << HtmlEscape(cell) << "</td>";
+          for (const auto& cell : row)
+            o << "<td class=\"" << (LooksNumeric(cell) ? "n" : "t") << "\">" << HtmlEscape(cell) << "</td>";
           o << "</tr>\n";
         }
         o << "</table>\n";

@@ -10,18 +10,14 @@
 #include "report/analysis_figures.hpp"
 #include "report/fit_json.hpp"
 #include "report/gnuplot_figure.hpp"
+#include "model/number_text.hpp"
 
 namespace uphill::report {
 namespace {
 
-std::string Fmt(const char* format, double v) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, v);
-  return buffer;
-}
-std::string Mm(double m, const char* format = "%.2f") { return Fmt(format, m * 1e3); }
-std::string Deg(double rad) { return Fmt("%.3f", rad * 180.0 / std::numbers::pi); }
-std::string Opt(const std::optional<double>& v, const char* format) { return v ? Fmt(format, *v) : "-"; }
+std::string Mm(double m, const char* format = "%.2f") { return Printf(format, m * 1e3); }
+std::string Deg(double rad) { return Printf("%.3f", rad * 180.0 / std::numbers::pi); }
+std::string Opt(const std::optional<double>& v, const char* format) { return v ? Printf(format, *v) : "-"; }
 
 // {"a": "15.875 mm", "type": "spheroid"} -> "type = spheroid, a = 15.875 mm" (type first).
 std::string KeyValues(const nlohmann::json& object) {
@@ -37,7 +33,7 @@ std::string KeyValues(const nlohmann::json& object) {
 
 std::string ParameterText(const FitReport& r, const ParameterEstimate& p) {
   const bool length = p.name == "c";
-  const auto show = [&](double v) { return length ? Mm(v, "%.3f") + " mm" : Fmt("%.6g", v); };
+  const auto show = [&](double v) { return length ? Mm(v, "%.3f") + " mm" : Printf("%.6g", v); };
   const auto primary = r.StandardError(p.name, r.primary_scaling);
   return p.name + " = " + show(p.value) + (primary ? " ± " + show(*primary) : " (no uncertainty: exact fit)");
 }
@@ -58,12 +54,12 @@ Table FitTable(const ExperimentAnalysis& a) {
     for (size_t i : r.outliers) flagged += (flagged.empty() ? "outliers: " : ", ") + a.rows[i].source->trial;
     for (const auto& d : r.downweighted)
       flagged += std::string(flagged.empty() ? "" : "; ") + "down-weighted " + a.rows[d.row].source->trial +
-                 " (w = " + Fmt("%.2f", d.weight) + ")";
+                 " (w = " + Printf("%.2f", d.weight) + ")";
     const bool scaled = r.primary_scaling == ErrorScaling::kScaled;
     // OLS has no stated uncertainties: its chi2 is the residual sum of squares, in m² → mm².
     const bool ols = r.method == FitMethod::kOrdinaryLeastSquares;
-    const std::string chi2 = ols ? "RSS " + Fmt("%.4g", r.chi2 * 1e6) + " mm^2" : Fmt("%.4g", r.chi2);
-    const std::string reduced = ols ? (r.reduced_chi2 ? "s^2 " + Fmt("%.3g", *r.reduced_chi2 * 1e6) + " mm^2" : "-")
+    const std::string chi2 = ols ? "RSS " + Printf("%.4g", r.chi2 * 1e6) + " mm^2" : Printf("%.4g", r.chi2);
+    const std::string reduced = ols ? (r.reduced_chi2 ? "s^2 " + Printf("%.3g", *r.reduced_chi2 * 1e6) + " mm^2" : "-")
                                     : Opt(r.reduced_chi2, "%.3g");
     t.rows.push_back({f.title, params, scaled ? "scaled by sqrt(chi2/dof)" : "unscaled (stated u)",
                       chi2, std::to_string(r.dof), reduced,
@@ -93,7 +89,7 @@ Table RowTable(const ExperimentAnalysis& a) {
       if (ols->report->rows[i].outlier) flags += std::string(flags.empty() ? "" : "; ") + "OLS outlier";
     }
     if (york && york->report) {
-      row.push_back(Fmt("%.2f", york->report->rows[i].normalised));
+      row.push_back(Printf("%.2f", york->report->rows[i].normalised));
       if (york->report->rows[i].outlier) flags += std::string(flags.empty() ? "" : "; ") + "York outlier";
     }
     row.push_back(flags);
@@ -109,20 +105,20 @@ std::string Summary(const ExperimentAnalysis& a) {
   s << ". ";
   if (const FitOutcome* ols = a.Fit("ols"); ols && ols->report) {
     const FitReport& r = *ols->report;
-    s << "The paper's fit (OLS) gives Y = " << Fmt("%.4f", r.slope()) << "·X " << (r.intercept() < 0 ? "- " : "+ ")
+    s << "The paper's fit (OLS) gives Y = " << Printf("%.4f", r.slope()) << "·X " << (r.intercept() < 0 ? "- " : "+ ")
       << Mm(std::abs(r.intercept())) << " mm";
-    if (const auto se = r.StandardError("k", r.primary_scaling)) s << " (slope ± " << Fmt("%.4f", *se) << ")";
+    if (const auto se = r.StandardError("k", r.primary_scaling)) s << " (slope ± " << Printf("%.4f", *se) << ")";
     s << ". ";
   }
   if (const FitOutcome* york = a.Fit("york"); york && york->report) {
     const FitReport& r = *york->report;
-    s << "With the uncertainties of both X and Y (York): slope " << Fmt("%.4f", r.slope()) << ", intercept "
+    s << "With the uncertainties of both X and Y (York): slope " << Printf("%.4f", r.slope()) << ", intercept "
       << Mm(r.intercept()) << " mm, chi2/dof = " << Opt(r.reduced_chi2, "%.2f") << ". ";
   }
   if (const FitOutcome* fr = a.Fit("friction"); fr && fr->report) {
     const FitReport& r = *fr->report;
-    s << "The friction model (rest where |dz/dx| <= mu) fits mu = " << Fmt("%.5f", r.Parameter("mu").value);
-    if (const auto se = r.StandardError("mu", r.primary_scaling)) s << " ± " << Fmt("%.5f", *se);
+    s << "The friction model (rest where |dz/dx| <= mu) fits mu = " << Printf("%.5f", r.Parameter("mu").value);
+    if (const auto se = r.StandardError("mu", r.primary_scaling)) s << " ± " << Printf("%.5f", *se);
     s << ". ";
   }
   if (a.friction_vs_line) s << a.friction_vs_line->verdict;

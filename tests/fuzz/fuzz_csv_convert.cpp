@@ -1,17 +1,16 @@
 // Fuzz target: io::ReadCsv followed by what `uphill convert --batch` does with the table
-// (tools/uphill/convert_command.cpp, ConvertBatch and RowSource, mirrored here without command-line
-// defaults): the column check, io::ParseConfiguration per row, io::Convert (first-order
+// (tools/uphill/convert_command.cpp, ConvertBatch, without command-line defaults): the column
+// check of io::ConfigurationTable, io::ParseConfiguration per row, io::Convert (first-order
 // uncertainties only: Monte Carlo trials = 0), a point on the path, and the JSON output.
 // Only uphill::InputError may escape a step; anything else (a crash, a sanitizer report, another
 // exception) is a bug.
-#include <algorithm>
 #include <cstddef>
 #include <cstdint>
-#include <map>
 #include <sstream>
 #include <string>
 
 #include "io/configuration.hpp"
+#include "io/configuration_table.hpp"
 #include "io/conversion.hpp"
 #include "io/csv_table.hpp"
 #include "io/units.hpp"
@@ -21,30 +20,9 @@ namespace {
 
 using namespace uphill;
 
-// RowSource of convert_command.cpp: a row's non-blank cells, with the unit of the header suffix.
-io::FieldSource RowSource(const io::CsvTable& table, const io::CsvRow& row,
-                          const std::map<std::string, int>& field_column) {
-  io::FieldSource source;
-  source.lookup = [&](const std::string& name) -> std::optional<io::FieldSource::Field> {
-    if (auto it = field_column.find(name); it != field_column.end()) {
-      const std::string& cell = row.cells[it->second];
-      if (cell.find_first_not_of(" \t") != std::string::npos)
-        return io::FieldSource::Field{cell, io::SplitUnitSuffix(table.header[it->second]).second};
-    }
-    return std::nullopt;
-  };
-  source.context = [&](const std::string& name) {
-    if (auto it = field_column.find(name); it != field_column.end())
-      return io::CellContext(table, row.row, table.header[it->second]);
-    return table.source + ", row " + std::to_string(row.row) + ": --" + name;
-  };
-  return source;
-}
-
-void ConvertRow(const io::CsvTable& table, const io::CsvRow& row,
-                const std::map<std::string, int>& field_column) {
+void ConvertRow(const io::ConfigurationTable& configurations, const io::CsvRow& row) {
   if (!row.error.empty()) return;
-  const io::Configuration c = io::ParseConfiguration(RowSource(table, row, field_column));
+  const io::Configuration c = io::ParseConfiguration(configurations.RowSource(row));
   io::ConversionOptions options;
   options.mu = 0.01;
   options.propagation.trials = 0;  // first order only: Monte Carlo is the model's, not the reader's
@@ -59,21 +37,12 @@ void ConvertRow(const io::CsvTable& table, const io::CsvRow& row,
 void Run(const std::string& text) {
   std::istringstream in(text);
   const io::CsvTable table = io::ReadCsv(in, "fuzz.csv");
-  const auto& known = io::ConfigurationFieldNames();
-  std::map<std::string, int> field_column;
-  for (size_t i = 0; i < table.header.size(); ++i) {
-    const std::string base = io::SplitUnitSuffix(table.header[i]).first;
-    if (base == "note") continue;
-    if (std::find(known.begin(), known.end(), base) == known.end())
-      throw InputError(table.source + ", row 1, column " + table.header[i], "unknown column");
-    if (!field_column.emplace(base, static_cast<int>(i)).second)
-      throw InputError(table.source + ", row 1, column " + table.header[i], "second time");
-  }
+  const io::ConfigurationTable configurations(table);
   size_t converted = 0;
   for (const io::CsvRow& row : table.rows) {
     if (++converted > 32) break;  // enough rows to mix good and bad ones; keeps runs fast
     try {
-      ConvertRow(table, row, field_column);
+      ConvertRow(configurations, row);
     } catch (const InputError&) {
       // A bad row: reported by convert, the other rows go on.
     }

@@ -3,10 +3,10 @@
 
 Run by `uphill bench convert` as a subprocess (it is also usable by hand):
 
-  numpy_convert.py convert IN.npy OUT.npy [--repeats K]
-      IN.npy: float64 array of shape (3, n) holding L, H, D (metres, horizontal convention);
+  numpy_convert.py convert IN.f64 OUT.f64 [--repeats K]
+      IN.f64: raw little-endian float64 array of shape (3, n), C order, holding L, H, D (metres, horizontal convention);
       computes θ, α (rad) and X = x_eq (m) of the spheroid --a/--b on line rails and saves them to
-      OUT.npy, shape (3, n). The formulas are uphill's (src/model/batch_convert.hpp):
+      OUT.f64, shape (3, n). The formulas are uphill's (src/model/batch_convert.hpp):
       B = H/L, T = D/(2L), θ = atan(B), α = 2 atan(T), A = a·T/b, X = a·B/(A·hypot(A, B)).
   numpy_convert.py mc --trials M --seed S [--case JSON] [--repeats K]
       GUM Supplement 1 Monte Carlo: Gaussian L, H, D, a, b (JSON {"L": [value, u], ...}, metres;
@@ -102,12 +102,16 @@ def monte_carlo(trials, seed, case, w, coverage=0.95):
     r = max((m - q + 1) // 2, 1)
     hi = min(r + q, m)
     stats = {}
-    part = w("partition")
+    part = w("partition")[:m]
     for name, y in (("theta", theta), ("alpha", alpha), ("phi", phi), ("x_eq", x_eq),
                     ("x_max", x_max)):
-        part[:m] = y
-        part[:m].partition((r - 1, hi - 1))
-        stats[name] = {"mean": float(y.mean()), "u": float(y.std(ddof=1)),
+        mean = y.mean()
+        np.subtract(y, mean, out=part)  # the variance without np.std's temporaries
+        np.square(part, out=part)
+        u = np.sqrt(part.sum() / (m - 1))
+        part[:] = y
+        part.partition((r - 1, hi - 1))
+        stats[name] = {"mean": float(mean), "u": float(u),
                        "low": float(part[r - 1]), "high": float(part[hi - 1])}
     return stats, int(trials - m)
 
@@ -138,12 +142,12 @@ def main():
     args = ap.parse_args()
     info = {"numpy": np.__version__, "python": sys.version.split()[0]}
     if args.mode == "convert":
-        L, H, D = np.load(args.input)
+        L, H, D = np.fromfile(args.input, dtype="<f8").reshape(3, -1)
         work = Work(L.size)
         convert(L, H, D, args.a, args.b, work)  # allocate and touch the work arrays once
         seconds, (theta, alpha, X) = best_of(
             args.repeats, lambda: convert(L, H, D, args.a, args.b, work))
-        np.save(args.output, np.stack((theta, alpha, X)))
+        np.stack((theta, alpha, X)).astype("<f8").tofile(args.output)
         info.update(mode="convert", n=int(L.size), seconds=seconds, repeats=args.repeats)
     else:
         work = Work(args.trials)

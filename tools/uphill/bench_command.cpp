@@ -7,6 +7,8 @@ void AddBenchCommand(CLI::App& app) {
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks: speed against error, with peers");
   bench->require_subcommand(1);
   AddBenchConvert(*bench);
+  AddBenchFit(*bench);
+  AddBenchMotion(*bench);
 }
 
 }  // namespace uphill::cli

@@ -1,12 +1,10 @@
 // `uphill bench convert`: throughput of the conversion and of the Monte Carlo propagation on one
 // core, each row with the accuracy it reached, and the same work in NumPy when /usr/bin/python3
-// has it (tools/bench/numpy_convert.py, run as a subprocess; inputs and outputs go through .npy
+// has it (tools/bench/numpy_convert.py, run as a subprocess; inputs and outputs go through raw float64
 // files in a temporary directory so that both sides compute on the very same numbers).
 //
 // Times are thread CPU time (CLOCK_THREAD_CPUTIME_ID here, time.thread_time() in Python), best
 // of --repeats: the throughput of one core, and not skewed by other load on the machine.
-#include <time.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -24,7 +22,9 @@
 #include <string>
 #include <vector>
 
+#include "bench_support.hpp"
 #include "commands.hpp"
+#include "model/number_text.hpp"
 #include "model/batch_convert.hpp"
 #include "model/input_error.hpp"
 #include "model/propagation.hpp"
@@ -57,107 +57,6 @@ constexpr std::array<LabInput, 5> kLab = {{{"L", 1.165, 0.002},
                                            {"a", 0.015875, 2e-5},
                                            {"b", 0.0254, 2e-5}}};
 constexpr double kA = 0.015875, kB = 0.0254;
-
-double CpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-template <typename F>
-double BestOf(int repeats, F&& f) {
-  double best = INFINITY;
-  for (int r = 0; r < repeats; ++r) {
-    const double t0 = CpuSeconds();
-    f();
-    best = std::min(best, CpuSeconds() - t0);
-  }
-  return best;
-}
-
-// A file found by walking up from the executable's directory and from the working directory.
-std::string FindUpward(const std::string& relative) {
-  std::vector<fs::path> starts;
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) starts.push_back(exe.parent_path());
-  starts.push_back(fs::current_path(ec));
-  for (fs::path dir : starts) {
-    for (int up = 0; up < 8 && !dir.empty(); ++up) {
-      if (fs::exists(dir / relative, ec)) return (dir / relative).string();
-      if (dir == dir.parent_path()) break;
-      dir = dir.parent_path();
-    }
-  }
-  return "";
-}
-
-std::string Quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-// Runs a shell command and returns its standard output; false if it failed.
-bool Capture(const std::string& command, std::string* out) {
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return false;
-  char buf[4096];
-  std::size_t got;
-  while ((got = std::fread(buf, 1, sizeof buf, pipe)) > 0) out->append(buf, got);
-  return pclose(pipe) == 0;
-}
-
-// --- .npy (format 1.0: magic, version, little-endian header length, a Python dict literal) ---
-
-void WriteNpy(const fs::path& path, const std::vector<const std::vector<double>*>& rows) {
-  const std::size_t n = rows.front()->size();
-  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" +
-                       std::to_string(rows.size()) + ", " + std::to_string(n) + "), }";
-  const std::size_t unpadded = 10 + header.size() + 1;
-  header.append((64 - unpadded % 64) % 64, ' ');
-  header += '\n';
-  std::ofstream out(path, std::ios::binary);
-  const unsigned char prefix[8] = {0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0};
-  out.write(reinterpret_cast<const char*>(prefix), 8);
-  const unsigned char len[2] = {static_cast<unsigned char>(header.size() & 0xFF),
-                                static_cast<unsigned char>(header.size() >> 8)};
-  out.write(reinterpret_cast<const char*>(len), 2);
-  out << header;
-  for (const auto* row : rows)
-    out.write(reinterpret_cast<const char*>(row->data()), static_cast<std::streamsize>(n * sizeof(double)));
-  if (!out) throw std::runtime_error("cannot write " + path.string());
-}
-
-// Reads a C-order float64 array of shape (rows, n) written by np.save.
-std::vector<std::vector<double>> ReadNpy(const fs::path& path, std::size_t rows, std::size_t n) {
-  std::ifstream in(path, std::ios::binary);
-  char magic[8];
-  in.read(magic, 8);
-  if (!in || std::memcmp(magic, "\x93NUMPY", 6) != 0) throw std::runtime_error("not .npy: " + path.string());
-  std::size_t header_len = 0;
-  if (magic[6] == 1) {
-    unsigned char b[2];
-    in.read(reinterpret_cast<char*>(b), 2);
-    header_len = b[0] | (static_cast<std::size_t>(b[1]) << 8);
-  } else {
-    unsigned char b[4];
-    in.read(reinterpret_cast<char*>(b), 4);
-    header_len = b[0] | (static_cast<std::size_t>(b[1]) << 8) | (static_cast<std::size_t>(b[2]) << 16) |
-                 (static_cast<std::size_t>(b[3]) << 24);
-  }
-  std::string header(header_len, '\0');
-  in.read(header.data(), static_cast<std::streamsize>(header_len));
-  const std::string shape = "(" + std::to_string(rows) + ", " + std::to_string(n) + ")";
-  if (header.find("'<f8'") == std::string::npos || header.find("False") == std::string::npos ||
-      header.find(shape) == std::string::npos)
-    throw std::runtime_error("unexpected .npy header in " + path.string() + ": " + header);
-  std::vector<std::vector<double>> out(rows, std::vector<double>(n));
-  for (auto& row : out)
-    in.read(reinterpret_cast<char*>(row.data()), static_cast<std::streamsize>(n * sizeof(double)));
-  if (!in) throw std::runtime_error("short .npy file " + path.string());
-  return out;
-}
 
 // --- accuracy against the 60-digit references ----------------------------------------------------
 
@@ -206,22 +105,17 @@ Accuracy AgainstReferences(const std::string& path, BatchKernel kernel) {
 
 // --- table -----------------------------------------------------------------------------------
 
-std::string Fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
 
 std::string Rate(double per_second) {
-  if (per_second >= 1e9) return Fmt("%.2f G/s", per_second / 1e9);
-  if (per_second >= 1e6) return Fmt("%.1f M/s", per_second / 1e6);
-  return Fmt("%.0f k/s", per_second / 1e3);
+  if (per_second >= 1e9) return Printf("%.2f G/s", per_second / 1e9);
+  if (per_second >= 1e6) return Printf("%.1f M/s", per_second / 1e6);
+  return Printf("%.0f k/s", per_second / 1e3);
 }
 
 void Row(const std::string& what, std::uint64_t n, double seconds, const std::string& accuracy) {
   const double per = seconds / static_cast<double>(n);
   std::printf("%-44s %9.3g %10s %11s  %s\n", what.c_str(), static_cast<double>(n),
-              (per < 1e-6 ? Fmt("%.2f ns", per * 1e9) : Fmt("%.2f us", per * 1e6)).c_str(),
+              (per < 1e-6 ? Printf("%.2f ns", per * 1e9) : Printf("%.2f us", per * 1e6)).c_str(),
               Rate(1.0 / per).c_str(), accuracy.c_str());
 }
 
@@ -229,7 +123,7 @@ void Run(const BenchFlags& f) {
   if (f.configurations < 1000) throw InputError("--configurations", "must be at least 1000");
   if (f.trials < 100) throw InputError("--trials", "must be at least 100");
   if (f.repeats < 1) throw InputError("--repeats", "must be at least 1");
-  const std::string reference = f.reference.empty() ? FindUpward("tests/data/physics_reference.json") : f.reference;
+  const std::string reference = f.reference.empty() ? bench::FindUpward("tests/data/physics_reference.json") : f.reference;
   const BatchKernel kernel = BatchKernel::kAuto;
   std::printf("uphill bench convert: one core, thread CPU time, best of %d; batch kernel %s\n",
               f.repeats, BatchKernelName(kernel));
@@ -258,12 +152,12 @@ void Run(const BenchFlags& f) {
   auto accuracy = [&](BatchKernel k) {
     if (reference.empty()) return std::string("(tests/data/physics_reference.json not found)");
     const Accuracy acc = AgainstReferences(reference, k);
-    return Fmt("max rel err %.2g", acc.max_rel) + " vs 60-digit refs (theta, alpha, X: " +
+    return Printf("max rel err %.2g", acc.max_rel) + " vs 60-digit refs (theta, alpha, X: " +
            std::to_string(acc.values) + " values)";
   };
   convert(kernel);  // first touch of the output pages outside the timing
-  const double t_scalar_model = BestOf(1, [&] { convert(BatchKernel::kScalar); });
-  const double t_convert = BestOf(f.repeats, [&] { convert(kernel); });
+  const double t_scalar_model = bench::BestOf(1, [&] { convert(BatchKernel::kScalar); });
+  const double t_convert = bench::BestOf(f.repeats, [&] { convert(kernel); });
   Row(std::string("convert L,H,D -> theta,alpha,X (") +
           (BatchKernelAvailable(BatchKernel::kAvx2) ? "avx2" : "scalar") + ")",
       n, t_convert, accuracy(kernel));
@@ -277,45 +171,39 @@ void Run(const BenchFlags& f) {
   options.trials = f.trials;
   options.seed = f.seed;
   PropagationResult mc;
-  const double t_mc = BestOf(f.repeats, [&] { mc = Propagate(rails, body, {}, options); });
+  const double t_mc = bench::BestOf(f.repeats, [&] { mc = Propagate(rails, body, {}, options); });
   double worst_fo = 0.0;
   for (const PropagatedValue* y : mc.Outputs())
     worst_fo = std::max(worst_fo, std::abs(y->u_monte_carlo / y->u_first_order - 1));
   const double se_u = 1.0 / std::sqrt(2.0 * static_cast<double>(mc.valid_trials - 1));
   Row("Monte Carlo (Propagate), 5 inputs, 5 outputs", f.trials, t_mc,
-      Fmt("u to ±%.2f %% (1/sqrt(2M))", 100 * se_u) + Fmt("; |u_MC/u_1st - 1| <= %.2f %%", 100 * worst_fo));
+      Printf("u to ±%.2f %% (1/sqrt(2M))", 100 * se_u) + Printf("; |u_MC/u_1st - 1| <= %.2f %%", 100 * worst_fo));
 
   // NumPy.
-  std::string script = f.script.empty() ? FindUpward("tools/bench/numpy_convert.py") : f.script;
+  std::string script = f.script.empty() ? bench::FindUpward("tools/bench/numpy_convert.py") : f.script;
   std::string why_not;
   if (f.no_numpy) why_not = "--no-numpy";
   else if (access(f.python.c_str(), X_OK) != 0) why_not = f.python + " not found";
   else if (script.empty()) why_not = "tools/bench/numpy_convert.py not found (use --numpy-script)";
-  else if (std::system((Quote(f.python) + " -c 'import numpy' > /dev/null 2>&1").c_str()) != 0)
+  else if (std::system((bench::ShellQuote(f.python) + " -c 'import numpy' > /dev/null 2>&1").c_str()) != 0)
     why_not = f.python + " has no NumPy (bash scripts/install-deps.sh --bench)";
   if (!why_not.empty()) {
     std::printf("\nNumPy comparison skipped: %s\n", why_not.c_str());
     return;
   }
-  char dir_template[] = "/tmp/uphill-bench-XXXXXX";
-  if (!mkdtemp(dir_template)) throw std::runtime_error("cannot create a temporary directory");
-  const fs::path dir = dir_template;
-  struct Cleanup {
-    fs::path dir;
-    ~Cleanup() {
-      std::error_code ec;
-      fs::remove_all(dir, ec);
-    }
-  } cleanup{dir};
-  WriteNpy(dir / "in.npy", {&L, &H, &D});
+  const bench::TemporaryDirectory temporary;
+  const fs::path& dir = temporary.path();
+  bench::WriteFloat64(dir / "in.f64", {&L, &H, &D});
   std::string out;
   const std::string reps = " --repeats " + std::to_string(f.repeats);
-  if (!Capture(Quote(f.python) + " " + Quote(script) + " convert " + Quote((dir / "in.npy").string()) + " " +
-                   Quote((dir / "out.npy").string()) + reps,
-               &out))
+  const std::string python = bench::OneCorePython(f.python);
+  if (!bench::Capture(python + " " + bench::ShellQuote(script) + " convert " +
+                          bench::ShellQuote((dir / "in.f64").string()) + " " +
+                          bench::ShellQuote((dir / "out.f64").string()) + reps,
+                      &out))
     throw std::runtime_error("the NumPy script failed: " + script);
   const nlohmann::json np_convert = nlohmann::json::parse(out);
-  const auto np = ReadNpy(dir / "out.npy", 3, n);
+  const auto np = bench::ReadFloat64(dir / "out.f64", 3, n);
   double diff = 0.0;
   const std::vector<double>* ours[3] = {&theta, &alpha, &x_eq};
   for (int k = 0; k < 3; ++k)
@@ -323,13 +211,13 @@ void Run(const BenchFlags& f) {
       diff = std::max(diff, std::abs((*ours[k])[i] - np[k][i]) / std::abs(np[k][i]));
   const double t_np = np_convert.at("seconds");
   Row("NumPy " + np_convert.at("numpy").get<std::string>() + " convert, same inputs", n, t_np,
-      Fmt("max rel diff vs uphill %.2g", diff));
+      Printf("max rel diff vs uphill %.2g", diff));
 
   nlohmann::json lab_case;
   for (const LabInput& x : kLab) lab_case[x.name] = {x.value, x.u};
   out.clear();
-  if (!Capture(Quote(f.python) + " " + Quote(script) + " mc --trials " + std::to_string(f.trials) +
-                   " --seed " + std::to_string(f.seed) + " --case " + Quote(lab_case.dump()) + reps,
+  if (!bench::Capture(python + " " + bench::ShellQuote(script) + " mc --trials " + std::to_string(f.trials) +
+                   " --seed " + std::to_string(f.seed) + " --case " + bench::ShellQuote(lab_case.dump()) + reps,
                &out))
     throw std::runtime_error("the NumPy script failed: " + script);
   const nlohmann::json np_mc = nlohmann::json::parse(out);
@@ -338,7 +226,7 @@ void Run(const BenchFlags& f) {
     worst_np = std::max(worst_np, std::abs(np_mc.at("stats").at(y->name).at("u").get<double>() / y->u_monte_carlo - 1));
   const double t_np_mc = np_mc.at("seconds");
   Row("NumPy Monte Carlo, same case, own RNG", f.trials, t_np_mc,
-      Fmt("|u_NumPy/u_uphill - 1| <= %.2f %% (statistical)", 100 * worst_np));
+      Printf("|u_NumPy/u_uphill - 1| <= %.2f %% (statistical)", 100 * worst_np));
 
   const double speed_convert = t_np / t_convert, speed_mc = t_np_mc / t_mc;
   std::printf("\nuphill vs NumPy per core: convert %.1fx (goal >= 10x, rel diff %.2g, goal <= 1e-14): %s\n",

@@ -16,8 +16,16 @@ void AddConvertCommand(CLI::App& app);
 void AddBenchCommand(CLI::App& app);
 // `fit` and `report` (fit_command.cpp).
 void AddFitCommand(CLI::App& app);
+// `serve`: the measurement-entry web page (serve_command.cpp, src/server/).
+void AddServeCommand(CLI::App& app);
+// `simulate`: the rolling motion released at --x0 (simulate_command.cpp, src/motion/).
+void AddSimulateCommand(CLI::App& app);
+// `paper-figures`: the seed paper's model figures (paper_figures_command.cpp).
+void AddPaperFiguresCommand(CLI::App& app);
 
 // `uphill bench <what>`: each benchmark adds itself to the bench subcommand.
 void AddBenchConvert(CLI::App& bench);
+void AddBenchFit(CLI::App& bench);  // bench_fit.cpp
+void AddBenchMotion(CLI::App& bench);  // bench_motion.cpp
 
 }  // namespace uphill::cli

@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "convert_output.hpp"
+#include "io/configuration_table.hpp"
 #include "io/csv_table.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
@@ -52,41 +53,10 @@ io::ConversionOptions Options(const ConvertFlags& f) {
   return o;
 }
 
-// A batch row as a field source: the row's non-empty cells, then the flags as defaults.
-io::FieldSource RowSource(const io::CsvTable& table, const io::CsvRow& row, const SceneFlags& flags,
-                          const std::map<std::string, int>& field_column) {
-  const io::FieldSource defaults = FlagSource(flags);
-  io::FieldSource source;
-  source.lookup = [&, defaults](const std::string& name) -> std::optional<io::FieldSource::Field> {
-    if (auto it = field_column.find(name); it != field_column.end()) {
-      const std::string& cell = row.cells[it->second];
-      if (cell.find_first_not_of(" \t") != std::string::npos)
-        return io::FieldSource::Field{cell, io::SplitUnitSuffix(table.header[it->second]).second};
-    }
-    return defaults.lookup(name);
-  };
-  source.context = [&, defaults](const std::string& name) {
-    if (auto it = field_column.find(name); it != field_column.end())
-      return io::CellContext(table, row.row, table.header[it->second]);
-    return table.source + ", row " + std::to_string(row.row) + ": " + defaults.context(name);
-  };
-  return source;
-}
-
 std::vector<ConvertedRow> ConvertBatch(const ConvertFlags& f, const io::ConversionOptions& options) {
   const io::CsvTable table = io::ReadCsvFile(f.batch);
-  const auto& known = io::ConfigurationFieldNames();
-  std::map<std::string, int> field_column;
-  for (size_t i = 0; i < table.header.size(); ++i) {
-    const std::string base = io::SplitUnitSuffix(table.header[i]).first;
-    if (base == "note") continue;
-    if (std::find(known.begin(), known.end(), base) == known.end())
-      throw InputError(table.source + ", row 1, column " + table.header[i],
-                       "unknown column (see README.md, 'Batch CSV of convert', for the accepted names)");
-    if (!field_column.emplace(base, static_cast<int>(i)).second)
-      throw InputError(table.source + ", row 1, column " + table.header[i],
-                       "gives '" + base + "' a second time");
-  }
+  const io::ConfigurationTable configurations(table);
+  const io::FieldSource defaults = FlagSource(f.scene);
   if (table.rows.empty()) throw InputError(table.source, "has a header but no data rows");
   std::vector<ConvertedRow> rows;
   for (const io::CsvRow& row : table.rows) {
@@ -94,7 +64,7 @@ std::vector<ConvertedRow> ConvertBatch(const ConvertFlags& f, const io::Conversi
     out.row = row.row;
     try {
       if (!row.error.empty()) throw InputError(table.source + ", row " + std::to_string(row.row), row.error);
-      const io::Configuration c = io::ParseConfiguration(RowSource(table, row, f.scene, field_column));
+      const io::Configuration c = io::ParseConfiguration(configurations.RowSource(row, &defaults));
       try {
         out.result = io::Convert(c, options);
       } catch (const InputError& e) {

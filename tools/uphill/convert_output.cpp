@@ -5,17 +5,13 @@
 #include <numbers>
 
 #include "io/units.hpp"
+#include "model/number_text.hpp"
 
 namespace uphill::cli {
 namespace {
 
 using io::ConversionResult;
 
-std::string Fmt(const char* format, double v) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, v);
-  return buffer;
-}
 
 // A column of the table and CSV: header (with unit) and how to get its text from a result.
 struct Column {
@@ -24,8 +20,8 @@ struct Column {
 };
 
 std::vector<Column> Columns(const std::vector<ConvertedRow>& rows, const std::string& unit) {
-  const auto deg = [](double rad) { return Fmt("%.6f", rad * 180.0 / std::numbers::pi); };
-  const auto len = [unit](double m) { return Fmt("%.6g", io::ToUnit(m, io::Dimension::kLength, unit)); };
+  const auto deg = [](double rad) { return Printf("%.6f", rad * 180.0 / std::numbers::pi); };
+  const auto len = [unit](double m) { return Printf("%.6g", io::ToUnit(m, io::Dimension::kLength, unit)); };
   bool any_rest = false, any_u = false, any_cone = false, any_label = false;
   for (const auto& r : rows) {
     if (!r.result) continue;
@@ -81,6 +77,10 @@ std::vector<Column> Columns(const std::vector<ConvertedRow>& rows, const std::st
   return cols;
 }
 
+std::string Pad(const std::string& s, size_t width) {
+  return s.size() < width ? s + std::string(width - s.size(), ' ') : s + " ";
+}
+
 std::string CsvEscape(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string out = "\"";
@@ -90,12 +90,12 @@ std::string CsvEscape(const std::string& s) {
 
 void PrintSingle(std::ostream& out, const ConvertedRow& row, const std::string& unit) {
   const ConversionResult& r = *row.result;
-  const auto deg = [](double rad) { return Fmt("%.6f", rad * 180.0 / std::numbers::pi) + " deg"; };
+  const auto deg = [](double rad) { return Printf("%.6f", rad * 180.0 / std::numbers::pi) + " deg"; };
   const auto len = [unit](double m) {
-    return Fmt("%.9g", io::ToUnit(m, io::Dimension::kLength, unit)) + " " + unit;
+    return Printf("%.9g", io::ToUnit(m, io::Dimension::kLength, unit)) + " " + unit;
   };
   const auto line = [&out](const std::string& key, const std::string& value) {
-    out << "  " << key << std::string(key.size() < 26 ? 26 - key.size() : 1, ' ') << value << "\n";
+    out << "  " << key << std::string(key.size() < 30 ? 30 - key.size() : 1, ' ') << value << "\n";
   };
   const Scene& s = r.scene;
   out << s.body().Name() << (r.configuration.label.empty() ? "" : " (" + r.configuration.label + ")")
@@ -109,28 +109,28 @@ void PrintSingle(std::ostream& out, const ConvertedRow& row, const std::string& 
   line(s.cone() ? "x_fall (apex)" : "x_max (fall-off)", len(s.x_max()));
   if (s.cone()) {
     line("theta0 (critical, fixed alpha)", deg(*s.theta0()));
-    line("dz/dx (constant)", Fmt("%.9g", -s.cone()->B()));
+    line("dz/dx (constant)", Printf("%.9g", -s.cone()->B()));
   }
   if (r.rest) {
     line("x_rest(-mu) (nearest rest)", len(r.rest->low));
     line("x_rest(mu) = Y (farthest)", len(r.rest->high));
   }
   if (r.propagation) {
-    out << "  standard uncertainties    first order    Monte Carlo (" << r.propagation->trials
-        << " trials)\n";
+    line("standard uncertainties", Pad("first order", 16) + "Monte Carlo (" +
+                                       std::to_string(r.propagation->trials) + " trials)");
     for (const PropagatedValue* q : r.propagation->Outputs()) {
       const bool is_angle = std::string(q->unit) == "rad";
       const std::string name = q->name;
       const auto show = [&](double v) {
-        return is_angle ? Fmt("%.3g", v * 180.0 / std::numbers::pi) + " deg"
-                        : Fmt("%.3g", io::ToUnit(v, io::Dimension::kLength, unit)) + " " + unit;
+        return is_angle ? Printf("%.3g", v * 180.0 / std::numbers::pi) + " deg"
+                        : Printf("%.3g", io::ToUnit(v, io::Dimension::kLength, unit)) + " " + unit;
       };
-      line("u(" + name + ")", show(q->u_first_order) + std::string(8, ' ') + show(q->u_monte_carlo) +
-                                  (q->disagrees ? "   DISAGREE > 5 %" : ""));
+      line("u(" + name + ")", Pad(show(q->u_first_order), 16) + Pad(show(q->u_monte_carlo), 16) +
+                                  (q->disagrees ? "first order and MC differ by > 5 %: use MC" : ""));
     }
   }
   for (const PathPoint& p : r.points)
-    line("at x = " + len(p.x), "z = " + len(p.z) + ", dz/dx = " + Fmt("%.9g", p.dzdx) +
+    line("at x = " + len(p.x), "z = " + len(p.z) + ", dz/dx = " + Printf("%.9g", p.dzdx) +
                                    ", R* = " + len(p.r_star) + ", x_M = " + len(p.x_contact));
   for (const std::string& v : r.verdict) out << "  * " << v << "\n";
 }

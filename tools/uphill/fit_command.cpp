@@ -26,18 +26,12 @@ struct FitFlags {
 };
 
 // Reads X,Y[,uX,uY] (io/xy_table.hpp); rows that cannot be read are reported on stderr and left out.
-LineData ReadXy(const std::string& path) {
-  io::XyTable table = io::ReadXyFile(path);
+LineData LineDataOf(const io::XyTable& table) {
   for (const std::string& error : table.row_errors) {
     std::cerr << "uphill: " << error << " (row left out)\n";
     ExitStatus() = 2;
   }
-  LineData data;
-  data.x = std::move(table.x);
-  data.y = std::move(table.y);
-  data.u_x = std::move(table.u_x);
-  data.u_y = std::move(table.u_y);
-  return data;
+  return LineData{table.x, table.y, table.u_x, table.u_y};
 }
 
 void PrintFitText(const FitReport& r) {
@@ -56,14 +50,22 @@ void PrintFitText(const FitReport& r) {
   for (const auto& n : r.notes) std::cout << "  note: " << n << "\n";
 }
 
+FitReport FitXy(const std::string& method, const LineData& data) {
+  if (method == "ols") return FitOrdinaryLeastSquares(data);
+  if (method == "wls") return FitWeightedLeastSquares(data);
+  if (method == "york") return FitErrorsInVariables(data);
+  if (method == "robust") return FitRobust(data);
+  throw InputError("--method", "must be ols, wls, york or robust (got '" + method + "')");
+}
+
 void RunXy(const FitFlags& f) {
-  const LineData data = ReadXy(f.xy);
+  const io::XyTable table = io::ReadXyFile(f.xy);
   FitReport r;
-  if (f.method == "ols") r = FitOrdinaryLeastSquares(data);
-  else if (f.method == "wls") r = FitWeightedLeastSquares(data);
-  else if (f.method == "york") r = FitErrorsInVariables(data);
-  else if (f.method == "robust") r = FitRobust(data);
-  else throw InputError("--method", "must be ols, wls, york or robust (got '" + f.method + "')");
+  try {
+    r = FitXy(f.method, LineDataOf(table));
+  } catch (const InputError& e) {
+    throw InputError(table.Locate(e.quantity()), e.rule());  // name the file's row and column
+  }
   if (f.json) {
     std::cout << report::FitToJson(r).dump(2) << "\n";
   } else {

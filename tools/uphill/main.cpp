@@ -17,6 +17,9 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "uphill 0.1.0");
   uphill::cli::AddConvertCommand(app);
   uphill::cli::AddFitCommand(app);
+  uphill::cli::AddServeCommand(app);
+  uphill::cli::AddSimulateCommand(app);
+  uphill::cli::AddPaperFiguresCommand(app);
   uphill::cli::AddBenchCommand(app);
   try {
     app.parse(argc, argv);

@@ -108,6 +108,9 @@ SolverInfo RunCeres(const FitOptions& options, bool seeded, ceres::Problem* prob
   solver.parameter_tolerance = options.parameter_tolerance;
   solver.num_threads = 1;  // the fits are cheap per row; threads would compete with callers
   solver.logging_type = ceres::SILENT;
+  // See below (stationary start): enough invalid steps for the trust region to shrink to
+  // min_trust_region_radius, which Ceres reports as CONVERGENCE, without an error log line.
+  solver.max_num_consecutive_invalid_steps = 100;
   solver.minimizer_progress_to_stdout = false;
   if (!(options.outlier_threshold > 0.0))
     throw InputError("outlier threshold",
@@ -115,14 +118,28 @@ SolverInfo RunCeres(const FitOptions& options, bool seeded, ceres::Problem* prob
   if (std::string error; !solver.IsValid(&error)) throw InputError("fit options", error);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, problem, &summary);
-  if (!summary.IsSolutionUsable())
+  // Started at a point that is stationary to rounding (a converged closed-form seed), every
+  // trust-region step has a model cost change ≤ 0, which Ceres counts as an invalid step, and
+  // after max_num_consecutive_invalid_steps it reports FAILURE with the start unchanged. That is
+  // convergence (the Gauss-Newton model predicts no decrease anywhere), not a failure: accept it
+  // when no step was taken and the cost is the finite start cost; the refinement that follows
+  // every solve confirms it. (gradient_tolerance cannot catch it: it is absolute.)
+  const bool stationary_start = summary.termination_type == ceres::FAILURE &&
+                                summary.num_successful_steps == 0 &&
+                                summary.message.find("invalid steps") != std::string::npos &&
+                                std::isfinite(summary.initial_cost) &&
+                                summary.final_cost == summary.initial_cost;
+  if (!summary.IsSolutionUsable() && !stationary_start)
     throw std::runtime_error("Ceres found no usable solution: " + summary.message);
   SolverInfo info;
-  info.converged = summary.termination_type == ceres::CONVERGENCE;
+  info.converged = summary.termination_type == ceres::CONVERGENCE || stationary_start;
   info.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
   info.seeded_with_closed_form = seeded;
-  info.termination = std::string(ceres::TerminationTypeToString(summary.termination_type)) + ": " +
-                     summary.message;
+  info.termination =
+      stationary_start
+          ? "CONVERGENCE: the start is stationary to rounding (Ceres: " + summary.message + ")"
+          : std::string(ceres::TerminationTypeToString(summary.termination_type)) + ": " +
+                summary.message;
   info.seconds = summary.total_time_in_seconds;
   return info;
 }

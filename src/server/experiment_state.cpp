@@ -1,0 +1,439 @@
+#include "server/experiment_state.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "io/csv_table.hpp"
+#include "io/experiment.hpp"
+#include "io/units.hpp"
+#include "model/input_error.hpp"
+
+namespace uphill::server {
+namespace {
+
+using nlohmann::json;
+using nlohmann::ordered_json;
+
+const std::set<std::string> kTopKeys = {"format", "title", "operator", "date", "notes", "body",
+                                        "apparatus", "uncertainties"};
+const std::set<std::string> kBodyKeys = {"type", "R", "a", "b", "h"};
+const std::set<std::string> kApparatusKeys = {"L", "H", "D", "theta", "alpha", "rod_diameter",
+                                              "L_convention"};
+const std::set<std::string> kUncertaintyKeys = {"L", "H", "D", "Y", "R", "a", "b", "h",
+                                                "theta", "alpha", "rod_diameter"};
+
+// experiment.json's keys in the order of data/README.md, whatever order a request or the journal
+// (whose objects are sorted) has them in: the file on disk stays readable and stable.
+ordered_json Canonical(const json& j) {
+  if (!j.is_object()) return ordered_json(j);
+  static const std::vector<std::string> order = {
+      "format", "title", "operator", "date", "notes", "body", "apparatus", "uncertainties", "type", "L", "H", "D",
+      "Y", "R", "a", "b", "h", "theta", "alpha", "rod_diameter", "L_convention"};
+  ordered_json out = ordered_json::object();
+  for (const std::string& key : order)
+    if (j.contains(key)) out[key] = Canonical(j.at(key));
+  for (const auto& [key, value] : j.items())
+    if (!out.contains(key)) out[key] = Canonical(value);
+  return out;
+}
+
+bool IsAngle(const std::string& key) { return key == "theta" || key == "alpha"; }
+
+// Text fit for a CSV cell and an HTML page: bounded, no control characters (a newline in a label
+// would split a CSV row for a careless reader; the page shows text only via textContent anyway).
+std::string CheckText(const json& j, const std::string& field, std::size_t max_length) {
+  if (!j.is_string()) throw InputError(field, "must be a string");
+  const std::string s = j.get<std::string>();
+  if (s.size() > max_length)
+    throw InputError(field, "is longer than " + std::to_string(max_length) + " characters");
+  for (unsigned char c : s)
+    if (c < 0x20 || c == 0x7f) throw InputError(field, "must not contain control characters (e.g. a line break)");
+  return s;
+}
+
+std::string Trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
+}
+
+// A plain decimal number (what a technician types into a field whose unit the page shows).
+std::string CheckNumber(const json& j, const std::string& field) {
+  if (j.is_number()) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.15g", j.get<double>());
+    return CheckNumber(json(std::string(buf)), field);
+  }
+  const std::string s = Trim(CheckText(j, field, kMaxNumberLength));
+  if (s.empty()) return s;
+  const char* begin = s.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(begin, &end);
+  if (end != begin + s.size() || !std::isfinite(v) || errno == ERANGE || s.find_first_of("xXpP") != std::string::npos ||
+      s.find_first_of("nNiI") != std::string::npos)
+    throw InputError(field, "must be a plain number in the experiment's unit (got \"" + s + "\")");
+  return s;
+}
+
+void CheckQuantity(const json& j, const std::string& field, io::Dimension dimension) {
+  const std::string s = CheckText(j, field, 64);
+  io::ParseQuantity(s, dimension, field);  // throws InputError naming the field
+}
+
+// RFC 4180: quote a field that holds a separator, a quote or surrounding spaces.
+std::string CsvCell(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos && Trim(s) == s) return s;
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string FormatNumber(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.12g", v);
+  return buf;
+}
+
+}  // namespace
+
+const std::vector<std::string>& RowQuantities() {
+  static const std::vector<std::string> q = {"L", "H", "D", "Y", "u_L", "u_H", "u_D", "u_Y"};
+  return q;
+}
+
+const std::string& Row::Value(const std::string& quantity) const {
+  static const std::string empty;
+  const auto it = values.find(quantity);
+  return it == values.end() ? empty : it->second;
+}
+
+std::vector<std::string> ExperimentState::Columns() const {
+  std::vector<std::string> out;
+  const json apparatus = metadata.is_object() && metadata.contains("apparatus") ? json(metadata.at("apparatus"))
+                                                                               : json::object();
+  const bool angles = apparatus.contains("theta") || apparatus.contains("alpha");
+  for (const char* q : {"L", "H", "D"})
+    if (!angles && !apparatus.contains(q)) out.push_back(q);
+  out.push_back("Y");
+  for (const char* q : {"u_L", "u_H", "u_D", "u_Y"}) {
+    const std::string base = std::string(q).substr(2);
+    if (base != "Y" && std::find(out.begin(), out.end(), base) == out.end()) continue;
+    if (std::any_of(rows.begin(), rows.end(), [&](const Row& r) { return !r.Value(q).empty(); }))
+      out.push_back(q);
+  }
+  return out;
+}
+
+std::vector<std::string> ExperimentState::RequiredQuantities() const {
+  std::vector<std::string> out;
+  for (const std::string& c : Columns())
+    if (c.rfind("u_", 0) != 0) out.push_back(c);
+  return out;
+}
+
+int ExperimentState::IndexOf(std::int64_t id) const {
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    if (rows[i].id == id) return static_cast<int>(i);
+  return -1;
+}
+
+std::string ExperimentState::ExperimentJson() const { return metadata.dump(2) + "\n"; }
+
+std::string ExperimentState::MeasurementsCsv() const {
+  const std::vector<std::string> columns = Columns();
+  std::string out = "trial,series";
+  // Appended piece by piece (`"," + c` trips GCC 12's false -Wrestrict).
+  for (const std::string& c : columns) out.append(",").append(c).append("_").append(unit);
+  out += ",note\n";
+  for (const Row& r : rows) {
+    out.append(CsvCell(r.trial)).append(",").append(CsvCell(r.series));
+    for (const std::string& c : columns) out.append(",").append(CsvCell(r.Value(c)));
+    out.append(",").append(CsvCell(r.note)).append("\n");
+  }
+  return out;
+}
+
+ordered_json ToJson(const Row& row) {
+  ordered_json j;
+  j["id"] = row.id;
+  j["trial"] = row.trial;
+  j["series"] = row.series;
+  for (const std::string& q : RowQuantities())
+    if (!row.Value(q).empty()) j[q] = row.Value(q);
+  j["note"] = row.note;
+  return j;
+}
+
+ordered_json ToJson(const ExperimentState& state) {
+  ordered_json j;
+  j["exists"] = state.exists;
+  j["experiment"] = state.metadata.is_null() ? ordered_json::object() : state.metadata;
+  j["unit"] = state.unit;
+  j["next_id"] = state.next_id;
+  j["rows"] = ordered_json::array();
+  for (const Row& r : state.rows) j["rows"].push_back(ToJson(r));
+  return j;
+}
+
+namespace {
+// A row as stored in the journal: trusted (it was validated when it was first accepted, or read
+// from a file, where bad text is kept on purpose), so only its shape is checked.
+Row RowFromJournal(const json& j) {
+  if (!j.is_object()) throw InputError("journal row", "must be an object");
+  Row r;
+  r.id = j.at("id").get<std::int64_t>();
+  r.trial = j.value("trial", "");
+  r.series = j.value("series", "");
+  r.note = j.value("note", "");
+  for (const std::string& q : RowQuantities())
+    if (j.contains(q)) r.values[q] = j.at(q).get<std::string>();
+  return r;
+}
+}  // namespace
+
+ExperimentState StateFromJson(const json& j) {
+  try {
+    ExperimentState s;
+    s.exists = j.at("exists").get<bool>();
+    s.metadata = Canonical(j.at("experiment"));
+    if (s.metadata.empty()) s.metadata = ordered_json();
+    s.unit = j.at("unit").get<std::string>();
+    s.next_id = j.at("next_id").get<std::int64_t>();
+    for (const json& r : j.at("rows")) s.rows.push_back(RowFromJournal(r));
+    return s;
+  } catch (const json::exception& e) {
+    throw InputError("journal snapshot", e.what());
+  }
+}
+
+void ValidateUnit(const std::string& unit) {
+  if (unit != "mm" && unit != "cm" && unit != "m" && unit != "in")
+    throw InputError("unit", "must be mm, cm, m or in (got \"" + unit.substr(0, 16) + "\")");
+}
+
+Row ValidateRow(const json& j, const ExperimentState& state) {
+  if (!j.is_object()) throw InputError("row", "must be a JSON object");
+  Row r;
+  std::set<std::string> allowed = {"id", "trial", "series", "note"};
+  for (const std::string& q : RowQuantities()) allowed.insert(q);
+  for (const auto& [key, value] : j.items())
+    if (!allowed.count(key)) throw InputError("row." + key.substr(0, 32), "unknown field");
+  r.trial = Trim(CheckText(j.value("trial", json("")), "row.trial", kMaxLabelLength));
+  if (r.trial.empty()) throw InputError("row.trial", "is empty: every trial needs a label");
+  r.series = Trim(CheckText(j.value("series", json("")), "row.series", kMaxLabelLength));
+  r.note = CheckText(j.value("note", json("")), "row.note", kMaxNoteLength);
+  for (const std::string& q : RowQuantities()) {
+    if (!j.contains(q) || j.at(q).is_null()) continue;
+    const std::string v = CheckNumber(j.at(q), "row." + q);
+    if (!v.empty()) r.values[q] = v;
+  }
+  for (const std::string& q : state.RequiredQuantities())
+    if (r.Value(q).empty()) throw InputError("row." + q, "is missing (a number in " + state.unit + ")");
+  return r;
+}
+
+ordered_json ValidateMetadata(const json& j) {
+  if (!j.is_object()) throw InputError("experiment", "must be a JSON object");
+  for (const auto& [key, value] : j.items())
+    if (!kTopKeys.count(key)) throw InputError("experiment." + key.substr(0, 32), "unknown key");
+  ordered_json out;
+  out["format"] = io::kExperimentFormat;
+  if (j.contains("format") && j.at("format") != io::kExperimentFormat)
+    throw InputError("experiment.format", std::string("must be \"") + io::kExperimentFormat + "\"");
+  for (const char* key : {"title", "operator", "date"})
+    if (j.contains(key)) {
+      const std::string s = CheckText(j.at(key), std::string("experiment.") + key, kMaxNoteLength);
+      if (!s.empty()) out[key] = s;
+    }
+  if (j.contains("notes")) {
+    const json& notes = j.at("notes");
+    if (notes.is_string()) {
+      if (!notes.get<std::string>().empty()) out["notes"] = CheckText(notes, "experiment.notes", kMaxNoteLength);
+    } else if (notes.is_array()) {
+      if (notes.size() > 50) throw InputError("experiment.notes", "has more than 50 paragraphs");
+      ordered_json list = ordered_json::array();
+      for (const json& p : notes) {
+        const std::string s = CheckText(p, "experiment.notes", kMaxNoteLength);
+        if (!s.empty()) list.push_back(s);
+      }
+      if (!list.empty()) out["notes"] = list;
+    } else {
+      throw InputError("experiment.notes", "must be a string or a list of strings");
+    }
+  }
+  if (!j.contains("body") || !j.at("body").is_object()) throw InputError("experiment.body", "is missing");
+  const json& body = j.at("body");
+  ordered_json out_body;
+  for (const auto& [key, value] : body.items())
+    if (!kBodyKeys.count(key)) throw InputError("experiment.body." + key.substr(0, 32), "unknown key");
+  const std::string type = CheckText(body.value("type", json("")), "experiment.body.type", 32);
+  if (type != "sphere" && type != "spheroid" && type != "double-cone")
+    throw InputError("experiment.body.type", "must be sphere, spheroid or double-cone");
+  out_body["type"] = type;
+  const std::vector<std::string> dims = type == "sphere" ? std::vector<std::string>{"R"}
+                                        : type == "spheroid" ? std::vector<std::string>{"a", "b"}
+                                                             : std::vector<std::string>{"R", "h"};
+  for (const auto& [key, value] : body.items()) {
+    if (key == "type") continue;
+    if (std::find(dims.begin(), dims.end(), key) == dims.end())
+      throw InputError("experiment.body." + key, "does not belong to a " + type);
+  }
+  for (const std::string& d : dims) {
+    if (!body.contains(d)) throw InputError("experiment.body." + d, "is missing (a length with its unit, e.g. \"12.7 mm\")");
+    CheckQuantity(body.at(d), "experiment.body." + d, io::Dimension::kLength);
+    if (!(io::ParseQuantity(body.at(d).get<std::string>(), io::Dimension::kLength, d) > 0))
+      throw InputError("experiment.body." + d, "must be > 0");
+    out_body[d] = Trim(body.at(d).get<std::string>());
+  }
+  out["body"] = out_body;
+  for (const char* section : {"apparatus", "uncertainties"}) {
+    if (!j.contains(section)) continue;
+    const json& s = j.at(section);
+    if (!s.is_object()) throw InputError(std::string("experiment.") + section, "must be a JSON object");
+    const auto& keys = std::string(section) == "apparatus" ? kApparatusKeys : kUncertaintyKeys;
+    ordered_json o = ordered_json::object();
+    for (const auto& [key, value] : s.items()) {
+      const std::string field = std::string("experiment.") + section + "." + key.substr(0, 32);
+      if (!keys.count(key)) throw InputError(field, "unknown key");
+      if (value.is_string() && Trim(value.get<std::string>()).empty()) continue;  // left blank
+      if (key == "L_convention") {
+        const std::string c = CheckText(value, field, 32);
+        if (c != "horizontal" && c != "along-rail") throw InputError(field, "must be horizontal or along-rail");
+        o[key] = c;
+      } else {
+        CheckQuantity(value, field, IsAngle(key) ? io::Dimension::kAngle : io::Dimension::kLength);
+        const double v = io::ParseQuantity(value.get<std::string>(), IsAngle(key) ? io::Dimension::kAngle
+                                                                                  : io::Dimension::kLength, field);
+        if (v < 0) throw InputError(field, "must be >= 0");
+        o[key] = Trim(value.get<std::string>());
+      }
+    }
+    if (!o.empty()) out[section] = o;
+  }
+  return out;
+}
+
+json ApplyOperation(ExperimentState& state, const json& op) {
+  const std::string type = op.at("type").get<std::string>();
+  if (type == "snapshot") {
+    json inverse = {{"type", "snapshot"}, {"state", ToJson(state)}};
+    state = StateFromJson(op.at("state"));
+    return inverse;
+  }
+  if (type == "meta") {
+    const std::string unit = op.at("unit").get<std::string>();
+    ValidateUnit(unit);
+    if (unit != state.unit && !state.rows.empty())
+      throw InputError("unit", "cannot change once rows exist (their numbers were typed in " + state.unit + ")");
+    json inverse = state.exists ? json{{"type", "meta"}, {"experiment", state.metadata}, {"unit", state.unit}}
+                                : json{{"type", "snapshot"}, {"state", ToJson(state)}};
+    state.metadata = Canonical(op.at("experiment"));
+    state.unit = unit;
+    state.exists = true;
+    return inverse;
+  }
+  if (!state.exists) throw InputError("experiment", "does not exist yet: create it first");
+  if (type == "put") {
+    Row row = RowFromJournal(op.at("row"));
+    const int index = state.IndexOf(row.id);
+    if (index >= 0) {
+      json inverse = {{"type", "put"}, {"row", ToJson(state.rows[index])}, {"index", index}};
+      state.rows[index] = std::move(row);
+      return inverse;
+    }
+    if (state.rows.size() >= kMaxRows)
+      throw InputError("rows", "at most " + std::to_string(kMaxRows) + " rows per experiment");
+    if (row.id < 1) throw InputError("row.id", "must be >= 1");
+    const std::int64_t at = std::clamp<std::int64_t>(op.value("index", static_cast<std::int64_t>(state.rows.size())), 0,
+                                                     static_cast<std::int64_t>(state.rows.size()));
+    state.next_id = std::max(state.next_id, row.id + 1);
+    json inverse = {{"type", "delete"}, {"id", row.id}};
+    state.rows.insert(state.rows.begin() + at, std::move(row));
+    return inverse;
+  }
+  if (type == "delete") {
+    const std::int64_t id = op.at("id").get<std::int64_t>();
+    const int index = state.IndexOf(id);
+    if (index < 0) throw InputError("row " + std::to_string(id), "does not exist (deleted meanwhile?)");
+    json inverse = {{"type", "put"}, {"row", ToJson(state.rows[index])}, {"index", index}};
+    state.rows.erase(state.rows.begin() + index);
+    return inverse;
+  }
+  throw InputError("operation", "unknown type \"" + type.substr(0, 32) + "\"");
+}
+
+ExperimentState LoadStateFromFiles(const std::string& directory) {
+  namespace fs = std::filesystem;
+  const std::string json_path = (fs::path(directory) / "experiment.json").string();
+  const std::string csv_path = (fs::path(directory) / "measurements.csv").string();
+  ExperimentState state;
+  std::ifstream in(json_path, std::ios::binary);
+  if (!in) throw InputError(json_path, "cannot be read");
+  std::stringstream text;
+  text << in.rdbuf();
+  json meta;
+  try {
+    meta = json::parse(text.str());
+  } catch (const json::exception& e) {
+    throw InputError(json_path, std::string("is not valid JSON: ") + e.what());
+  }
+  try {
+    state.metadata = ValidateMetadata(meta);
+  } catch (const InputError& e) {
+    throw InputError(json_path + ": " + e.quantity(), e.rule());
+  }
+  // Keep what ValidateMetadata would drop only for being empty: the file is the authority here.
+  state.metadata = Canonical(meta);
+  state.exists = true;
+  if (!fs::exists(csv_path)) return state;
+  const io::CsvTable table = io::ReadCsvFile(csv_path);
+  const int y = [&] {
+    for (std::size_t i = 0; i < table.header.size(); ++i)
+      if (io::SplitUnitSuffix(table.header[i]).first == "Y") return static_cast<int>(i);
+    return -1;
+  }();
+  if (y >= 0) {
+    const std::string suffix = io::SplitUnitSuffix(table.header[y]).second;
+    if (suffix == "mm" || suffix == "cm" || suffix == "m" || suffix == "in") state.unit = suffix;
+  }
+  for (const io::CsvRow& csv_row : table.rows) {
+    Row r;
+    r.id = state.next_id++;
+    for (std::size_t i = 0; i < table.header.size() && i < csv_row.cells.size(); ++i) {
+      const auto [base, suffix] = io::SplitUnitSuffix(table.header[i]);
+      const std::string& cell = csv_row.cells[i];
+      if (base == "trial") r.trial = cell;
+      else if (base == "series") r.series = cell;
+      else if (base == "note") r.note = cell;
+      else if (std::find(RowQuantities().begin(), RowQuantities().end(), base) != RowQuantities().end()) {
+        const std::string text = Trim(cell);
+        if (text.empty()) continue;
+        if (suffix == state.unit) {
+          r.values[base] = text;
+          continue;
+        }
+        try {  // another unit (a suffix or a unit in the cell): re-express in the state's unit
+          const double si = io::ParseQuantity(text, io::Dimension::kLength, base, suffix);
+          r.values[base] = FormatNumber(io::ToUnit(si, io::Dimension::kLength, state.unit));
+        } catch (const InputError&) {
+          r.values[base] = text;  // kept as it is: the row's check will say what is wrong
+        }
+      }
+    }
+    state.rows.push_back(std::move(r));
+  }
+  return state;
+}
+
+}  // namespace uphill::server

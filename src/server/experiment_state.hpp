@@ -1,0 +1,89 @@
+// ExperimentState: an experiment folder (data/README.md, uphill-experiment/1) as the page edits
+// it, and the operations that change it — the unit of the journal (experiment_store.hpp).
+//
+// Numbers are kept as the technician typed them: plain decimal text in the experiment's one
+// measurement unit (`unit`, e.g. "mm"; it becomes the CSV headers' suffix, `L_mm`). Keeping the
+// text, not a double, means the file on disk shows exactly what was entered, and a reload gives
+// the same text back.
+//
+// Operations are JSON objects (so the journal stores them verbatim):
+//   {"type":"snapshot","state":{...}}                  the whole state (ToJson below)
+//   {"type":"meta","experiment":{...},"unit":"mm"}     replace experiment.json and the unit
+//   {"type":"put","row":{...},"index":i}               insert (new id) or replace (same id) a row
+//   {"type":"delete","id":n}                           remove a row
+// ApplyOperation returns the operation that undoes it, so undo is itself just an operation.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace uphill::server {
+
+// Request limits (also the server's): a page that asks for more is not a lab notebook.
+inline constexpr std::size_t kMaxRows = 5000;
+inline constexpr std::size_t kMaxLabelLength = 64;   // trial, series
+inline constexpr std::size_t kMaxNoteLength = 2000;  // note, notes paragraphs, title
+inline constexpr std::size_t kMaxNumberLength = 32;
+
+// The quantities a row may carry: the crossbar measurements, Y, and per-row uncertainties.
+const std::vector<std::string>& RowQuantities();  // L, H, D, Y, u_L, u_H, u_D, u_Y
+
+struct Row {
+  std::int64_t id = 0;  // assigned by the store, stable across edits; never reused
+  std::string trial, series, note;
+  std::map<std::string, std::string> values;  // quantity -> plain number text in `unit`
+
+  // The value as typed, or "" when absent.
+  const std::string& Value(const std::string& quantity) const;
+};
+
+struct ExperimentState {
+  bool exists = false;              // experiment.json has been written (or will be, on replay)
+  nlohmann::ordered_json metadata;  // experiment.json, validated (ValidateMetadata)
+  std::string unit = "mm";          // of every length in measurements.csv
+  std::vector<Row> rows;
+  std::int64_t next_id = 1;
+
+  // The measured quantities that are columns (vary per row): L, H, D unless experiment.json's
+  // apparatus gives them (or gives θ/α), then Y; then the u_ columns some row uses.
+  std::vector<std::string> Columns() const;
+  // The quantities a row must give: Columns() without the u_ ones.
+  std::vector<std::string> RequiredQuantities() const;
+  // Index into rows, or -1.
+  int IndexOf(std::int64_t id) const;
+
+  // The files' contents, exactly as written to disk.
+  std::string ExperimentJson() const;
+  std::string MeasurementsCsv() const;
+};
+
+nlohmann::ordered_json ToJson(const Row& row);
+nlohmann::ordered_json ToJson(const ExperimentState& state);
+ExperimentState StateFromJson(const nlohmann::json& json);  // of a snapshot; throws InputError
+
+// A row from a request: checks types, lengths, control characters, that every value is a plain
+// finite decimal number, and that the quantities the experiment needs are there. The id is not
+// read. Throws InputError("row.<field>", rule).
+Row ValidateRow(const nlohmann::json& json, const ExperimentState& state);
+
+// experiment.json from a request: known keys only (as io::LoadExperiment), strings with units
+// that parse, a body type, lengths and counts bounded. Sets "format". Throws InputError.
+nlohmann::ordered_json ValidateMetadata(const nlohmann::json& json);
+// "mm", "cm", "m" or "in". Throws InputError otherwise.
+void ValidateUnit(const std::string& unit);
+
+// Applies `op` (format above) to `state` and returns its inverse. Throws InputError (and leaves
+// `state` unchanged) when the operation does not fit the state: unknown row id, unit change
+// while rows exist, too many rows.
+nlohmann::json ApplyOperation(ExperimentState& state, const nlohmann::json& op);
+
+// Reads an experiment folder written by hand or by another program (any units in the CSV) into
+// a state; lengths are re-expressed in the Y column's unit (default mm). Rows that cannot be read
+// keep their raw text, so nothing is dropped. Throws InputError for a bad experiment.json or a
+// missing/unreadable measurements.csv header.
+ExperimentState LoadStateFromFiles(const std::string& directory);
+
+}  // namespace uphill::server

@@ -1,0 +1,517 @@
+// The HTTP API of `uphill serve` (src/server/): an in-process server on a free loopback port,
+// driven with httplib::Client; a crash test that SIGKILLs the real program mid-burst and
+// restarts it; and a concurrency test with two writers.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "io/experiment.hpp"
+#include "server/experiment_store.hpp"
+#include "server/http_server.hpp"
+#include "server/row_check.hpp"
+// Last: <httplib.h> includes <resolv.h>, whose `_res` macro breaks Eigen.
+#include <httplib.h>
+
+namespace uphill::server {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const char* kJson = "application/json";
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() /
+                       ("uphill-server-test-" + std::to_string(::getpid()) + "-" + name);
+  fs::remove_all(dir);
+  return dir;
+}
+
+json Experiment() {
+  return {{"title", "Series 2 <script>alert(1)</script>"},
+          {"operator", "A. Technician"},
+          {"body", {{"type", "spheroid"}, {"a", "15.875 mm"}, {"b", "25.4 mm"}}},
+          {"apparatus", {{"H", "300 mm"}, {"L_convention", "horizontal"}}},
+          {"uncertainties", {{"L", "1 mm"}, {"H", "0.5 mm"}, {"D", "0.2 mm"}, {"Y", "0.5 mm"}}}};
+}
+
+// A plausible row of series 2 (L = 1165 mm, D varied). X is 389.8 mm at D = 150 mm, 289.7 at
+// 200, 229.1 at 250 (the fall-off 5-8 mm further): Y a little beyond X.
+json Row(const std::string& trial, double D = 150, double Y = 392) {
+  char d[32], y[32];
+  std::snprintf(d, sizeof d, "%g", D);
+  std::snprintf(y, sizeof y, "%g", Y);
+  return {{"trial", trial}, {"series", "s2"}, {"L", "1165"}, {"D", d}, {"Y", y}, {"note", "ok"}};
+}
+
+class ServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override { Start(); }
+  void TearDown() override {
+    Stop();
+    fs::remove_all(dir_);
+  }
+  void Start() {
+    ServerOptions options;
+    options.directory = dir_.string();
+    options.port = 0;
+    options.report_mc_trials = 1000;
+    server_ = std::make_unique<Server>(options);
+    port_ = server_->Bind();
+    thread_ = std::thread([this] { server_->Run(); });
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", port_);
+    client_->set_connection_timeout(5);
+    client_->set_read_timeout(20);
+  }
+  void Stop() {
+    client_.reset();
+    if (server_) server_->Stop();
+    if (thread_.joinable()) thread_.join();
+    server_.reset();
+  }
+  json State() {
+    auto r = client_->Get("/api/state");
+    EXPECT_TRUE(r);
+    EXPECT_EQ(r->status, 200);
+    return json::parse(r->body);
+  }
+  // Sends a change; returns {status, body}.
+  std::pair<int, json> Send(const std::string& method, const std::string& path, const json& body) {
+    httplib::Result r = method == "POST"  ? client_->Post(path.c_str(), body.dump(), kJson)
+                        : method == "PUT" ? client_->Put(path.c_str(), body.dump(), kJson)
+                                          : client_->Delete(path.c_str(), body.dump(), kJson);
+    if (!r) return {0, json()};
+    json parsed;
+    try {
+      parsed = json::parse(r->body);
+    } catch (...) {
+    }
+    return {r->status, parsed};
+  }
+  json Create() {
+    auto [status, body] = Send("PUT", "/api/experiment", {{"version", State()["version"]}, {"experiment", Experiment()}, {"unit", "mm"}});
+    EXPECT_EQ(status, 200) << body.dump();
+    return body;
+  }
+  json Add(const json& row) {
+    auto [status, body] = Send("POST", "/api/rows", {{"version", State()["version"]}, {"row", row}});
+    EXPECT_EQ(status, 200) << body.dump();
+    return body;
+  }
+  static std::vector<std::string> Codes(const json& check) {
+    std::vector<std::string> codes;
+    for (const json& f : check["flags"]) codes.push_back(f["code"]);
+    return codes;
+  }
+  static bool Has(const std::vector<std::string>& codes, const std::string& code) {
+    return std::find(codes.begin(), codes.end(), code) != codes.end();
+  }
+
+  fs::path dir_ = TempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+  std::unique_ptr<Server> server_;
+  std::thread thread_;
+  std::unique_ptr<httplib::Client> client_;
+  int port_ = 0;
+};
+
+TEST_F(ServerTest, ServesTheEmbeddedPageWithAStrictPolicy) {
+  auto page = client_->Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_NE(page->body.find("<script src=\"/app.js\">"), std::string::npos);
+  const std::string csp = page->get_header_value("Content-Security-Policy");
+  EXPECT_NE(csp.find("default-src 'none'"), std::string::npos);
+  EXPECT_NE(csp.find("script-src 'self'"), std::string::npos);
+  EXPECT_EQ(csp.find("unsafe-inline"), std::string::npos);
+  auto js = client_->Get("/app.js");
+  ASSERT_TRUE(js);
+  EXPECT_EQ(js->status, 200);
+  EXPECT_EQ(js->body.find("innerHTML"), std::string::npos);  // user text only via textContent
+  EXPECT_EQ(js->body.find("http://cdn"), std::string::npos);
+}
+
+TEST_F(ServerTest, CreatesAnExperimentAndWritesFilesThatLoad) {
+  json s = State();
+  EXPECT_FALSE(s["exists"]);
+  EXPECT_EQ(s["version"], 0);
+  s = Create();
+  EXPECT_TRUE(s["exists"]);
+  EXPECT_EQ(s["version"], 1);
+  EXPECT_EQ(s["columns"], json({"L", "D", "Y"}));
+  EXPECT_TRUE(fs::exists(dir_ / "experiment.json"));
+  EXPECT_TRUE(fs::exists(dir_ / "journal.jsonl"));
+  Add(Row("t1", 150, 392));
+  s = Add(Row("t2, with \"quotes\"", 200, 292));
+  ASSERT_EQ(s["rows"].size(), 2u);
+  const io::Experiment e = io::LoadExperiment(dir_.string());
+  ASSERT_EQ(e.rows.size(), 2u);
+  EXPECT_TRUE(e.rows[0].error.empty()) << e.rows[0].error;
+  EXPECT_EQ(e.rows[1].trial, "t2, with \"quotes\"");
+  EXPECT_NEAR(e.rows[0].Y.value, 0.392, 1e-12);
+  EXPECT_NEAR(e.rows[0].Y.u, 0.0005, 1e-12);
+  EXPECT_EQ(e.title, "Series 2 <script>alert(1)</script>");  // stored as text; the page never parses it
+}
+
+TEST_F(ServerTest, ComputesTheModelAndTheFit) {
+  Create();
+  Add(Row("t1", 150, 392));
+  Add(Row("t2", 200, 292));
+  const json s = Add(Row("t3", 250, 232));
+  const json& c = s["rows"][0]["check"];
+  // tanθ = 300/1165, tan(α/2) = 150/2330.
+  EXPECT_NEAR(c["theta_deg"].get<double>(), std::atan(300.0 / 1165) * 180 / M_PI, 1e-9);
+  EXPECT_NEAR(c["alpha_deg"].get<double>(), 2 * std::atan(150.0 / 2330) * 180 / M_PI, 1e-9);
+  EXPECT_GT(c["x"].get<double>(), 300);
+  EXPECT_LT(c["x"].get<double>(), 392);
+  EXPECT_GT(c["u_x"].get<double>(), 0);
+  EXPECT_NEAR(c["residual"].get<double>(), 392 - c["x"].get<double>(), 1e-9);
+  EXPECT_TRUE(c["flags"].empty()) << c.dump();
+  EXPECT_EQ(s["fit"]["n"], 3);
+  EXPECT_TRUE(s["fit"].contains("slope")) << s["fit"].dump();
+}
+
+TEST_F(ServerTest, FlagsMistakes) {
+  Create();
+  Add(Row("t1", 150, 392));
+  Add(Row("t2", 200, 292));
+  const auto check = [&](const json& row) {
+    auto [status, body] = Send("POST", "/api/check", {{"row", row}});
+    EXPECT_EQ(status, 200) << body.dump();
+    EXPECT_TRUE(body["complete"]) << body.dump();
+    return Codes(body);
+  };
+  EXPECT_TRUE(check(Row("t3", 150, 393)).empty());
+  EXPECT_TRUE(Has(check(Row("t3", 150, 900)), "y_far"));
+  EXPECT_TRUE(Has(check(Row("t3", 150, 392)), "duplicate_row"));
+  EXPECT_TRUE(Has(check(Row("t1", 150, 393)), "duplicate_trial"));
+  EXPECT_TRUE(Has(check(Row("t3", 175.0 / 25.4, 392)), "unit_mixup"));  // D typed in inches
+  EXPECT_TRUE(Has(check(Row("t3", 150, 392 / 25.4)), "unit_mixup"));   // Y typed in inches
+  json far = Row("t3", 150, 392);
+  far["L"] = "9000";
+  EXPECT_TRUE(Has(check(far), "implausible"));
+  EXPECT_TRUE(Has(check(Row("t3", 45, 1300)), "x_beyond_crossbar"));  // the paper's D = 45 mm
+  // An incomplete draft is answered, not refused.
+  auto [status, body] = Send("POST", "/api/check", {{"row", {{"trial", "t4"}, {"L", "1165"}}}});
+  EXPECT_EQ(status, 200);
+  EXPECT_FALSE(body["complete"]);
+  EXPECT_EQ(body["field"], "row.D");
+}
+
+TEST_F(ServerTest, EditsDeletesAndUndoes) {
+  Create();
+  Add(Row("t1", 150, 392));
+  json s = Add(Row("t2", 200, 292));
+  const std::int64_t id1 = s["rows"][0]["id"];
+  auto [st1, edited] = Send("PUT", "/api/rows/" + std::to_string(id1), {{"version", s["version"]}, {"row", Row("t1", 150, 393)}});
+  ASSERT_EQ(st1, 200) << edited.dump();
+  EXPECT_EQ(edited["rows"][0]["Y"], "393");
+  auto [st2, deleted] = Send("DELETE", "/api/rows/" + std::to_string(id1), {{"version", edited["version"]}});
+  ASSERT_EQ(st2, 200);
+  EXPECT_EQ(deleted["rows"].size(), 1u);
+  EXPECT_TRUE(deleted["can_undo"]);
+  auto [st3, undone] = Send("POST", "/api/undo", {{"version", deleted["version"]}});
+  ASSERT_EQ(st3, 200);
+  ASSERT_EQ(undone["rows"].size(), 2u);
+  EXPECT_EQ(undone["rows"][0]["id"], id1);  // back in its place, with its id
+  EXPECT_EQ(undone["rows"][0]["Y"], "393");
+  auto [st4, undone2] = Send("POST", "/api/undo", {{"version", undone["version"]}});
+  ASSERT_EQ(st4, 200);
+  EXPECT_EQ(undone2["rows"][0]["Y"], "392");  // the edit undone too
+  // The history survives a restart.
+  Stop();
+  Start();
+  json after = State();
+  EXPECT_EQ(after["version"], undone2["version"]);
+  EXPECT_EQ(after["rows"], undone2["rows"]);
+  EXPECT_TRUE(after["can_undo"]);  // the add of t2 can still be undone
+  EXPECT_EQ(io::LoadExperiment(dir_.string()).rows.size(), 2u);
+}
+
+TEST_F(ServerTest, StaleVersionIsAConflictWithTheCurrentState) {
+  Create();
+  const json s = Add(Row("t1", 150, 392));
+  const std::int64_t stale = s["version"].get<std::int64_t>() - 1;
+  auto [status, body] = Send("POST", "/api/rows", {{"version", stale}, {"row", Row("t2", 200, 292)}});
+  EXPECT_EQ(status, 409);
+  EXPECT_NE(body["error"].get<std::string>().find("changed meanwhile"), std::string::npos);
+  EXPECT_EQ(body["state"]["version"], s["version"]);
+  EXPECT_EQ(body["state"]["rows"].size(), 1u);
+  auto [st2, b2] = Send("PUT", "/api/rows/" + std::to_string(s["rows"][0]["id"].get<int>()),
+                        {{"version", stale}, {"row", Row("t1", 150, 999)}});
+  EXPECT_EQ(st2, 409);
+  EXPECT_EQ(State()["rows"][0]["Y"], "392");
+}
+
+TEST_F(ServerTest, RefusesBadRequests) {
+  Create();
+  const json v = State()["version"];
+  // Too large.
+  json big = Row("t1");
+  big["note"] = std::string(100 * 1024, 'x');
+  EXPECT_EQ(Send("POST", "/api/rows", {{"version", v}, {"row", big}}).first, 413);
+  // Bad content: 422 naming the field; malformed JSON and a missing version: 400.
+  json bad = Row("t1");
+  bad["D"] = "12 mm";
+  auto [st, body] = Send("POST", "/api/rows", {{"version", v}, {"row", bad}});
+  EXPECT_EQ(st, 422);
+  EXPECT_EQ(body["field"], "row.D");
+  json control = Row("t1");
+  control["trial"] = "a\nb";
+  EXPECT_EQ(Send("POST", "/api/rows", {{"version", v}, {"row", control}}).first, 422);
+  EXPECT_EQ(Send("POST", "/api/rows", {{"row", Row("t1")}}).first, 400);
+  auto malformed = client_->Post("/api/rows", "{\"version\":", kJson);
+  ASSERT_TRUE(malformed);
+  EXPECT_EQ(malformed->status, 400);
+  auto deep = client_->Post("/api/rows", std::string(5000, '[') + std::string(5000, ']'), kJson);
+  ASSERT_TRUE(deep);
+  EXPECT_EQ(deep->status, 422);
+  // Not JSON: refused before any handler (a cross-site form cannot send application/json).
+  auto form = client_->Post("/api/rows", "version=1", "application/x-www-form-urlencoded");
+  ASSERT_TRUE(form);
+  EXPECT_EQ(form->status, 415);
+  // Another origin, another Host.
+  httplib::Headers origin = {{"Origin", "http://evil.example"}};
+  auto cross = client_->Post("/api/rows", origin, json({{"version", v}, {"row", Row("t1")}}).dump(), kJson);
+  ASSERT_TRUE(cross);
+  EXPECT_EQ(cross->status, 403);
+  httplib::Headers host = {{"Host", "evil.example"}};
+  auto rebinding = client_->Get("/api/state", host);
+  ASSERT_TRUE(rebinding);
+  EXPECT_EQ(rebinding->status, 403);
+  EXPECT_EQ(State()["rows"].size(), 0u);
+}
+
+TEST_F(ServerTest, ServesReportFilesByNameOnly) {
+  Create();
+  Add(Row("t1", 150, 392));
+  Add(Row("t2", 200, 292));
+  Add(Row("t3", 250, 232));
+  fs::create_directories(dir_ / "report");
+  std::ofstream(dir_ / "report" / "note.md") << "# hello\n";
+  auto ok = client_->Get("/report/note.md");
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200);
+  EXPECT_EQ(ok->body, "# hello\n");
+  EXPECT_NE(ok->get_header_value("Content-Security-Policy").find("sandbox"), std::string::npos);
+  for (const char* path : {"/report/../experiment.json", "/report/..%2fexperiment.json", "/report/%2e%2e/journal.jsonl",
+                           "/report/.hidden", "/report/a/../../experiment.json", "/report/..", "/../experiment.json"}) {
+    auto r = client_->Get(path);
+    ASSERT_TRUE(r) << path;
+    EXPECT_NE(r->status, 200) << path;
+    EXPECT_EQ(r->body.find("uphill-experiment"), std::string::npos) << path;
+  }
+  fs::create_symlink(dir_ / "experiment.json", dir_ / "report" / "link.json");
+  auto link = client_->Get("/report/link.json");
+  ASSERT_TRUE(link);
+  EXPECT_EQ(link->status, 404);
+}
+
+TEST_F(ServerTest, WritesTheFitReport) {
+  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) GTEST_SKIP() << "gnuplot not installed";
+  Create();
+  Add(Row("t1", 150, 392));
+  Add(Row("t2", 200, 292));
+  Add(Row("t3", 250, 232));
+  auto [status, body] = Send("POST", "/api/report", json::object());
+  ASSERT_EQ(status, 200) << body.dump();
+  EXPECT_EQ(body["url"], "/report/report.html");
+  auto html = client_->Get("/report/report.html");
+  ASSERT_TRUE(html);
+  EXPECT_EQ(html->status, 200);
+  EXPECT_TRUE(State()["report"]["exists"]);
+}
+
+TEST(ExperimentStoreTest, RecoversFromACrashBetweenJournalAndFiles) {
+  const fs::path dir = TempDir("store-recovery");
+  std::string csv_before;
+  {
+    ExperimentStore store(dir.string());
+    store.SetMetadata(0, Experiment(), "mm");
+    store.AddRow(1, Row("t1", 150, 392));
+    std::stringstream s;
+    s << std::ifstream(dir / "measurements.csv").rdbuf();
+    csv_before = s.str();
+    store.AddRow(2, Row("t2", 200, 292));
+  }
+  // As if the server died after the journal entry of t2 but before the files were replaced.
+  { std::ofstream(dir / "measurements.csv", std::ios::binary) << csv_before; }
+  // And while appending a third entry (never acknowledged): a torn line.
+  { std::ofstream(dir / "journal.jsonl", std::ios::app) << "{\"version\":4,\"op\":{\"ty"; }
+  {
+    ExperimentStore store(dir.string());
+    const StoreSnapshot s = store.Get();
+    EXPECT_EQ(s.version, 3);
+    ASSERT_EQ(s.state.rows.size(), 2u);
+    EXPECT_EQ(io::LoadExperiment(dir.string()).rows.size(), 2u);  // files rewritten
+    store.AddRow(3, Row("t3", 250, 232));                          // the journal continues cleanly
+  }
+  {
+    ExperimentStore store(dir.string());
+    EXPECT_EQ(store.Get().state.rows.size(), 3u);
+  }
+  // Files edited by hand while the server was off: they win.
+  {
+    std::ofstream(dir / "measurements.csv", std::ios::binary) << "trial,series,L_mm,D_mm,Y_mm,note\nh1,,1165,150,421,by hand\n";
+    ExperimentStore store(dir.string());
+    ASSERT_EQ(store.Get().state.rows.size(), 1u);
+    EXPECT_EQ(store.Get().state.rows[0].trial, "h1");
+    const std::int64_t v = store.Get().version;
+    store.AddRow(v, Row("t9", 200, 330));
+  }
+  {
+    ExperimentStore store(dir.string());
+    ASSERT_EQ(store.Get().state.rows.size(), 2u);
+    EXPECT_EQ(store.Get().state.rows[0].trial, "h1");
+  }
+  fs::remove_all(dir);
+}
+
+TEST(ExperimentStoreTest, OpensAHandMadeExperimentWithoutWriting) {
+  const fs::path dir = TempDir("sample");
+  fs::copy(fs::path(UPHILL_SOURCE_DIR) / "data" / "series2-fixed-L", dir, fs::copy_options::recursive);
+  {
+    ExperimentStore store(dir.string());
+    EXPECT_EQ(store.Get().state.rows.size(), io::LoadExperiment(dir.string()).rows.size());
+    EXPECT_FALSE(fs::exists(dir / "journal.jsonl"));
+    const json checks = CheckAll(store.Get().state);  // declared in row_check.hpp
+    EXPECT_EQ(checks["fit"]["n"], store.Get().state.rows.size());
+  }
+  fs::remove_all(dir);
+}
+
+TEST_F(ServerTest, TwoWritersLoseNothing) {
+  Create();
+  constexpr int kPerWriter = 15;
+  std::atomic<int> acknowledged{0};
+  const auto writer = [&](const std::string& prefix) {
+    httplib::Client c("127.0.0.1", port_);
+    c.set_read_timeout(10);
+    for (int i = 0; i < kPerWriter; ++i) {
+      const json row = Row(prefix + std::to_string(i), 110 + i * 9 + (prefix == "b" ? 4 : 0), 400);
+      // Retry on 409 against the version the conflict reports (bounded).
+      auto state = c.Get("/api/state");
+      ASSERT_TRUE(state);
+      std::int64_t version = json::parse(state->body)["version"];
+      for (int attempt = 0; attempt < 200; ++attempt) {
+        auto r = c.Post("/api/rows", json({{"version", version}, {"row", row}}).dump(), kJson);
+        ASSERT_TRUE(r);
+        if (r->status == 200) {
+          ++acknowledged;
+          break;
+        }
+        ASSERT_EQ(r->status, 409) << r->body;
+        version = json::parse(r->body)["state"]["version"];
+      }
+    }
+  };
+  std::thread a(writer, "a"), b(writer, "b");
+  a.join();
+  b.join();
+  EXPECT_EQ(acknowledged.load(), 2 * kPerWriter);
+  const json s = State();
+  std::set<std::string> trials;
+  for (const json& r : s["rows"]) trials.insert(r["trial"]);
+  EXPECT_EQ(trials.size(), 2u * kPerWriter);
+  EXPECT_EQ(io::LoadExperiment(dir_.string()).rows.size(), 2u * kPerWriter);
+}
+
+// The real program, killed with SIGKILL in the middle of a burst of writes, then restarted.
+class ServeProcess {
+ public:
+  ServeProcess(const fs::path& dir) {
+    int out[2];
+    if (::pipe(out) != 0) throw std::runtime_error("pipe");
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::dup2(out[1], 1);
+      ::close(out[0]);
+      ::close(out[1]);
+      ::execl(UPHILL_PROGRAM, UPHILL_PROGRAM, "serve", dir.c_str(), "--port", "0", static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    ::close(out[1]);
+    // "uphill serve: http://127.0.0.1:PORT/ ..." is the first line.
+    std::string line;
+    char c;
+    while (line.size() < 4096 && ::read(out[0], &c, 1) == 1 && c != '\n') line += c;
+    ::close(out[0]);
+    const auto colon = line.find("127.0.0.1:");
+    if (colon == std::string::npos) throw std::runtime_error("no address in: " + line);
+    port_ = std::stoi(line.substr(colon + 10));
+  }
+  ~ServeProcess() { Kill(SIGKILL); }
+  void Kill(int signal) {
+    if (pid_ <= 0) return;
+    ::kill(pid_, signal);
+    int status = 0;
+    ::waitpid(pid_, &status, 0);
+    pid_ = -1;
+  }
+  int port() const { return port_; }
+
+ private:
+  pid_t pid_ = -1;
+  int port_ = 0;
+};
+
+TEST(ServeProcessTest, KillNineLosesNoAcknowledgedRow) {
+  signal(SIGPIPE, SIG_IGN);  // writing to the killed server must fail, not kill the test
+  const fs::path dir = TempDir("kill9");
+  std::set<std::string> acknowledged;
+  {
+    ServeProcess serve(dir);
+    httplib::Client c("127.0.0.1", serve.port());
+    c.set_read_timeout(5);
+    auto r = c.Put("/api/experiment", json({{"version", 0}, {"experiment", Experiment()}, {"unit", "mm"}}).dump(), kJson);
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->status, 200);
+    std::int64_t version = json::parse(r->body)["version"];
+    std::atomic<bool> killed{false};
+    std::thread killer([&] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(150));
+      serve.Kill(SIGKILL);
+      killed = true;
+    });
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    for (int i = 0; i < 2000 && std::chrono::steady_clock::now() < deadline; ++i) {
+      const std::string trial = std::string("k").append(std::to_string(i));  // not "k" + …: GCC 12 -Wrestrict
+      auto w = c.Post("/api/rows", json({{"version", version}, {"row", Row(trial, 110 + (i % 100), 400 + i % 7)}}).dump(), kJson);
+      if (!w) {
+        if (killed) break;
+        continue;
+      }
+      ASSERT_EQ(w->status, 200) << w->body;
+      acknowledged.insert(trial);
+      version = json::parse(w->body)["version"];
+    }
+    killer.join();
+  }
+  ASSERT_GT(acknowledged.size(), 0u);
+  ServeProcess again(dir);
+  httplib::Client c("127.0.0.1", again.port());
+  auto r = c.Get("/api/state");
+  ASSERT_TRUE(r);
+  const json s = json::parse(r->body);
+  std::set<std::string> present;
+  for (const json& row : s["rows"]) present.insert(row["trial"]);
+  for (const std::string& t : acknowledged) EXPECT_TRUE(present.count(t)) << "lost acknowledged row " << t;
+  EXPECT_LE(present.size(), acknowledged.size() + 1);  // at most the one in flight
+  const io::Experiment e = io::LoadExperiment(dir.string());
+  EXPECT_EQ(e.rows.size(), present.size());
+  again.Kill(SIGTERM);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace uphill::server

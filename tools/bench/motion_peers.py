@@ -1,0 +1,143 @@
+#!/usr/bin/env python3
+"""Peers for `uphill bench motion` (tools/uphill/bench_motion.cpp): the same trajectory problem
+with SciPy and NumPy. Usage: motion_peers.py PROBLEM.txt, where PROBLEM.txt holds
+"a b tan_theta tan_half_alpha g x0" and then 200 lines "x t_reference" (the 50-digit reference
+of the C++ side). Prints one row per method and setting: "method|setting|microseconds|max_rel_err".
+
+Problem: release from rest at x0 (beyond X) of a spheroid on line rails; t(x) = integral of
+dx/xdot. As in src/motion: psi - psi0 = u0 cosh(w) removes the release singularity, and
+dt/dw = sqrt(K M / (g z_eq sinc(u0 ch^2) sinc(u0 sh^2))) is smooth (PHYSICS.md).
+  quad        scipy.integrate.quad on each interval [w_{i-1}, w_i] (cumulative), epsrel = tol
+  solve_ivp   dt/dw = f(w) integrated with t_eval = w_i (RK45, DOP853, LSODA), rtol = tol
+  numpy GL    12-node Gauss-Legendre per interval in s, x = x0 + s^2 (removes the release
+              singularity; the x form of the integrand), vectorised over all intervals
+"""
+import sys
+import time
+
+import numpy as np
+from scipy import integrate
+
+
+def load(path):
+    with open(path) as f:
+        a, b, B, T, g, x0 = (float(v) for v in f.readline().split())
+        rows = np.array([[float(v) for v in line.split()] for line in f if line.strip()])
+    return a, b, B, T, g, x0, rows[:, 0], rows[:, 1]
+
+
+class Ellipse:
+    def __init__(self, a, b, B, T):
+        A = a * T / b
+        P = 1 + A * A + B * B
+        sp = np.sqrt(P)
+        self.x_max = np.hypot(a, b / T)
+        self.z_eq = a * np.hypot(A, B) / A
+        h = np.hypot(A * sp, B)
+        self.c0, self.s0 = A * sp / h, B / h
+        hg = np.hypot(A * B, sp)
+        self.cg, self.sg = sp / hg, A * B / hg
+        self.q = A * A / P
+        self.inertia = 0.4
+
+    def u_of_x(self, x):
+        sp = x / self.x_max
+        cp = np.sqrt(np.maximum((self.x_max - x) / self.x_max, 0) * (1 + sp))
+        return np.arctan2(sp * self.c0 - cp * self.s0, cp * self.c0 + sp * self.s0)
+
+    def geometry(self, u):
+        su, cu = np.sin(u), np.cos(u)
+        sp = su * self.c0 + cu * self.s0
+        cp = cu * self.c0 - su * self.s0
+        cw = cp * self.cg - sp * self.sg
+        sw = sp * self.cg + cp * self.sg
+        dx, dz = self.x_max * cp, -self.z_eq * su
+        d = cw * cw + self.q * sw * sw
+        K = 1 + self.inertia / d
+        return dx, dz, K
+
+
+def main():
+    a, b, B, T, g, x0, xs, ref = load(sys.argv[1])
+    e = Ellipse(a, b, B, T)
+    u0 = float(e.u_of_x(x0))
+    gz = g * e.z_eq
+
+    def f(w):
+        ch, sh = np.cosh(0.5 * w), np.sinh(0.5 * w)
+        a1, a2 = u0 * ch * ch, u0 * sh * sh
+        dx, dz, K = e.geometry(a1 + a2)
+        return np.sqrt(K * (dx * dx + dz * dz) / (gz * np.sinc(a1 / np.pi) * np.sinc(a2 / np.pi)))
+
+    def f_scalar(w):
+        return float(f(np.float64(w)))
+
+    def w_of(x):
+        u = e.u_of_x(x)
+        return 2 * np.arcsinh(np.sqrt(np.maximum((u - u0) / (2 * u0), 0)))
+
+    ws = w_of(xs)
+
+    def timed(work):
+        best = 1e300
+        for _ in range(3):
+            n, start = 0, time.perf_counter()
+            while True:
+                out = work()
+                n += 1
+                el = time.perf_counter() - start
+                if el > 0.2:
+                    break
+            best = min(best, el / n)
+        return best * 1e6, out
+
+    def report(method, setting, work):
+        try:
+            micros, got = timed(work)
+        except Exception as exc:  # e.g. a tolerance the solver refuses
+            print(f"# {method} {setting}: failed ({exc})", file=sys.stderr)
+            return
+        err = float(np.max(np.abs(got / ref - 1)))
+        print(f"{method}|{setting}|{micros:.3f}|{err:.3e}", flush=True)
+
+    tols = [10.0 ** -k for k in (3, 5, 7, 9, 11, 13)]
+    for tol in tols:
+        def quad_work():
+            edges = np.concatenate(([0.0], ws))
+            pieces = [integrate.quad(f_scalar, edges[i], edges[i + 1], epsabs=0, epsrel=tol, limit=200)[0]
+                      for i in range(len(ws))]
+            return np.cumsum(pieces)
+        report("scipy quad (w substitution)", f"epsrel {tol:.0e}", quad_work)
+    for method in ("RK45", "DOP853", "LSODA"):
+        for tol in tols:
+            def ivp_work():
+                sol = integrate.solve_ivp(lambda w, t: [f_scalar(w)], (0.0, ws[-1]), [0.0], method=method,
+                                          t_eval=ws, rtol=tol, atol=1e-20)
+                if not sol.success or len(sol.y[0]) != len(ws):
+                    raise RuntimeError(sol.message)
+                return sol.y[0]
+            report(f"scipy solve_ivp {method} (dt/dw)", f"rtol {tol:.0e}", ivp_work)
+
+    # NumPy Gauss-Legendre, 12 nodes per interval in s (x = x0 + s^2), vectorised.
+    nodes, weights = np.polynomial.legendre.leggauss(12)
+    z0 = e.z_eq * np.cos(u0)
+    del z0
+
+    def gl_work():
+        s_edges = np.concatenate(([0.0], np.sqrt(xs - x0)))
+        lo, hi = s_edges[:-1, None], s_edges[1:, None]
+        s = 0.5 * (hi - lo) * nodes[None, :] + 0.5 * (hi + lo)
+        x = x0 + s * s
+        u = e.u_of_x(x)
+        dx, dz, K = e.geometry(u)
+        slope = dz / dx
+        drop = 2 * e.z_eq * np.sin(0.5 * (u + u0)) * np.sin(0.5 * (u - u0))
+        # dt/ds = 2 s / xdot, xdot = sqrt(2 g drop / (K (1 + z'^2)))
+        integrand = 2 * s * np.sqrt(K * (1 + slope * slope) / (2 * g * drop))
+        pieces = 0.5 * (hi[:, 0] - lo[:, 0]) * (integrand @ weights)
+        return np.cumsum(pieces)
+    report("numpy Gauss-Legendre 12/interval (x = x0 + s^2)", "12 nodes", gl_work)
+
+
+if __name__ == "__main__":
+    main()
