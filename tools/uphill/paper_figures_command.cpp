@@ -6,12 +6,17 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 
+#include "bench_support.hpp"
 #include "commands.hpp"
+#include "io/atomic_file.hpp"
+#include "io/experiment.hpp"
 #include "model/scene.hpp"
 #include "motion/motion.hpp"
+#include "report/analysis.hpp"
+#include "report/analysis_figures.hpp"
+#include "report/document.hpp"
 #include "report/gnuplot_figure.hpp"
 
 namespace uphill::cli {
@@ -158,24 +163,51 @@ std::vector<report::GnuplotFigure> SphereFigures() {
   return out;
 }
 
-void Run(const std::string& dir) {
+// The paper's two experiment plots, from the sample experiments (data/README.md): Y against X
+// with the fits, drawn by the report layer into DIR/<series>/.
+void ExperimentFigures(const std::string& data_dir, const std::string& dir, report::Document* gallery) {
+  const struct {
+    const char* folder;
+    const char* title;
+  } series[] = {{"series1-fixed-D", "Experiment 1 (sample data): D fixed, L varied"},
+                {"series2-fixed-L", "Experiment 2 (sample data): L fixed, D varied"}};
+  for (const auto& s : series) {
+    const io::Experiment experiment = io::LoadExperiment((fs::path(data_dir) / s.folder).string());
+    report::AnalysisOptions options;
+    options.mc_trials = 10000;
+    const report::ExperimentAnalysis analysis = report::AnalyseExperiment(experiment, options);
+    const fs::path sub = fs::path(dir) / s.folder;
+    fs::create_directories(sub);
+    for (const report::GnuplotFigure& f : report::AnalysisFigures(analysis)) {
+      if (f.name == "fit_residuals") continue;
+      report::RenderFigure(f, sub.string());
+      gallery->Figure(std::string(s.folder) + "/" + f.name, std::string(s.title) + ": " + f.title, f.caption);
+      std::cout << sub.string() << "/" << f.name << ".{svg,png}\n";
+    }
+  }
+}
+
+void Run(const std::string& dir, const std::string& data_dir) {
   fs::create_directories(dir);
   std::vector<report::GnuplotFigure> figures{PotentialFigure(), XFigure(true), XFigure(false)};
   for (auto& f : SphereFigures()) figures.push_back(std::move(f));
-  std::string html =
-      "<!doctype html><html><head><meta charset='utf-8'><title>uphill: the paper's figures</title>"
-      "<style>body{font-family:sans-serif;max-width:1000px;margin:auto}figure{margin:2em 0}"
-      "img{max-width:100%}</style></head><body><h1>The seed paper's model figures, redrawn by uphill</h1>"
-      "<p>Each figure: SVG, PNG, data (.dat) and gnuplot script (.gp). The experiment plots are drawn by "
-      "<code>uphill report</code>.</p>\n";
+  report::Document gallery;
+  gallery.title = "The seed paper's figures, redrawn by uphill";
+  gallery.Paragraph("Each figure is drawn by gnuplot from the script (.gp) and data (.dat) kept beside its SVG "
+                    "and PNG in this folder. Where PHYSICS.md shows the paper's formula to be wrong, the "
+                    "corrected physics is drawn and the paper's curve is added, labelled as such.");
   for (const auto& f : figures) {
     report::RenderFigure(f, dir);
-    html += "<figure><img src='" + f.name + ".svg' alt='" + f.title + "'><figcaption><b>" + f.title + ".</b> " +
-            f.caption + " (<a href='" + f.name + ".png'>PNG</a>, <a href='" + f.name + ".gp'>script</a>)</figcaption></figure>\n";
+    gallery.Figure(f.name, f.title, f.caption);
     std::cout << dir << "/" << f.name << ".{svg,png}\n";
   }
-  html += "</body></html>\n";
-  std::ofstream(fs::path(dir) / "index.html") << html;
+  if (data_dir.empty()) {
+    gallery.Paragraph("The experiment plots need the sample experiments (data/series1-fixed-D, "
+                      "data/series2-fixed-L): give --data.");
+  } else {
+    ExperimentFigures(data_dir, dir, &gallery);
+  }
+  io::WriteFileAtomically((fs::path(dir) / "index.html").string(), report::RenderHtml(gallery, dir));
   std::cout << dir << "/index.html\n";
 }
 
@@ -183,9 +215,15 @@ void Run(const std::string& dir) {
 
 void AddPaperFiguresCommand(CLI::App& app) {
   auto dir = std::make_shared<std::string>("paper-figures");
-  CLI::App* cmd = app.add_subcommand("paper-figures", "Redraw the seed paper's model figures (SVG, PNG, index.html)");
+  auto data = std::make_shared<std::string>();
+  CLI::App* cmd = app.add_subcommand("paper-figures", "Redraw the seed paper's figures (SVG, PNG, index.html)");
   cmd->add_option("-o,--out", *dir, "output folder")->capture_default_str();
-  cmd->callback([dir] { Run(*dir); });
+  cmd->add_option("--data", *data, "folder with the sample experiments (default: the repository's data/)");
+  cmd->callback([dir, data] {
+    const std::string data_dir =
+        data->empty() ? fs::path(bench::FindUpward("data/series1-fixed-D")).parent_path().string() : *data;
+    Run(*dir, data_dir);
+  });
 }
 
 }  // namespace uphill::cli
