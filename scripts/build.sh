@@ -10,5 +10,7 @@ case "$flavour" in
   sanitize) flags=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DUPHILL_SANITIZE=ON) ;;
   *) echo "build.sh: unknown flavour '$flavour' (release|sanitize)" >&2; exit 2 ;;
 esac
+# ccache keyed on paths relative to the checkout, so a fresh clone elsewhere reuses the cache.
+export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
 cmake -S . -B "build/$flavour" -G Ninja "${flags[@]}" > /dev/null
 cmake --build "build/$flavour" -j"${UPHILL_JOBS:-2}"

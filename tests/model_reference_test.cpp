@@ -10,30 +10,13 @@ namespace uphill {
 namespace {
 
 using nlohmann::json;
+using testing::CaseBody;
 using testing::CaseIdsWhere;
+using testing::CaseRails;
+using testing::CaseRodRadius;
 using testing::Cond;
 using testing::ReferenceCase;
 using testing::RefValue;
-
-Body BodyOf(const json& b) {
-  const std::string type = b.at("type");
-  if (type == "sphere") return Body::Sphere(b.at("R"));
-  if (type == "spheroid") return Body::Spheroid(b.at("a"), b.at("b"));
-  return Body::DoubleCone(b.at("R"), b.at("h"));
-}
-
-Rails RailsOf(const json& rails, LConvention convention = LConvention::kHorizontal) {
-  if (rails.contains("apparatus")) {
-    const json& app = rails.at("apparatus");
-    return Rails::FromApparatus(app.at("L"), app.at("H"), app.at("D"), convention);
-  }
-  return Rails::FromAngles(rails.at("theta"), rails.at("alpha"));
-}
-
-double RodRadius(const json& c) {
-  return c.contains("rod_radius") && !c.at("rod_radius").is_null() ? c.at("rod_radius").get<double>()
-                                                                    : 0.0;
-}
 
 json CondAt(const json& c, const std::string& key) {
   return c.contains("cond") && c.at("cond").contains(key) ? c.at("cond").at(key) : json();
@@ -62,7 +45,7 @@ class ConeCaseTest : public ::testing::TestWithParam<std::string> {};
 TEST_P(ReferenceCaseTest, AnglesAndHalfAngle) {
   const json& c = ReferenceCase(GetParam());
   const json& out = c.at("outputs");
-  const Rails rails = RailsOf(c.at("rails"));
+  const Rails rails = CaseRails(c.at("rails"));
   EXPECT_REF(rails.theta, out.at("theta"), 1.0);
   EXPECT_REF(rails.alpha, out.at("alpha"), 1.0);
   EXPECT_REF(rails.HalfAngleBetweenRails(), out.at("phi"), 1.0);
@@ -73,7 +56,7 @@ TEST_P(ReferenceCaseTest, AnglesAndHalfAngle) {
 TEST_P(EquilibriumCaseTest, EquilibriumFallOffAndRest) {
   const json& c = ReferenceCase(GetParam());
   const json& out = c.at("outputs");
-  const Scene scene(BodyOf(c.at("body")), RailsOf(c.at("rails")), RodRadius(c));
+  const Scene scene(CaseBody(c.at("body")), CaseRails(c.at("rails")), CaseRodRadius(c));
   EXPECT_REF(*scene.x_eq(), out.at("x_eq"), Cond(CondAt(c, "x_eq")));
   EXPECT_REF(*scene.z_eq(), out.at("z_eq"), 1.0);
   EXPECT_REF(scene.x_max(), out.at("x_max"), Cond(CondAt(c, "x_max")));
@@ -92,7 +75,7 @@ TEST_P(EquilibriumCaseTest, EquilibriumFallOffAndRest) {
 TEST_P(ReferenceCaseTest, PointsAlongThePath) {
   const json& c = ReferenceCase(GetParam());
   const json& out = c.at("outputs");
-  const Scene scene(BodyOf(c.at("body")), RailsOf(c.at("rails")), RodRadius(c));
+  const Scene scene(CaseBody(c.at("body")), CaseRails(c.at("rails")), CaseRodRadius(c));
   const json& points = out.at("points");
   const json conds = CondAt(c, "points");
   for (size_t i = 0; i < points.size(); ++i) {
@@ -114,7 +97,7 @@ TEST_P(ApparatusCaseTest, LengthMeasuredAlongARail) {
   const json& app = c.at("rails").at("apparatus");
   EXPECT_REF(HorizontalDistance<double>(app.at("L"), app.at("H"), app.at("D"), LConvention::kAlongRail),
              ref.at("L_horizontal"), 1.0);
-  const Scene scene(BodyOf(c.at("body")), RailsOf(c.at("rails"), LConvention::kAlongRail), RodRadius(c));
+  const Scene scene(CaseBody(c.at("body")), CaseRails(c.at("rails"), LConvention::kAlongRail), CaseRodRadius(c));
   EXPECT_REF(scene.rails().theta, ref.at("theta"), 1.0);
   EXPECT_REF(scene.rails().alpha, ref.at("alpha"), 1.0);
   EXPECT_REF(scene.rails().HalfAngleBetweenRails(), ref.at("phi"), 1.0);
@@ -127,7 +110,7 @@ TEST_P(ApparatusCaseTest, LengthMeasuredAlongARail) {
 TEST_P(ConeCaseTest, DoubleConeClosedForm) {
   const json& c = ReferenceCase(GetParam());
   const json& out = c.at("outputs");
-  const Scene scene(BodyOf(c.at("body")), RailsOf(c.at("rails")));
+  const Scene scene(CaseBody(c.at("body")), CaseRails(c.at("rails")));
   const auto* cone = scene.cone();
   ASSERT_NE(cone, nullptr);
   EXPECT_REF(cone->A(), out.at("A"), 1.0);
@@ -163,7 +146,7 @@ INSTANTIATE_TEST_SUITE_P(PhysicsReference, ConeCaseTest, ::testing::ValuesIn(Cas
 TEST(SweepTest, EquilibriumAgainstPhiAndTheta) {
   for (const char* id : {"paper_xeq_vs_phi_theta1deg", "paper_xeq_vs_theta_phi30deg"}) {
     const json& c = ReferenceCase(id);
-    const Body body = BodyOf(c.at("body"));
+    const Body body = CaseBody(c.at("body"));
     for (const json& row : c.at("outputs").at("sweep")) {
       SCOPED_TRACE(std::string(id) + " " + row.dump().substr(0, 60));
       const Scene scene(body, Rails::FromAngles(row.at("theta"), row.at("alpha")));

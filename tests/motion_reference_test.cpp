@@ -19,25 +19,6 @@ using testing::Cond;
 using testing::ReferenceCase;
 using testing::RefValue;
 
-Body BodyOf(const json& b) {
-  const std::string type = b.at("type");
-  if (type == "sphere") return Body::Sphere(b.at("R"));
-  if (type == "spheroid") return Body::Spheroid(b.at("a"), b.at("b"));
-  return Body::DoubleCone(b.at("R"), b.at("h"));
-}
-
-Rails RailsOf(const json& rails) {
-  if (rails.contains("apparatus")) {
-    const json& app = rails.at("apparatus");
-    return Rails::FromApparatus(app.at("L"), app.at("H"), app.at("D"), LConvention::kHorizontal);
-  }
-  return Rails::FromAngles(rails.at("theta"), rails.at("alpha"));
-}
-
-Scene SceneOf(const json& c) {
-  const double r = c.contains("rod_radius") && !c.at("rod_radius").is_null() ? c.at("rod_radius").get<double>() : 0.0;
-  return Scene(BodyOf(c.at("body")), RailsOf(c.at("rails")), r);
-}
 
 // Spheroid on rods: the numeric path limits the quadrature to ~1e-7 relative (motion.hpp).
 double g_floor = 1e-10;
@@ -66,7 +47,7 @@ TEST_P(ReleaseTest, TimesAndPositions) {
   const json& c = ReferenceCase(GetParam().id);
   const json& rel = c.at("outputs").at("release");
   const json& cond = c.at("cond");
-  const Scene scene = SceneOf(c);
+  const Scene scene = testing::CaseScene(c);
   MotionOptions o;
   o.g = rel.at("g");
   o.method = GetParam().method;

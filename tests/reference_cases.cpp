@@ -17,17 +17,32 @@ const nlohmann::json& ReferenceFile() {
   return file;
 }
 
-std::vector<std::string> ReferenceCaseIds() {
-  std::vector<std::string> ids;
-  for (const auto& c : ReferenceFile().at("cases")) ids.push_back(c.at("id").get<std::string>());
-  return ids;
-}
-
 const nlohmann::json& ReferenceCase(const std::string& id) {
   for (const auto& c : ReferenceFile().at("cases"))
     if (c.at("id") == id) return c;
   throw std::runtime_error("no reference case " + id);
 }
+
+Body CaseBody(const nlohmann::json& b) {
+  const std::string type = b.at("type");
+  if (type == "sphere") return Body::Sphere(b.at("R"));
+  if (type == "spheroid") return Body::Spheroid(b.at("a"), b.at("b"));
+  return Body::DoubleCone(b.at("R"), b.at("h"));
+}
+
+Rails CaseRails(const nlohmann::json& rails, LConvention convention) {
+  if (rails.contains("apparatus")) {
+    const nlohmann::json& app = rails.at("apparatus");
+    return Rails::FromApparatus(app.at("L"), app.at("H"), app.at("D"), convention);
+  }
+  return Rails::FromAngles(rails.at("theta"), rails.at("alpha"));
+}
+
+double CaseRodRadius(const nlohmann::json& c) {
+  return c.contains("rod_radius") && !c.at("rod_radius").is_null() ? c.at("rod_radius").get<double>() : 0.0;
+}
+
+Scene CaseScene(const nlohmann::json& c) { return Scene(CaseBody(c.at("body")), CaseRails(c.at("rails")), CaseRodRadius(c)); }
 
 double RefValue(const nlohmann::json& v) {
   if (v.is_number()) return v.get<double>();

@@ -9,10 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "model/scene.hpp"
+
 namespace uphill::testing {
 
 const nlohmann::json& ReferenceFile();
-std::vector<std::string> ReferenceCaseIds();
 // Ids of the cases for which keep(case) is true.
 template <typename Predicate>
 std::vector<std::string> CaseIdsWhere(Predicate keep) {
@@ -22,6 +23,13 @@ std::vector<std::string> CaseIdsWhere(Predicate keep) {
   return ids;
 }
 const nlohmann::json& ReferenceCase(const std::string& id);
+
+// The case's body, rails (apparatus cases in the given L convention) and rod radius (0 if none),
+// and the Scene they make.
+Body CaseBody(const nlohmann::json& body);
+Rails CaseRails(const nlohmann::json& rails, LConvention convention = LConvention::kHorizontal);
+double CaseRodRadius(const nlohmann::json& reference_case);
+Scene CaseScene(const nlohmann::json& reference_case);
 
 // Reference outputs are strings of 25 digits; parse to double (correctly rounded).
 double RefValue(const nlohmann::json& v);

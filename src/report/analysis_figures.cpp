@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <numeric>
 #include <sstream>
+#include <tuple>
 
 namespace uphill::report {
 namespace {
@@ -29,6 +30,43 @@ std::string LineParameters(const ExperimentAnalysis& a, const std::string& metho
          Num(f->report->intercept() * 1e3) + "\n";
 }
 
+// The friction model at each trial's setting, in increasing X: x_rest(mu) (offset: minus X), mm.
+std::string FrictionCurveData(const ExperimentAnalysis& a, bool offset) {
+  std::ostringstream data;
+  data << "\n\n# X_mm " << (offset ? "(x_rest(mu)-X)_mm" : "Y_friction_mm")
+       << " (friction model at each trial's setting, increasing X)\n";
+  const FitOutcome* friction = a.Fit("friction");
+  if (friction && friction->report)
+    for (size_t i : ByX(a))
+      data << Num(a.rows[i].x_eq * 1e3) << " "
+           << Num((friction->report->rows[i].fitted - (offset ? a.rows[i].x_eq : 0.0)) * 1e3) << "\n";
+  return data.str();
+}
+
+// The plot clauses of the fitted models: the OLS and York lines (offset: as (k - 1)X + c) and
+// the friction model read from block 1 of the figure's data file.
+std::string ModelCurves(const ExperimentAnalysis& a, const std::string& data_file, bool offset) {
+  std::ostringstream plot;
+  const char* line = offset ? "(k_%s - 1)*x + c_%s" : "k_%s*x + c_%s";
+  for (const auto& [method, label, style] :
+       {std::tuple{"ols", "OLS", "lw 2 lc rgb '#d62728'"}, std::tuple{"york", "York", "lw 2 dt 4 lc rgb '#2ca02c'"}}) {
+    if (!a.Fit(method)->report) continue;
+    char expression[64];
+    std::snprintf(expression, sizeof expression, line, method, method);
+    plot << ", \\\n  " << expression << " with lines " << style << " title ";
+    if (offset) {
+      plot << "'" << label << " line'";
+    } else {
+      plot << "sprintf('" << label << ": Y = %.4f X %+.2f mm', k_" << method << ", c_" << method << ")";
+    }
+  }
+  const FitOutcome* friction = a.Fit("friction");
+  if (friction && friction->report)
+    plot << ", \\\n  '" << data_file << "' index 1 using 1:2 with linespoints pt 6 ps 0.6 lw 2 lc rgb '#ff7f0e' "
+         << "title sprintf('friction model, mu = %.4f', " << Num(friction->report->Parameter("mu").value) << ")";
+  return plot.str();
+}
+
 GnuplotFigure YAgainstX(const ExperimentAnalysis& a) {
   GnuplotFigure f;
   f.name = "fit_y_vs_x";
@@ -40,11 +78,7 @@ GnuplotFigure YAgainstX(const ExperimentAnalysis& a) {
   data << "# X_mm Y_mm uX_mm uY_mm (one line per trial)\n";
   for (const auto& r : a.rows)
     data << Num(r.x_eq * 1e3) << " " << Num(r.y * 1e3) << " " << Num(r.u_x_eq * 1e3) << " " << Num(r.u_y * 1e3) << "\n";
-  const FitOutcome* friction = a.Fit("friction");
-  data << "\n\n# X_mm Y_friction_mm (friction model at each trial's setting, increasing X)\n";
-  if (friction && friction->report)
-    for (size_t i : ByX(a)) data << Num(a.rows[i].x_eq * 1e3) << " " << Num(friction->report->rows[i].fitted * 1e3) << "\n";
-  f.data = data.str();
+  f.data = data.str() + FrictionCurveData(a, false);
   std::ostringstream plot;
   plot << LineParameters(a, "ols") << LineParameters(a, "york");
   plot << "set xlabel 'X, theoretical equilibrium (mm)'\n"
@@ -52,16 +86,7 @@ GnuplotFigure YAgainstX(const ExperimentAnalysis& a) {
        << "set offsets graph 0.04, graph 0.04, graph 0.06, graph 0.04\n"
        << "plot '" << f.name << ".dat' index 0 using 1:2:3:4 with xyerrorbars pt 7 ps 0.7 lc rgb '#1f4e79' "
        << "title 'trials: Y ± u(Y), X ± u(X)', \\\n"
-       << "  x with lines dt 2 lw 1.5 lc rgb '#777777' title 'y = x'";
-  if (a.Fit("ols")->report)
-    plot << ", \\\n  k_ols*x + c_ols with lines lw 2 lc rgb '#d62728' "
-         << "title sprintf('OLS: Y = %.4f X %+.2f mm', k_ols, c_ols)";
-  if (a.Fit("york")->report)
-    plot << ", \\\n  k_york*x + c_york with lines lw 2 dt 4 lc rgb '#2ca02c' "
-         << "title sprintf('York: Y = %.4f X %+.2f mm', k_york, c_york)";
-  if (friction && friction->report)
-    plot << ", \\\n  '" << f.name << ".dat' index 1 using 1:2 with linespoints pt 6 ps 0.6 lw 2 lc rgb '#ff7f0e' "
-         << "title sprintf('friction model, mu = %.4f', " << Num(friction->report->Parameter("mu").value) << ")";
+       << "  x with lines dt 2 lw 1.5 lc rgb '#777777' title 'y = x'" << ModelCurves(a, f.name + ".dat", false);
   f.plot = plot.str();
   return f;
 }
@@ -80,12 +105,7 @@ GnuplotFigure OffsetAgainstX(const ExperimentAnalysis& a) {
   for (const auto& r : a.rows)
     data << Num(r.x_eq * 1e3) << " " << Num((r.y - r.x_eq) * 1e3) << " " << Num(std::hypot(r.u_x_eq, r.u_y) * 1e3)
          << "\n";
-  const FitOutcome* friction = a.Fit("friction");
-  data << "\n\n# X_mm (x_rest(mu)-X)_mm (friction model, increasing X)\n";
-  if (friction && friction->report)
-    for (size_t i : ByX(a))
-      data << Num(a.rows[i].x_eq * 1e3) << " " << Num((friction->report->rows[i].fitted - a.rows[i].x_eq) * 1e3) << "\n";
-  f.data = data.str();
+  f.data = data.str() + FrictionCurveData(a, true);
   std::ostringstream plot;
   plot << LineParameters(a, "ols") << LineParameters(a, "york");
   plot << "set xlabel 'X, theoretical equilibrium (mm)'\n"
@@ -93,14 +113,8 @@ GnuplotFigure OffsetAgainstX(const ExperimentAnalysis& a) {
        << "set offsets graph 0.04, graph 0.04, graph 0.1, graph 0.1\n"
        << "plot '" << f.name << ".dat' index 0 using 1:2:3 with yerrorbars pt 7 ps 0.7 lc rgb '#1f4e79' "
        << "title 'trials: Y - X'";
-  plot << ", \\\n  0 with lines dt 2 lw 1.5 lc rgb '#777777' title 'no friction'";
-  if (a.Fit("ols")->report)
-    plot << ", \\\n  (k_ols - 1)*x + c_ols with lines lw 2 lc rgb '#d62728' title 'OLS line'";
-  if (a.Fit("york")->report)
-    plot << ", \\\n  (k_york - 1)*x + c_york with lines lw 2 dt 4 lc rgb '#2ca02c' title 'York line'";
-  if (friction && friction->report)
-    plot << ", \\\n  '" << f.name << ".dat' index 1 using 1:2 with linespoints pt 6 ps 0.6 lw 2 lc rgb '#ff7f0e' "
-         << "title sprintf('friction model, mu = %.4f', " << Num(friction->report->Parameter("mu").value) << ")";
+  plot << ", \\\n  0 with lines dt 2 lw 1.5 lc rgb '#777777' title 'no friction'"
+       << ModelCurves(a, f.name + ".dat", true);
   f.plot = plot.str();
   return f;
 }
