@@ -191,6 +191,20 @@ TEST(FitCli, ReportFolderIsCompleteSelfContainedAndEscaped) {
   fs::remove_all(out);
 }
 
+TEST(FitCli, ReportIntoARelativeFolderThatDoesNotExistYet) {
+  // The Quick start's form: `uphill report data/series1-fixed-D -o out/series1-fixed-D`.
+  namespace fs = std::filesystem;
+  const fs::path work = fs::temp_directory_path() / "uphill_report_relative";
+  fs::remove_all(work);
+  fs::create_directories(work);
+  const std::string command = "cd " + work.string() + " && " + UPHILL_PROGRAM + " report " + kSource +
+                              "/data/series1-fixed-D -o out/nested/series1 --mc-trials 1000 > /dev/null";
+  EXPECT_EQ(std::system(command.c_str()), 0);
+  EXPECT_TRUE(fs::exists(work / "out/nested/series1/report.html"));
+  EXPECT_TRUE(fs::exists(work / "out/nested/series1/fit_y_vs_x.png"));
+  fs::remove_all(work);
+}
+
 TEST(FitCli, ReportOfABadExperimentNamesTheProblem) {
   const auto r = RunUphill("report /nonexistent/exp -o /tmp/uphill_never_written");
   EXPECT_EQ(r.status, 2);

@@ -23,7 +23,8 @@ std::string Quote(const std::string& s) {
 
 void RenderFigure(const GnuplotFigure& f, const std::string& directory) {
   namespace fs = std::filesystem;
-  const fs::path dir(directory);
+  // Absolute: the gnuplot command runs after a cd into it, and names its log by this path.
+  const fs::path dir = fs::absolute(directory);
   io::WriteFileAtomically((dir / (f.name + ".dat")).string(), f.data);
   std::ostringstream script;
   script << "# " << f.name << ".gp: " << f.title << "\n"
