@@ -318,7 +318,6 @@ TEST_F(ServerTest, ServesReportFilesByNameOnly) {
 }
 
 TEST_F(ServerTest, WritesTheFitReport) {
-  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) GTEST_SKIP() << "gnuplot not installed";
   Create();
   Add(Row("t1", 150, 392));
   Add(Row("t2", 200, 292));
