@@ -10,6 +10,8 @@ packages=(
   libeigen3-dev libceres-dev nlohmann-json3-dev libgtest-dev libcli11-dev libboost-dev
   libcsv-dev gnuplot-nox
   libcpp-httplib-dev chromium
+  libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
+  libopencv-calib3d-dev
 )
 # The browser test of `uphill serve` (tests/e2e) runs on node + npm and Debian's chromium. A
 # machine that already has Node (e.g. a newer one from elsewhere) keeps it: Debian's npm would
@@ -18,7 +20,7 @@ if ! command -v node > /dev/null 2>&1; then
   packages+=(nodejs npm)
 fi
 if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(python3-numpy python3-scipy)
+  packages+=(python3-numpy python3-scipy python3-opencv)
 fi
 
 missing=()

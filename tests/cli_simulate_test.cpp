@@ -3,6 +3,8 @@
 // one-line message naming the flag for bad input.
 #include <gtest/gtest.h>
 
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "cli_test_support.hpp"
@@ -88,6 +90,34 @@ TEST(SimulateCli, FrictionUsesTheOdeAndComesToRest) {
   const json j = json::parse(r.out);
   EXPECT_EQ(j.at("method"), "ode");
   EXPECT_EQ(j.at("events").back().at("kind"), "comes to rest");
+}
+
+// A spheroid on round rods: both methods from rest agree; an initial speed or rolling resistance
+// picks the ode method under --method auto.
+TEST(SimulateCli, SpheroidOnRodsByBothMethods) {
+  const std::string rods = "simulate --body spheroid --a 15.875mm --b 25.4mm --L 1165mm --H 300mm --D 200mm "
+                           "--rod-diameter 10mm ";
+  std::vector<double> x_by_method;
+  for (const char* method : {"quadrature", "ode"}) {
+    const auto r = RunUphill(rods + "--x0 346mm --at-times 0.3s --json --method " + method);
+    ASSERT_EQ(r.status, 0) << r.err;
+    x_by_method.push_back(json::parse(r.out).at("samples").at(0).at("x").get<double>());
+  }
+  EXPECT_NEAR(x_by_method[0], x_by_method[1], 1e-12);
+  const auto push = RunUphill(rods + "--x0 300mm --v0 0.05m/s --dt 0.1s --json");
+  ASSERT_EQ(push.status, 0) << push.err;
+  EXPECT_EQ(json::parse(push.out).at("method"), "ode");
+  // Pushed from just below the rest band of μ = 0.01 ([344.18, 345.64] mm) with the speed that
+  // stops it near the middle.
+  const auto rest = RunUphill(rods + "--x0 344mm --v0 5.5mm/s --mu 0.01 --dt 0.1s --json");
+  ASSERT_EQ(rest.status, 0) << rest.err;
+  const json rest_event = json::parse(rest.out).at("events").back();
+  EXPECT_EQ(rest_event.at("kind"), "comes to rest");
+  EXPECT_GE(rest_event.at("x").get<double>(), 0.34417);
+  EXPECT_LE(rest_event.at("x").get<double>(), 0.34565);
+  const auto refused = RunUphill(rods + "--x0 300mm --v0 0.05m/s --dt 0.1s --method quadrature");
+  EXPECT_EQ(refused.status, 2);
+  EXPECT_EQ(refused.err.rfind("uphill: --v0:", 0), 0u) << refused.err;
 }
 
 TEST(SimulateCli, BadInputExitsTwoNamingTheFlag) {

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <ceres/ceres.h>
+
 #include "fit/least_squares_line.hpp"
 #include "fit/model_comparison.hpp"
 #include "fit/robust_line.hpp"
@@ -668,6 +670,57 @@ TEST(IndependentCheck, OlsWlsYorkMatchLongDoubleClosedForms) {
         RelNear((*fit.covariance_scaled)(1, 1), static_cast<double>(ols.var_c * s2), 1e-12));
     ExpectMatchesClosed(FitWeightedLeastSquares(d), ClosedWeighted(d, true), 1e-13, 1e-12);
     ExpectMatchesClosed(FitErrorsInVariables(d), ClosedYork(d), 1e-12, 1e-11);
+  }
+}
+
+// York's fit hands Ceres its N residuals compressed to 3 (src/fit/internal/compressed_cost.hpp)
+// and takes the covariance from ceres::Covariance of that small problem. Here Ceres sees the full
+// problem instead - N residuals (Y − c − kX)/sqrt(u(Y)² + k²u(X)²) in data units, differentiated
+// by Ceres' own autodiff, not the library's analytic Jacobian - and ceres::Covariance (dense
+// SVD) of it at the fitted (k, c) must be the same matrix.
+struct FullYorkResiduals {
+  const LineData* d;
+  template <typename T>
+  bool operator()(const T* theta, T* residuals) const {
+    for (std::size_t i = 0; i < d->size(); ++i) {
+      const T variance = T(d->u_y[i] * d->u_y[i]) + theta[0] * theta[0] * (d->u_x[i] * d->u_x[i]);
+      residuals[i] = (d->y[i] - theta[1] - theta[0] * d->x[i]) / sqrt(variance);
+    }
+    return true;
+  }
+};
+
+TEST(IndependentCheck, CompressedYorkCovarianceIsCeresCovarianceOfAllRows) {
+  for (const LineData& d : {PearsonYork(), Synthetic(1000, 1.3, 0.7, 5, true),
+                            Synthetic(200, -0.4, 2.0, 6, true)}) {
+    SCOPED_TRACE("N = " + std::to_string(d.size()));
+    const FitReport fit = FitErrorsInVariables(d);
+    double theta[2] = {fit.slope(), fit.intercept()};
+    ceres::Problem problem;
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<FullYorkResiduals, ceres::DYNAMIC, 2>(
+            new FullYorkResiduals{&d}, static_cast<int>(d.size())),
+        nullptr, theta);
+    ceres::Covariance::Options options;
+    options.algorithm_type = ceres::DENSE_SVD;
+    ceres::Covariance covariance(options);
+    const std::vector<std::pair<const double*, const double*>> blocks = {{theta, theta}};
+    ASSERT_TRUE(covariance.Compute(blocks, &problem));
+    double c[4];
+    ASSERT_TRUE(covariance.GetCovarianceBlock(theta, theta, c));
+    EXPECT_TRUE(RelNear(fit.covariance(0, 0), c[0], 1e-12));
+    EXPECT_TRUE(RelNear(fit.covariance(0, 1), c[1], 1e-12));
+    EXPECT_TRUE(RelNear(fit.covariance(1, 0), c[2], 1e-12));
+    EXPECT_TRUE(RelNear(fit.covariance(1, 1), c[3], 1e-12));
+    // And the fitted line is the minimum of that problem: its gradient vanishes.
+    double cost = 0.0;
+    std::vector<double> gradient;
+    problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient, nullptr);
+    EXPECT_TRUE(RelNear(2.0 * cost, fit.chi2, 1e-12));
+    // The Newton step the gradient implies, (JᵀJ)⁻¹g, against the standard errors: zero to
+    // rounding (it would be ~1e-5 of σ if the fit had stopped where Ceres' cost test does).
+    EXPECT_LT(std::abs(c[0] * gradient[0] + c[1] * gradient[1]), 1e-10 * std::sqrt(c[0]));
+    EXPECT_LT(std::abs(c[2] * gradient[0] + c[3] * gradient[1]), 1e-10 * std::sqrt(c[3]));
   }
 }
 

@@ -11,8 +11,10 @@
 // changes the cost, with parameters good to ~1e-9 relative. Every fit therefore ends with a
 // Gauss-Newton refinement on Ceres' own cost functions (for a robust loss, Newton's step), which
 // stops where the step no longer shrinks: the gradient is accurate to ~ε, so the parameters are
-// too. SolverInfo::refinement_steps counts the steps; a linear fit seeded with its closed form
-// needs one or two, the second at the rounding level. From a cold start
+// too. (York's fit, whose residuals are curved in the slope, polishes with Newton's step on the
+// exact Hessian instead, which gets there in one step: york_line.hpp.) SolverInfo::
+// refinement_steps counts the steps; a linear fit seeded with its closed form needs one or two,
+// the second at the rounding level. From a cold start
 // (seed_with_closed_form = false) Ceres plus the refinement reach NIST's certified values to
 // ≥ 13 digits.
 #pragma once

@@ -33,6 +33,8 @@
 #include <string_view>
 #include <vector>
 
+#include "fit/large_array_allocator.hpp"
+
 namespace uphill {
 
 enum class FitMethod {
@@ -62,6 +64,11 @@ struct RowResult {
   double weight = 1.0;      // robust weight ρ'(s_i) (1 for non-robust fits)
   bool outlier = false;     // |normalised| > outlier_threshold
 };
+
+// One RowResult per input row. A std::vector; its allocator puts arrays of ≥ 4 MiB (~75 000
+// rows) in transparent huge pages, which makes large fits' per-row output cheap
+// (large_array_allocator.hpp).
+using RowResults = std::vector<RowResult, LargeArrayAllocator<RowResult>>;
 
 // A row the robust fit trusts less than a plain least-squares fit would.
 struct DownWeightedRow {
@@ -98,7 +105,7 @@ struct FitReport {
   bool exact = false;
 
   double outlier_threshold = 3.0;
-  std::vector<RowResult> rows;
+  RowResults rows;
   std::vector<std::size_t> outliers;          // rows with outlier = true, ascending
   std::vector<DownWeightedRow> downweighted;  // robust fit only, ascending row
   std::vector<std::string> notes;             // caveats in plain words (exact fit, bounds, ...)

@@ -35,25 +35,9 @@ FitReport FitLeastSquares(const LineData& data, const FitOptions& options, bool 
   ValidateLineData(data, weighted ? UncertaintyUse::kY : UncertaintyUse::kNone, method);
   const std::size_t n = data.size();
 
-  // Centre at the weighted mean of X: there the centred intercept and the slope are
-  // uncorrelated, so the design's two columns are orthogonal. Weights are (u_min/u_i)² so
-  // that tiny or huge u cannot overflow.
-  std::vector<double> centre_weights;
-  if (weighted) {
-    const double u_min = *std::min_element(data.u_y.begin(), data.u_y.end());
-    centre_weights.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const double ratio = u_min / data.u_y[i];
-      centre_weights[i] = ratio * ratio;
-    }
-  }
-  const Standardised s = Standardise(data, centre_weights, false, weighted);
-  std::vector<double> inv_sigma;
-  if (weighted) {
-    RequireRepresentable(s.uy, "u(Y)");
-    inv_sigma.resize(n);
-    for (std::size_t i = 0; i < n; ++i) inv_sigma[i] = 1.0 / s.uy[i];
-  }
+  const WeightedStandardised standardised = StandardiseWithUy(data, weighted);
+  const Standardised& s = standardised.s;
+  const std::vector<double>& inv_sigma = standardised.inv_sigma;
 
   Eigen::Vector2d theta =
       options.seed_with_closed_form ? ClosedFormLine(s, inv_sigma) : Eigen::Vector2d::Zero();
@@ -63,12 +47,10 @@ FitReport FitLeastSquares(const LineData& data, const FitOptions& options, bool 
       static_cast<int>(n));
   problem.AddResidualBlock(cost, nullptr, theta.data());
 
-  FitReport report;
-  report.method = weighted ? FitMethod::kWeightedLeastSquares : FitMethod::kOrdinaryLeastSquares;
-  report.n = n;
-  report.uses_stated_uncertainties = weighted;
-  report.primary_scaling = weighted ? ErrorScaling::kUnscaled : ErrorScaling::kScaled;
-  report.outlier_threshold = options.outlier_threshold;
+  FitReport report =
+      StartReport(weighted ? FitMethod::kWeightedLeastSquares : FitMethod::kOrdinaryLeastSquares, n,
+                  weighted, weighted ? ErrorScaling::kUnscaled : ErrorScaling::kScaled,
+                  options.outlier_threshold);
   report.solver = RunCeres(options, options.seed_with_closed_form, &problem);
   report.solver.refinement_steps = RefineGaussNewton({cost}, theta.data(), 2);
 

@@ -18,7 +18,24 @@ std::string At(const std::string& column, std::size_t i) {
 // (weights are 1/u², York's use u² + k²·u(X)²): beyond these bounds Ceres' residuals overflow.
 constexpr double kLargest = 1e100, kSmallestUncertainty = 1e-100;
 
+// Whether every |v_i| ≤ bound (false for NaN and ±inf): a branch-free pass the compiler
+// vectorises, so that valid data - the common case - costs one streaming read; the loops that
+// name the offending row run only when it fails.
+bool AllWithin(const std::vector<double>& v, double bound) {
+  bool ok = true;
+  for (double vi : v) ok &= std::abs(vi) <= bound;
+  return ok;
+}
+
+// Likewise: every u_i in [lo, hi], or 0 when zero_allowed.
+bool AllUncertaintiesWithin(const std::vector<double>& u, double lo, double hi, bool zero_allowed) {
+  bool ok = true;
+  for (double ui : u) ok &= (ui >= lo && ui <= hi) || (zero_allowed && ui == 0.0);
+  return ok;
+}
+
 void RequireFinite(const std::vector<double>& v, const std::string& column) {
+  if (AllWithin(v, kLargest)) return;
   for (std::size_t i = 0; i < v.size(); ++i) {
     if (!std::isfinite(v[i]))
       throw InputError(At(column, i), "must be finite (got " + Num(v[i]) + ")");
@@ -36,6 +53,7 @@ void RequireUncertainties(const std::vector<double>& u, std::size_t n, const std
   if (u.size() != n)
     throw InputError(column, "must have one value per row (" + std::to_string(n) + " rows, got " +
                                  std::to_string(u.size()) + ")");
+  if (AllUncertaintiesWithin(u, kSmallestUncertainty, kLargest, zero_allowed)) return;
   for (std::size_t i = 0; i < n; ++i) {
     const bool ok = std::isfinite(u[i]) && (zero_allowed ? u[i] >= 0.0 : u[i] > 0.0);
     if (!ok)

@@ -52,30 +52,13 @@ FitReport FitRobust(const LineData& data, const RobustOptions& options) {
                            : (options.loss == RobustLoss::kHuber ? kHuberDefault : kCauchyDefault);
   const FitOptions& fit = options.fit;
 
-  std::vector<double> centre_weights;
-  if (stated) {
-    const double u_min = *std::min_element(data.u_y.begin(), data.u_y.end());
-    centre_weights.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const double ratio = u_min / data.u_y[i];
-      centre_weights[i] = ratio * ratio;
-    }
-  }
-  const Standardised s = Standardise(data, centre_weights, false, stated);
-  std::vector<double> inv_sigma;
-  if (stated) {
-    RequireRepresentable(s.uy, "u(Y)");
-    inv_sigma.resize(n);
-    for (std::size_t i = 0; i < n; ++i) inv_sigma[i] = 1.0 / s.uy[i];
-  }
+  WeightedStandardised standardised = StandardiseWithUy(data, stated);
+  const Standardised& s = standardised.s;
+  std::vector<double>& inv_sigma = standardised.inv_sigma;
   // The least-squares line: the seed, and (without u(Y)) the residuals for the first scale.
   const Eigen::Vector2d least_squares = ClosedFormLine(s, inv_sigma);
-  FitReport report;
-  report.method = FitMethod::kRobust;
-  report.n = n;
-  report.uses_stated_uncertainties = stated;
-  report.primary_scaling = ErrorScaling::kUnscaled;
-  report.outlier_threshold = fit.outlier_threshold;
+  FitReport report = StartReport(FitMethod::kRobust, n, stated, ErrorScaling::kUnscaled,
+                                 fit.outlier_threshold);
   if (!stated) inv_sigma.assign(n, 1.0);
 
   // Without u(Y) the common σ enters through the loss alone: ρ_{δσ}(r²) = σ²·ρ_δ((r/σ)²) for

@@ -1,11 +1,11 @@
 #include "io/experiment.hpp"
 
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
 
 #include "io/csv_table.hpp"
+#include "io/json_file.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 
@@ -35,15 +35,6 @@ std::string Text(const json& j, const std::string& context) {
   throw InputError(context, "must be a string with a unit, e.g. \"300 mm\" (got " + Shown(j) + ")");
 }
 
-json ReadJson(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot be opened for reading");
-  try {
-    return json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw InputError(path, std::string("is not valid JSON: ") + e.what());
-  }
-}
 
 void CheckKeys(const json& object, const std::set<std::string>& allowed, const std::string& context) {
   if (!object.is_object()) throw InputError(context, "must be a JSON object");
@@ -86,7 +77,7 @@ Experiment LoadExperiment(const std::string& directory) {
   const std::string csv_path = (fs::path(directory) / "measurements.csv").string();
   Experiment e;
   e.directory = directory;
-  e.metadata = ReadJson(json_path);
+  e.metadata = ReadJsonFile(json_path);
   const json& meta = e.metadata;
   CheckKeys(meta, kTopKeys, json_path);
   if (!meta.contains("format") || meta.at("format") != kExperimentFormat)

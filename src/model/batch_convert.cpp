@@ -1,28 +1,15 @@
 #include "model/batch_convert.hpp"
 
-#include <immintrin.h>
-
 #include <algorithm>
 #include <boost/random/normal_distribution.hpp>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
 
+#include "model/libmvec_avx2.hpp"
 #include "model/spheroid_on_rods_closed_forms.hpp"
 
-// glibc's libmvec vector variants (x86_64 "d" = AVX2 ABI, 4 doubles). Declared by hand rather than
-// reached through <math.h>'s `#pragma omp declare simd` so that the choice does not depend on
-// -ffast-math or -fopenmp-simd, which the project does not use.
-#if defined(UPHILL_HAVE_LIBMVEC) && defined(__x86_64__)
-#define UPHILL_BATCH_AVX2 1
-#pragma GCC push_options
-#pragma GCC target("avx2,fma")
-extern "C" __m256d _ZGVdN4v_atan(__m256d);
-extern "C" __m256d _ZGVdN4v_tan(__m256d);
-#pragma GCC pop_options
-#else
-#define UPHILL_BATCH_AVX2 0
-#endif
+#define UPHILL_BATCH_AVX2 UPHILL_LIBMVEC_AVX2
 
 namespace uphill {
 namespace {

@@ -162,4 +162,60 @@ SpheroidPathPoint<double> SpheroidOnRods::At(double x) const {
   return p;
 }
 
+// ---- The path in the normal angle (appended for src/motion's equation of motion) -----------
+
+SpheroidOnRods::NormalAnglePoint SpheroidOnRods::PathAtNormalAngle(double beta) const {
+  // n(β) = cosβ·u + sinβ·v (unit, n·d = 0), n' = −sinβ·u + cosβ·v, n'' = −n.
+  const double s1 = std::sqrt(1.0 + T_ * T_), dn = std::sqrt(1.0 + T_ * T_ + B_ * B_);
+  const double u[3] = {-T_ / s1, 1.0 / s1, 0.0};
+  const double v[3] = {B_ / (dn * s1), T_ * B_ / (dn * s1), -(1.0 + T_ * T_) / (dn * s1)};
+  const double c = std::cos(beta), s = std::sin(beta);
+  double n[3], n1[3];
+  for (int k = 0; k < 3; ++k) {
+    n[k] = c * u[k] + s * v[k];
+    n1[k] = -s * u[k] + c * v[k];
+  }
+  const double D[3] = {a_ * a_, b_ * b_, a_ * a_};
+  // N = |D^½ n|, N' = (n·D n')/N, N'' = (n'·D n' + n·D n'')/N − N'²/N with n·D n'' = −N².
+  double nn = 0, nn1 = 0, n1n1 = 0;
+  for (int k = 0; k < 3; ++k) {
+    nn += D[k] * n[k] * n[k];
+    nn1 += D[k] * n[k] * n1[k];
+    n1n1 += D[k] * n1[k] * n1[k];
+  }
+  const double N = std::sqrt(nn), N1 = nn1 / N, N2 = (n1n1 - nn) / N - N1 * N1 / N;
+  // S = D n/N (contact point from the centre); S', S''.
+  double S[3], S1[3], S2[3];
+  for (int k = 0; k < 3; ++k) {
+    S[k] = D[k] * n[k] / N;
+    S1[k] = D[k] * n1[k] / N - D[k] * n[k] * N1 / (N * N);
+    S2[k] = -D[k] * n[k] / N - 2.0 * D[k] * n1[k] * N1 / (N * N) - D[k] * n[k] * N2 / (N * N) +
+            2.0 * D[k] * n[k] * N1 * N1 / (N * N * N);
+  }
+  // t = (S_y + r n_y)/T, x = t − S_x − r n_x, z = t·B − S_z − r n_z (and the same for the
+  // derivatives, with n'' = −n).
+  auto centre = [&](const double* Sk, const double* nk, double* x, double* z) {
+    const double t = (Sk[1] + r_ * nk[1]) / T_;
+    *x = t - Sk[0] - r_ * nk[0];
+    *z = t * B_ - Sk[2] - r_ * nk[2];
+  };
+  const double n2[3] = {-n[0], -n[1], -n[2]};
+  NormalAnglePoint p;
+  centre(S, n, &p.x, &p.z);
+  centre(S1, n1, &p.dx, &p.dz);
+  centre(S2, n2, &p.ddx, &p.ddz);
+  p.r_star = std::hypot(S[0], S[2]);
+  p.dr_star = (S[0] * S1[0] + S[2] * S1[2]) / p.r_star;
+  return p;
+}
+
+double SpheroidOnRods::NormalAngleAtEquilibrium() const {
+  // n ∝ (0, B/T, −1): β = atan2(n·v, n·u) with u, v of PathAtNormalAngle.
+  const double s1 = std::sqrt(1.0 + T_ * T_), dn = std::sqrt(1.0 + T_ * T_ + B_ * B_);
+  const double ny = B_ / T_, nz = -1.0;
+  const double nu = ny / s1;
+  const double nv = (T_ * B_ * ny / dn - (1.0 + T_ * T_) * nz / dn) / s1;
+  return std::atan2(nv, nu);
+}
+
 }  // namespace uphill

@@ -45,6 +45,26 @@ class SpheroidOnRods {
   // The centre (x, z) for a contact normal at angle beta (see above); exposed for tests.
   void CentreAtNormalAngle(double beta, double* x, double* z) const;
 
+  // --- The path in the normal angle β (for the equation of motion, src/motion) --------------
+  // β is a smooth coordinate along the whole path, through the fall-off β = 0 (where dx/dβ = 0
+  // and z(x) turns vertical): x, z and R* (centre to the true contact, in the x–z plane) with
+  // their derivatives in β, in closed form (n'' = −n for the unit normal n(β) = cosβ·u + sinβ·v,
+  // then the quotient rule through S = D·n/|D^½·n|, D = diag(a², b², a²)); no root solve, so
+  // they carry only a few ulp of rounding, no solver noise. Domain: 0 ≤ β ≤ normal_angle_low().
+  struct NormalAnglePoint {
+    double x, z;        // centre
+    double dx, dz;      // d/dβ
+    double ddx, ddz;    // d²/dβ²
+    double r_star, dr_star;
+  };
+  NormalAnglePoint PathAtNormalAngle(double beta) const;
+  // β of the centre at x (x_low ≤ x ≤ x_max), as At() solves it (0 at x_max).
+  double NormalAngleOf(double x) const { return x >= x_max_ ? 0.0 : BetaOf(x); }
+  // β at X, in closed form (the normal ∝ (0, B/T, −1) there).
+  double NormalAngleAtEquilibrium() const;
+  // β at x_low (the end of the branch used).
+  double normal_angle_low() const { return beta_low_; }
+
  private:
   // Centre for a given (not necessarily unit) normal with n·d = 0.
   void CentreForNormal(double nx, double ny, double nz, double* x, double* z) const;

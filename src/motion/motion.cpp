@@ -60,11 +60,8 @@ Motion::Motion(const Scene& scene, double x0, const MotionOptions& o) {
     throw InputError("mu", "must be a finite number >= 0 (got " + Num(o.mu) + ")");
   if (!(o.tolerance >= 1e-15 && o.tolerance <= 1e-2))
     throw InputError("tolerance", "must lie in [1e-15, 1e-2] (got " + Num(o.tolerance) + ")");
-  const bool rods_spheroid = !cone && !motion_detail::IsEllipse(scene);
   if (o.method == MotionMethod::kQuadrature && o.mu > 0.0)
     throw InputError("mu", "rolling resistance needs the ode method (energy is not conserved)");
-  if (rods_spheroid && o.mu > 0.0)
-    throw InputError("mu", "must be 0 for a spheroid on rods (only the quadrature method is available there)");
   engine_ = o.method == MotionMethod::kQuadrature ? motion_detail::MakeQuadratureEngine(scene, x0, o)
                                                   : motion_detail::MakeOdeEngine(scene, x0, o);
 }

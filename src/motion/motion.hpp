@@ -16,23 +16,33 @@
 //               ellipse parameter), which makes dt/dw = sqrt(K·M/(g·z_eq·sinc(u_t·cosh²(w/2))·
 //               sinc(u_t·sinh²(w/2)))) smooth and bounded from the release through the fall-off
 //               (M = |dC/dψ|²), and turns the ln(1/(x0 − X)) escape time into the length of the
-//               w interval; double cone with x = x_t + s²; spheroid on rods (numeric path) in x
-//               with x = x0 + (x_end − x0)·sin²φ (removes the release and fall-off 1/sqrt
-//               singularities). Integrals by adaptive Gauss–Kronrod (Boost.Math), x(t) by
-//               bracketed Newton on t(w). μ must be 0.
+//               w interval; double cone with x = x_t + s²; spheroid on rods in its contact-normal
+//               coordinate q = β_X − β (below) with q = q0·cosh w as for the ellipse, the height
+//               drop z(q0) − z(q) from the explicit path (near the release as −∫dz/dq by
+//               Gauss–Legendre, not as a difference of heights). Integrals by adaptive
+//               Gauss–Kronrod (Boost.Math), x(t) by bracketed Newton on t(w). μ must be 0, and
+//               v0 must be 0 for a spheroid on rods (use kOde).
 //  kOde         the Euler–Lagrange equation m(q)·q̈ + ½·m'(q)·q̇² = −g·z'(q) − g·μ·|x'(q)|·sgn q̇
-//               in a smooth coordinate q (q = ψ − ψ0 for sphere/spheroid, q = x for the cone),
-//               integrated by Boost.Odeint's Dormand–Prince 5(4) with dense output; events
-//               (fall-off, reaching O, turning point, rest, a position) located by TOMS 748 on
-//               the dense output. Not available for a spheroid on rods (InputError).
+//               in a smooth coordinate q (q = ψ − ψ0 for sphere/spheroid, q = x for the cone,
+//               q = β_X − β for a spheroid on rods), integrated by Boost.Odeint's
+//               Dormand–Prince 5(4) with dense output; events (fall-off, reaching O, turning
+//               point, rest, a position) located by TOMS 748 on the dense output. Every scene,
+//               any v0, μ ≥ 0.
+//
+// Spheroid on round rods: no closed form z(x), but the path is explicit in the contact normal's
+// angle β (SpheroidOnRods::PathAtNormalAngle: x, z, R* and their β-derivatives in closed form,
+// smooth through the fall-off β = 0 where z(x) turns vertical). Only converting a position x to
+// β needs a root solve (TimeAt(x), AtPosition(x), x0); the equation of motion and the quadrature
+// run in β, so no solver noise enters dz/dq or m'(q).
 //
 // Accuracy (tests/motion_reference_test.cpp against 25-digit references; both methods at the
 // default tolerance 1e-13): t(x), x(t) within max(1e-10, 16·cond·1.1e-16) relative, cond the
 // value's condition number; in practice a few 1e-13 except where cond is large (release close
-// to X: cond(t) ≈ x0/((x0 − X)·λ·t)). Exception: a spheroid on rods (numeric path, whose z has
-// a few ulp of solver noise that the height drop amplifies near the release): ~1e-7 relative,
-// tested to 1e-7. Energy is conserved along a μ = 0 trajectory to 1e-12
-// relative; time reversal returns to the start.
+// to X: cond(t) ≈ x0/((x0 − X)·λ·t)). The same holds for a spheroid on rods (both methods; the
+// two agree to ~1e-12, and at a = b with the sphere-on-rods closed form to 1e-11), except for a
+// release very close to X, where dz/dq ∝ q is formed from O(1) terms: the quadrature is then
+// limited to ~4e-17/|q0| relative (3e-12 measured at x0 − X = 1e-6·(x_max − X)). Energy is
+// conserved along a μ = 0 trajectory to 1e-12 relative; time reversal returns to the start.
 //
 // Hard cases (tests/motion_property_test.cpp): x0 within 1e-9 of X (escape time
 // ≈ ln(1/(x0 − X))/λ), motion up to x_max where the path turns vertical (t(x_max) is finite
@@ -42,6 +52,7 @@
 
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -87,7 +98,7 @@ class Motion {
  public:
   // Throws InputError (naming x0, v0, g, mu, tolerance or method) for input outside the domain:
   // x0 outside [x_low, x_max] (x_fall excluded for the cone), g ≤ 0, μ < 0, μ > 0 with
-  // kQuadrature, a spheroid on rods with kOde, v0 ≠ 0 or μ > 0 for a spheroid on rods.
+  // kQuadrature, v0 ≠ 0 with kQuadrature for a spheroid on rods.
   Motion(const Scene& scene, double x0, const MotionOptions& options = {});
   ~Motion();
   Motion(Motion&&) noexcept;
@@ -118,14 +129,37 @@ class Motion {
   std::unique_ptr<Engine> engine_;
 };
 
-// Fast path for a whole trajectory: the times at which a sphere or spheroid on line rails,
-// released from rest at x0 (beyond X), reaches the increasing positions xs (x0 < xs[i] ≤
-// x_max), by the quadrature of Motion (same substitution ψ − ψ0 = u0·cosh w) with a fixed
-// Boost Gauss–Legendre rule of `nodes` points (2 … 10) on each interval between consecutive
-// positions, accumulated. No error control: the accuracy of a node count for a given problem is
-// what `uphill bench motion` measures (for its spheroid, 4 nodes give ~1e-13). Throws
-// InputError for other scenes, x0 ≤ X, or positions that are not increasing in (x0, x_max].
-std::vector<double> ReleaseTimes(const Scene& scene, double x0, const std::vector<double>& xs, double g,
-                                 int nodes);
+// Fast path for a whole trajectory (src/motion/release_times.cpp): the times at which a sphere
+// or spheroid on line rails (or a sphere on rods), released from rest at x0 (X < x0 < x_max),
+// reaches the strictly increasing positions xs (x0 < xs[i] ≤ x_max). The integral of the
+// quadrature method (ψ − ψ0 = u0·cosh w), written in v = sinh(w/2), by a fixed Boost
+// Gauss–Legendre rule on each interval between consecutive positions, accumulated; the integrand
+// is evaluated in closed form on arrays of nodes (AVX2 + glibc libmvec when the CPU has them,
+// chosen at run time, else scalar libm), with no allocation but the returned vector.
+//
+// Node count: nodes = 0 chooses it per interval a priori from `tolerance`: dt/dv is analytic
+// except at a few complex points known in closed form, and the Gauss–Legendre error of N nodes
+// on an interval follows from its distance to them (Bernstein ellipse); an interval needing
+// more than 12 nodes is split. nodes = 2 … 12 forces that many on every interval.
+// Accuracy: the relative error of every time ≲ tolerance (an estimate, not an error control;
+// tests/motion_property_test.cpp checks it on five scenes from 1e-4 to 1e-13, and
+// `uphill bench motion` prints the error reached against a 50-digit reference). Throws
+// InputError (naming x0, xs, g, nodes, tolerance, kernel or scene) for other scenes, x0 ≤ X,
+// positions not increasing in (x0, x_max].
+enum class ReleaseKernel { kAuto, kScalar, kAvx2 };
+struct ReleaseTimesOptions {
+  double g = 9.80665;        // m/s², > 0
+  double tolerance = 1e-13;  // relative, in [1e-15, 1e-2]; used when nodes = 0
+  int nodes = 0;             // 0: from the tolerance; 2 … 12: fixed
+  ReleaseKernel kernel = ReleaseKernel::kAuto;  // kAvx2 throws where the CPU lacks AVX2 + FMA
+};
+// Writes t[i] for xs[i]; t.size() == xs.size().
+void ReleaseTimes(const Scene& scene, double x0, std::span<const double> xs, std::span<double> t,
+                  const ReleaseTimesOptions& options = {});
+std::vector<double> ReleaseTimes(const Scene& scene, double x0, const std::vector<double>& xs,
+                                 const ReleaseTimesOptions& options = {});
+bool ReleaseKernelAvailable(ReleaseKernel kernel);
+// "avx2+fma (libmvec)" or "scalar (libm)": what kAuto (or the given kernel) runs.
+std::string ReleaseKernelName(ReleaseKernel kernel);
 
 }  // namespace uphill

@@ -2,7 +2,8 @@
 //
 // State y = (q/q_s, T·q̇/q_s, angle) in scaled time τ = t/T, T = sqrt(L/g) (L = x_max or x_fall),
 // so that every component is O(1) (or O(u0) just after a release near X) for bodies of any size;
-// q = ψ − ψ0 (q_s = 1) for sphere/spheroid, q = x (q_s = L) for the double cone.
+// q = ψ − ψ0 (q_s = 1) for sphere/spheroid, q = x (q_s = L) for the double cone, q = β_X − β
+// (q_s = 1, β the contact normal angle) for a spheroid on rods.
 // The run is split into legs at turning points (the friction force changes sign there); each
 // leg is a list of steps of Dormand–Prince 5(4) with step control. A value at a time inside a
 // step is recomputed by integrating from the step's start to exactly that time with the
@@ -52,7 +53,12 @@ class OdeEngine : public Motion::Engine {
       apex_horizon_ = true;
       q_lo_ = line_->x_low() / qs_;
     } else {
-      throw InputError("method", "ode is not available for a spheroid on rods (numeric path): use quadrature");
+      // Spheroid on rods: q = β_X − β (path_coordinate.hpp), explicit in β.
+      rods_.emplace(scene);
+      qs_ = 1.0;
+      length_ = scene.x_max();
+      q_hi_ = rods_->q_max();
+      q_lo_ = rods_->q_low();
     }
     time_scale_ = std::sqrt(length_ / g_);
     Run(o.v0);
@@ -91,9 +97,21 @@ class OdeEngine : public Motion::Engine {
 
  private:
   // ---- geometry -----------------------------------------------------------------------------
-  double QOf(double x) const { return ellipse_ ? ellipse_->UOfX(x) : x / qs_; }
-  double XOf(double q) const { return ellipse_ ? ellipse_->XOfU(q) : q * qs_; }
-  Geometry GeometryAt(double q) const { return ellipse_ ? ellipse_->At(q) : line_->At(q * qs_); }
+  double QOf(double x) const {
+    if (ellipse_) return ellipse_->UOfX(x);
+    if (rods_) return rods_->QOfX(x);
+    return x / qs_;
+  }
+  double XOf(double q) const {
+    if (ellipse_) return ellipse_->XOfU(q);
+    if (rods_) return rods_->XOfQ(q);
+    return q * qs_;
+  }
+  Geometry GeometryAt(double q) const {
+    if (ellipse_) return ellipse_->At(q);
+    if (rods_) return rods_->At(q);
+    return line_->At(q * qs_);
+  }
 
   void Rhs(const State& y, State& dy, int fdir) const {
     const Geometry g = GeometryAt(y[0]);
@@ -192,7 +210,7 @@ class OdeEngine : public Motion::Engine {
     }
     direction_ = dir;
     abs_scale_ = std::max({std::abs(q0), std::abs(y_start_[1]), 1e-300});
-    if (!ellipse_) abs_scale_ = 1.0;
+    if (line_) abs_scale_ = 1.0;
     abs_scale_ = std::min(abs_scale_, 1.0);
 
     State y = y_start_;
@@ -256,6 +274,7 @@ class OdeEngine : public Motion::Engine {
   double g_, mu_, rel_;
   std::optional<EllipseCoordinate> ellipse_;
   std::optional<LineCoordinate> line_;
+  std::optional<RodsCoordinate> rods_;
   double qs_ = 1.0, length_ = 1.0, time_scale_ = 1.0, q_hi_ = 0.0, q_lo_ = 0.0, abs_scale_ = 1.0;
   bool apex_horizon_ = false, rest_ = false;
   State y_start_{}, y_end_{};

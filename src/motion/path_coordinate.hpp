@@ -56,6 +56,13 @@ class EllipseCoordinate {
   double z_eq() const { return z_eq_; }
   double u_max() const { return u_max_; }
   double u_low() const { return u_low_; }
+  // sin/cos of ψ0 (the ellipse parameter of X) and of γ, q = A²/P, and I/(m·a_true²).
+  double sin_psi0() const { return s0_; }
+  double cos_psi0() const { return c0_; }
+  double sin_gamma() const { return sg_; }
+  double cos_gamma() const { return cg_; }
+  double q() const { return q_; }
+  double inertia() const { return inertia_; }
 
   // u of a position x on the path (x_low ≤ x ≤ x_max), without forming ψ0 + u.
   double UOfX(double x) const {
@@ -143,6 +150,45 @@ class LineCoordinate {
 
  private:
   double a_, b_, x_fall_, x_low_, r_slope_, inertia_;
+};
+
+// Spheroid on round rods (the numeric contact path, SpheroidOnRods): q = β_X − β, β the contact
+// normal angle (PathAtNormalAngle), measured from the equilibrium X so that q grows with x.
+// The path is explicit in β (no root solve, no solver noise), smooth through the fall-off
+// q_max = β_X (β = 0, where dx/dq = 0 and the path in x turns vertical) down to x_low.
+class RodsCoordinate {
+ public:
+  explicit RodsCoordinate(const Scene& scene)
+      : path_(scene.body().across, scene.body().along, scene.rails().tan_theta, scene.rails().tan_half_alpha,
+              scene.rod_radius()),
+        beta_eq_(path_.NormalAngleAtEquilibrium()),
+        inertia_(scene.body().InertiaFactor() * scene.body().across * scene.body().across) {}
+  double q_max() const { return beta_eq_; }
+  double q_low() const { return beta_eq_ - path_.normal_angle_low(); }
+  double QOfX(double x) const { return beta_eq_ - path_.NormalAngleOf(x); }
+  double XOfQ(double q) const { return path_.PathAtNormalAngle(beta_eq_ - q).x; }
+  Geometry At(double q) const {
+    const SpheroidOnRods::NormalAnglePoint p = path_.PathAtNormalAngle(beta_eq_ - q);
+    Geometry g;
+    g.x = p.x;
+    g.z = p.z;
+    g.dx = -p.dx;  // d/dq = −d/dβ
+    g.dz = -p.dz;
+    g.metric = p.dx * p.dx + p.dz * p.dz;
+    g.r_star = p.r_star;
+    const double c = inertia_ / (p.r_star * p.r_star);  // I/(m R*²)
+    g.kinetic = 1.0 + c;
+    // dK/dq = 2·c·R*'_β/R*, dM/dq = −2·(x'x'' + z'z'')_β.
+    const double dk = 2.0 * c * p.dr_star / p.r_star;
+    const double dm = -2.0 * (p.dx * p.ddx + p.dz * p.ddz);
+    g.mass = g.kinetic * g.metric;
+    g.dmass = dk * g.metric + g.kinetic * dm;
+    return g;
+  }
+
+ private:
+  SpheroidOnRods path_;  // the same construction as the Scene's (which does not expose its own)
+  double beta_eq_, inertia_;
 };
 
 }  // namespace uphill::motion_detail

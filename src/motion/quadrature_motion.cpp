@@ -5,7 +5,8 @@
 //   kDirect sphere/spheroid over the top (v0 carries it across X), or a cone on level rails:
 //           σ = q, dt/dq = sqrt(m/(2·(E − g·z)))  (E − g·z ≥ E − g·z_top > 0: bounded)
 //   kSquare double cone: x = x_t + d·σ², d = sign(B) the downhill direction
-//   kRods   spheroid on rods (numeric path): x = x0 + d·D·sin²σ, D the distance to the end
+//   kRods   spheroid on rods, in its normal-angle coordinate q (path_coordinate.hpp, measured
+//           from X): q = q0·cosh σ as kCosh, with the height drop from the explicit path
 #include <algorithm>
 #include <boost/math/quadrature/gauss.hpp>
 #include <boost/math/quadrature/gauss_kronrod.hpp>
@@ -154,17 +155,20 @@ class QuadratureEngine : public Motion::Engine {
 
   void SetUpRods(double v0) {
     if (v0 != 0.0)
-      throw InputError("v0", "must be 0 for a spheroid on rods (release from rest only; see motion.hpp)");
+      throw InputError("v0", "must be 0 for a spheroid on rods with the quadrature method (use the ode method)");
     mode_ = Mode::kRods;
+    rods_.emplace(scene_);
     const double X = *scene_.x_eq();
     if (x0_ == X) return Stays();
     d_ = x0_ > X ? 1 : -1;
     direction_ = d_;
-    const PathPoint p0 = scene_.At(x0_);
-    rods_z0_ = p0.z;
-    rods_slope0_ = std::abs(p0.dzdx);
-    rods_span_ = d_ > 0 ? scene_.x_max() - x0_ : x0_ - scene_.x_low();
-    AddLeg(0.0, M_PI / 2, 1, d_, d_ > 0 ? MotionEventKind::kFallOff : MotionEventKind::kReachesO);
+    rods_q0_ = rods_->QOfX(x0_);
+    const Geometry g0 = rods_->At(rods_q0_);
+    rods_z0_ = g0.z;
+    rods_slope0_ = std::abs(g0.dz);
+    const double q_end = d_ > 0 ? rods_->q_max() : rods_->q_low();
+    rods_span_ = std::abs(q_end - rods_q0_);
+    AddLeg(0.0, SigmaOfQ(q_end), 1, d_, d_ > 0 ? MotionEventKind::kFallOff : MotionEventKind::kReachesO);
   }
 
   void Stays() {
@@ -196,12 +200,7 @@ class QuadratureEngine : public Motion::Engine {
       case Mode::kCosh: return u_t_ * std::cosh(s);
       case Mode::kDirect: return s;
       case Mode::kSquare: return x_t_ + d_ * s * s;
-      case Mode::kRods: {
-        // Near the end measure from it, so that x stays below x_max for every σ < π/2.
-        const double c = std::cos(s), sn = std::sin(s);
-        if (d_ > 0) return s < M_PI / 4 ? x0_ + rods_span_ * sn * sn : scene_.x_max() - rods_span_ * c * c;
-        return s < M_PI / 4 ? x0_ - rods_span_ * sn * sn : scene_.x_low() + rods_span_ * c * c;
-      }
+      case Mode::kRods: return rods_q0_ * std::cosh(s);
     }
     return 0.0;
   }
@@ -210,18 +209,26 @@ class QuadratureEngine : public Motion::Engine {
       case Mode::kCosh: return u_t_ * std::sinh(s);
       case Mode::kDirect: return 1.0;
       case Mode::kSquare: return 2.0 * d_ * s;
-      case Mode::kRods: return d_ * rods_span_ * std::sin(2.0 * s);
+      case Mode::kRods: return rods_q0_ * std::sinh(s);
     }
     return 0.0;
   }
-  double QOfX(double x) const { return ellipse_ ? ellipse_->UOfX(x) : x; }
-  double XOfQ(double q) const { return ellipse_ ? ellipse_->XOfU(q) : q; }
+  double QOfX(double x) const {
+    if (ellipse_) return ellipse_->UOfX(x);
+    if (rods_) return rods_->QOfX(x);
+    return x;
+  }
+  double XOfQ(double q) const {
+    if (ellipse_) return ellipse_->XOfU(q);
+    if (rods_) return rods_->XOfQ(q);
+    return q;
+  }
   double SigmaOfQ(double q) const {
     switch (mode_) {
       case Mode::kCosh: return 2.0 * std::asinh(std::sqrt(std::max(0.0, (q - u_t_) / (2.0 * u_t_))));
       case Mode::kDirect: return q;
       case Mode::kSquare: return std::sqrt(std::max(0.0, d_ * (q - x_t_)));
-      case Mode::kRods: return std::asin(std::min(1.0, std::sqrt(std::max(0.0, d_ * (q - x0_) / rods_span_))));
+      case Mode::kRods: return 2.0 * std::asinh(std::sqrt(std::max(0.0, (q - rods_q0_) / (2.0 * rods_q0_))));
     }
     return 0.0;
   }
@@ -229,19 +236,7 @@ class QuadratureEngine : public Motion::Engine {
   Geometry GeometryAt(double q) const {
     if (ellipse_) return ellipse_->At(q);
     if (line_) return line_->At(q);
-    const PathPoint p = scene_.At(std::clamp(q, scene_.x_low(), scene_.x_max()));
-    Geometry g;
-    g.x = q;
-    g.z = p.z;
-    g.dx = 1.0;
-    g.dz = p.dzdx;
-    g.metric = 1.0 + p.dzdx * p.dzdx;
-    g.r_star = p.r_star;
-    const double across = scene_.body().across;
-    g.kinetic = 1.0 + scene_.body().InertiaFactor() * across * across / (p.r_star * p.r_star);
-    g.mass = g.kinetic * g.metric;
-    g.dmass = 0.0;
-    return g;
+    return rods_->At(q);
   }
 
   // |dt/dσ| (smooth and bounded on every leg).
@@ -264,34 +259,28 @@ class QuadratureEngine : public Motion::Engine {
       }
       case Mode::kSquare: return std::sqrt(2.0 * line_->At(QOfSigma(s)).mass / (g_ * std::abs(line_->B())));
       case Mode::kRods: {
-        const double x = QOfSigma(s);
-        const Geometry g = GeometryAt(x);
-        const double sn = std::sin(s), c = std::cos(s);
-        // 2·D·sinσ·cosσ·sqrt(m/(2·g·(z0 − z))); at σ → 0, z0 − z → |z'0|·D·sin²σ.
-        double ratio;  // sinσ/sqrt(z0 − z)
-        const double drop = RodsDrop(x, g.z);
-        if (sn < 1e-7 || !(drop > 0.0)) {
-          ratio = 1.0 / std::sqrt(rods_slope0_ * rods_span_);
-        } else {
-          ratio = sn / std::sqrt(drop);
-        }
-        // cosσ·sqrt(metric): finite at the fall-off (metric ~ 1/cos²σ).
-        return 2.0 * rods_span_ * c * ratio * std::sqrt(g.mass / (2.0 * g_));
+        // |q0·sinh σ|·sqrt(m/(2·g·(z0 − z))); the drop → |dz/dq(q0)|·(q − q0) as σ → 0, with
+        // q − q0 = 2·q0·sinh²(σ/2) (not the difference of two q).
+        const Geometry g = rods_->At(QOfSigma(s));
+        const double h = std::sinh(0.5 * s), dq = 2.0 * rods_q0_ * h * h;
+        const double drop = RodsDrop(dq, g.z);
+        const double ratio = !(drop > 0.0) ? std::sqrt(2.0 / (rods_slope0_ * std::abs(rods_q0_)))
+                                           : std::abs(rods_q0_ * std::sinh(s)) / std::sqrt(drop);
+        return ratio * std::sqrt(g.mass / (2.0 * g_));
       }
     }
     return 0.0;
   }
-  // Spheroid on rods: z(x0) − z(x) for the centre at x (z = z(x) given). Near x0 the difference
-  // of two heights would lose its digits (z is accurate to an ulp, the drop is ~|z'|·|x − x0|),
-  // so within 2 % of the span it is −∫z'dx by composite Simpson (4 panels; error ~1e-12
-  // relative there, z' being accurate to a few ulp).
-  double RodsDrop(double x, double z) const {
-    const double delta = x - x0_;
-    if (std::abs(delta) >= 0.02 * rods_span_) return rods_z0_ - z;
-    const double h = delta / 4.0;
-    double sum = -d_ * rods_slope0_ + scene_.At(x).dzdx;  // z'(x0) = −d·|z'(x0)|
-    for (int i = 1; i < 4; ++i) sum += (i % 2 ? 4.0 : 2.0) * scene_.At(x0_ + i * h).dzdx;
-    return -h / 3.0 * sum;
+  // Spheroid on rods: z(q0) − z(q0 + dq) for z = z(q0 + dq) given. Near q0 the difference of two
+  // heights would lose its digits (the drop is ~|dz/dq|·|dq|), so within 30 % of the span it is
+  // −∫dz/dq by 15-point Gauss–Legendre (Boost; dz/dq is explicit and smooth there: error far
+  // below an ulp of the drop).
+  double RodsDrop(double dq, double z) const {
+    if (std::abs(dq) >= 0.3 * rods_span_) return rods_z0_ - z;
+    // On [0, 1] with the width dq as a factor: q0 + dq may round to within an ulp of q0 while
+    // dq itself is exact.
+    auto slope = [this, dq](double y) { return rods_->At(rods_q0_ + dq * y).dz; };
+    return -dq * boost::math::quadrature::gauss<double, 15>::integrate(slope, 0.0, 1.0);
   }
   // |dangle/dσ| = sqrt(M)/R*·|dq/dσ|.
   double DangleDsigma(double s) const {
@@ -307,12 +296,12 @@ class QuadratureEngine : public Motion::Engine {
   double Integrate(F f, double a, double b) const {
     if (a == b) return 0.0;
     const double lo = std::min(a, b), width = std::abs(b - a);
-    // The numeric path of a spheroid on rods has a few ulp of noise in z, which the height drop
-    // amplifies near the release: ~1e-7 relative is what it reaches there (motion.hpp).
-    const bool rods = mode_ == Mode::kRods;
-    const double tol = std::max(0.1 * tol_, rods ? 1e-10 : 1e-14);
+    // Spheroid on rods released near X: dz/dq ∝ q there is computed from O(1) terms, so the
+    // integrand carries ~ulp/|q0| of rounding noise that no tolerance below it can beat.
+    const double noise = mode_ == Mode::kRods ? 4e-17 / std::abs(rods_q0_) : 0.0;
+    const double tol = std::max({0.1 * tol_, 1e-14, noise});
     auto unit = [&](double y) { return f(lo + width * y); };
-    return width * boost::math::quadrature::gauss_kronrod<double, 31>::integrate(unit, 0.0, 1.0, rods ? 8 : 12, tol);
+    return width * boost::math::quadrature::gauss_kronrod<double, 31>::integrate(unit, 0.0, 1.0, 12, tol);
   }
   double TimeIntegral(double a, double b) const {
     return Integrate([this](double s) { return DtDsigma(s); }, a, b);
@@ -376,12 +365,13 @@ class QuadratureEngine : public Motion::Engine {
     out.z = g.z;
     const double dtds = DtDsigma(s);
     if (mode_ == Mode::kRods) {
-      // ẋ from energy; q = x.
-      const double drop = RodsDrop(out.x, g.z);
-      const double v = std::sqrt(std::max(0.0, 2.0 * g_ * drop / g.kinetic));
+      // Speed from energy (at the fall-off σ = π/2 both dq/dσ and dt/dσ vanish).
+      const double h = std::sinh(0.5 * s);
+      const double v = std::sqrt(std::max(0.0, 2.0 * g_ * RodsDrop(2.0 * rods_q0_ * h * h, g.z) / g.kinetic));
+      const double qdot = leg.xdir * v / std::sqrt(g.metric);  // dx/dq ≥ 0
       out.v = v;
-      out.vx = leg.xdir * v / std::sqrt(g.metric);
-      out.vz = out.vx * g.dz;
+      out.vx = g.dx * qdot;
+      out.vz = g.dz * qdot;
     } else {
       const double qdot = leg.sdir * DqDsigma(s) / dtds;
       out.v = std::sqrt(g.metric) * std::abs(qdot);
@@ -408,7 +398,8 @@ class QuadratureEngine : public Motion::Engine {
   std::vector<Leg> legs_;
   double u_t_ = 0.0, energy_over_ = 0.0, x_t_ = 0.0;
   int d_ = 1;
-  double rods_z0_ = 0.0, rods_slope0_ = 0.0, rods_span_ = 0.0;
+  std::optional<RodsCoordinate> rods_;
+  double rods_q0_ = 0.0, rods_z0_ = 0.0, rods_slope0_ = 0.0, rods_span_ = 0.0;
 };
 
 }  // namespace
@@ -418,60 +409,4 @@ std::unique_ptr<Motion::Engine> MakeQuadratureEngine(const Scene& scene, double 
   return std::make_unique<QuadratureEngine>(scene, x0, options);
 }
 
-namespace {
-
-template <unsigned N, class F>
-double Gauss(F& f, double a, double b) {
-  return boost::math::quadrature::gauss<double, N>::integrate(f, a, b);
-}
-
-}  // namespace
 }  // namespace uphill::motion_detail
-
-namespace uphill {
-
-std::vector<double> ReleaseTimes(const Scene& scene, double x0, const std::vector<double>& xs, double g,
-                                 int nodes) {
-  using namespace motion_detail;
-  if (!IsEllipse(scene)) throw InputError("scene", "ReleaseTimes needs a sphere or spheroid on line rails");
-  if (!(x0 > *scene.x_eq() && x0 < scene.x_max())) throw InputError("x0", "must lie in (X, x_max)");
-  if (nodes < 2 || nodes > 10) throw InputError("nodes", "must be 2 … 10");
-  const EllipseCoordinate e = MakeEllipse(scene);
-  const double u0 = e.UOfX(x0), u_end = e.u_max();
-  const double gz = g * e.z_eq();
-  auto f = [&](double w) {
-    // dt/dw = sqrt(K·M/(g·z_eq·sinc(u0·ch²)·sinc(u0·sh²))), ch = cosh(w/2), sh = sinh(w/2).
-    const double ex = std::exp(0.5 * w), inv = 1.0 / ex;
-    const double ch = 0.5 * (ex + inv), sh = 0.5 * (ex - inv);
-    const double a1 = u0 * ch * ch, a2 = u0 * sh * sh;
-    const Geometry geo = e.At(a1 + a2);
-    // sin(x)/x; below 1e-4 the two-term series is exact to rounding.
-    const auto sinc = [](double x) { return std::abs(x) < 1e-4 ? 1.0 - x * x / 6.0 : std::sin(x) / x; };
-    return std::sqrt(geo.mass / (gz * sinc(a1) * sinc(a2)));
-  };
-  std::vector<double> out(xs.size());
-  double t = 0.0, w_prev = 0.0, x_prev = x0;
-  for (size_t i = 0; i < xs.size(); ++i) {
-    const double x = xs[i];
-    if (!(x > x_prev && x <= scene.x_max())) throw InputError("xs", "must increase within (x0, x_max]");
-    const double u = x == scene.x_max() ? u_end : e.UOfX(x);
-    const double w = 2.0 * std::asinh(std::sqrt(std::max(0.0, (u - u0) / (2.0 * u0))));
-    switch (nodes) {
-      case 2: t += Gauss<2>(f, w_prev, w); break;
-      case 3: t += Gauss<3>(f, w_prev, w); break;
-      case 4: t += Gauss<4>(f, w_prev, w); break;
-      case 5: t += Gauss<5>(f, w_prev, w); break;
-      case 6: t += Gauss<6>(f, w_prev, w); break;
-      case 7: t += Gauss<7>(f, w_prev, w); break;
-      case 8: t += Gauss<8>(f, w_prev, w); break;
-      case 9: t += Gauss<9>(f, w_prev, w); break;
-      default: t += Gauss<10>(f, w_prev, w); break;
-    }
-    out[i] = t;
-    w_prev = w;
-    x_prev = x;
-  }
-  return out;
-}
-
-}  // namespace uphill

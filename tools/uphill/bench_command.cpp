@@ -9,6 +9,7 @@ void AddBenchCommand(CLI::App& app) {
   AddBenchConvert(*bench);
   AddBenchFit(*bench);
   AddBenchMotion(*bench);
+  AddBenchTrack(*bench);
 }
 
 }  // namespace uphill::cli

@@ -14,11 +14,11 @@
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 #include <boost/multiprecision/cpp_bin_float.hpp>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <sstream>
 
 #include "commands.hpp"
@@ -40,11 +40,13 @@ struct Flags {
   std::string python = "/usr/bin/python3";
   std::string script;
   bool no_python = false;
+  bool release_only = false;  // only the ReleaseTimes rows (no Motion rows, no peers)
 };
 
 struct Row {
   std::string method, setting;
   double micros, error;
+  double cpu_micros = -1;  // thread CPU time, where measured (uphill rows)
 };
 
 std::string FindUpward(const std::string& rel) {
@@ -113,13 +115,22 @@ double MaxRelError(const std::vector<double>& got, const std::vector<double>& re
   return worst;
 }
 
-// Best of 5 repeats of ≥ 0.1 s each; microseconds per call.
-double TimeIt(const std::function<void()>& work) {
+double ThreadCpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// Best of 5 repeats of ≥ 0.1 s each; microseconds per call (wall time), and the thread CPU time
+// of the same repeats in *cpu_micros (what a loaded, shared machine still measures fairly).
+template <class Work>
+double TimeIt(const Work& work, double* cpu_micros = nullptr) {
   using Clock = std::chrono::steady_clock;
-  double best = 1e300;
+  double best = 1e300, best_cpu = 1e300;
   for (int r = 0; r < 5; ++r) {
     long n = 0;
     const auto start = Clock::now();
+    const double cpu_start = ThreadCpuSeconds();
     double elapsed = 0;
     do {
       work();
@@ -127,7 +138,9 @@ double TimeIt(const std::function<void()>& work) {
       elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     } while (elapsed < 0.1);
     best = std::min(best, elapsed / n);
+    best_cpu = std::min(best_cpu, (ThreadCpuSeconds() - cpu_start) / n);
   }
+  if (cpu_micros) *cpu_micros = best_cpu * 1e6;
   return best * 1e6;
 }
 
@@ -146,7 +159,7 @@ void Run(const Flags& f) {
               x0 * 1e3, kPoints, x_end * 1e3, ref.back());
   std::vector<Row> rows;
   std::vector<double> got(kPoints);
-  for (int e = 3; e <= 13; e += 2) {
+  for (int e = 3; e <= 13 && !f.release_only; e += 2) {
     const double tol = std::pow(10.0, -e);
     for (MotionMethod m : {MotionMethod::kQuadrature, MotionMethod::kOde}) {
       MotionOptions o;
@@ -162,17 +175,39 @@ void Run(const Flags& f) {
                       "tol 1e-" + std::to_string(e), TimeIt(work), err});
     }
   }
-  for (int n = 2; n <= 10; ++n) {
-    auto work = [&] { got = ReleaseTimes(scene, x0, xs, kG, n); };
-    work();
-    rows.push_back({"uphill ReleaseTimes (Gauss-Legendre per interval)", std::to_string(n) + " nodes", TimeIt(work),
-                    MaxRelError(got, ref)});
+  // The fast path: node count from the a-priori estimate (per tolerance), and fixed counts.
+  std::vector<ReleaseKernel> kernels = {ReleaseKernel::kScalar};
+  if (ReleaseKernelAvailable(ReleaseKernel::kAvx2)) kernels.insert(kernels.begin(), ReleaseKernel::kAvx2);
+  for (ReleaseKernel kernel : kernels) {
+    const std::string name = "uphill ReleaseTimes, " + ReleaseKernelName(kernel);
+    // Fixed node counts are a separate curve (same method, no a-priori choice).
+    auto add = [&](const ReleaseTimesOptions& o, const std::string& setting) {
+      auto work = [&] { ReleaseTimes(scene, x0, xs, got, o); };
+      work();
+      double cpu = 0;
+      const double wall = TimeIt(work, &cpu);
+      rows.push_back({o.nodes ? name + ", fixed nodes" : name, setting, wall, MaxRelError(got, ref), cpu});
+    };
+    for (int e = 3; e <= 15; e += (e < 11 ? 2 : 1)) {
+      ReleaseTimesOptions o;
+      o.g = kG;
+      o.kernel = kernel;
+      o.tolerance = std::pow(10.0, -e);
+      add(o, "tol 1e-" + std::to_string(e));
+    }
+    for (int n : {3, 4, 5, 6}) {
+      ReleaseTimesOptions o;
+      o.g = kG;
+      o.kernel = kernel;
+      o.nodes = n;
+      add(o, std::to_string(n) + " nodes");
+    }
   }
 
   // Peers.
   std::string why_not;
   const std::string script = f.script.empty() ? FindUpward("tools/bench/motion_peers.py") : f.script;
-  if (f.no_python) why_not = "--no-python";
+  if (f.no_python || f.release_only) why_not = f.no_python ? "--no-python" : "--release-only";
   else if (access(f.python.c_str(), X_OK) != 0) why_not = f.python + " not found";
   else if (script.empty()) why_not = "tools/bench/motion_peers.py not found (use --script)";
   else if (std::system((Quote(f.python) + " -c 'import scipy' > /dev/null 2>&1").c_str()) != 0)
@@ -207,14 +242,22 @@ void Run(const Flags& f) {
       if (parts.size() == 4) rows.push_back({parts[0], parts[1], std::stod(parts[2]), std::stod(parts[3])});
     }
   }
-  std::printf("%-52s %-12s %14s %12s\n", "method", "setting", "time/traj", "max rel err");
-  for (const Row& r : rows)
-    std::printf("%-52s %-12s %11.1f us %12.2e\n", r.method.c_str(), r.setting.c_str(), r.micros, r.error);
+  std::printf("%-60s %-12s %14s %12s %12s\n", "method", "setting", "time/traj", "max rel err", "(cpu time)");
+  for (const Row& r : rows) {
+    std::printf("%-60s %-12s %11.1f us %12.2e", r.method.c_str(), r.setting.c_str(), r.micros, r.error);
+    if (r.cpu_micros >= 0) std::printf(" %9.1f us", r.cpu_micros);
+    std::printf("\n");
+  }
   if (!why_not.empty()) std::printf("\nSciPy/NumPy comparison skipped: %s\n", why_not.c_str());
-  double best = 1e300;
+  double best = 1e300, best_cpu = 1e300;
   for (const Row& r : rows)
-    if (r.method.rfind("uphill", 0) == 0 && r.error <= 1e-12) best = std::min(best, r.micros);
-  std::printf("\nGoal: <= 1e-12 in <= 10 us per trajectory. Fastest uphill row at <= 1e-12: %.1f us.\n", best);
+    if (r.method.rfind("uphill", 0) == 0 && r.error <= 1e-12) {
+      best = std::min(best, r.micros);
+      if (r.cpu_micros >= 0) best_cpu = std::min(best_cpu, r.cpu_micros);
+    }
+  std::printf("\nGoal: <= 1e-12 in <= 10 us per trajectory. Fastest uphill row at <= 1e-12: %.1f us wall, "
+              "%.1f us thread CPU time (%s).\n",
+              best, best_cpu, best <= 10.0 ? "met" : best_cpu <= 10.0 ? "met in CPU time only: the machine is loaded" : "not met");
 
   // Figure.
   std::string data;
@@ -255,6 +298,7 @@ void AddBenchMotion(CLI::App& bench) {
   cmd->add_option("--python", flags->python, "Python with SciPy for the comparison")->capture_default_str();
   cmd->add_option("--script", flags->script, "path of tools/bench/motion_peers.py");
   cmd->add_flag("--no-python", flags->no_python, "skip the SciPy/NumPy comparison");
+  cmd->add_flag("--release-only", flags->release_only, "only the ReleaseTimes rows (no Motion rows, no peers)");
   cmd->callback([flags] { Run(*flags); });
 }
 

@@ -17,15 +17,18 @@ namespace uphill::cli::bench {
 // CPU time of the calling thread (CLOCK_THREAD_CPUTIME_ID): one core's work, not skewed by
 // other load on the machine.
 double CpuSeconds();
+// CPU time of the whole process (CLOCK_PROCESS_CPUTIME_ID), for work that libraries spread over
+// their own threads (FFmpeg's decoder): the work one core would have to do.
+double ProcessCpuSeconds();
 
-// The smallest thread CPU time of `repeats` runs of f.
+// The smallest time of `repeats` runs of f on `clock` (by default the thread's CPU time).
 template <typename F>
-double BestOf(int repeats, F&& f) {
+double BestOf(int repeats, F&& f, double (*clock)() = CpuSeconds) {
   double best = INFINITY;
   for (int r = 0; r < repeats; ++r) {
-    const double t0 = CpuSeconds();
+    const double t0 = clock();
     f();
-    best = std::min(best, CpuSeconds() - t0);
+    best = std::min(best, clock() - t0);
   }
   return best;
 }

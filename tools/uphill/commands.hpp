@@ -22,10 +22,17 @@ void AddServeCommand(CLI::App& app);
 void AddSimulateCommand(CLI::App& app);
 // `paper-figures`: the seed paper's model figures (paper_figures_command.cpp).
 void AddPaperFiguresCommand(CLI::App& app);
+// `calibrate camera|scene|target`: camera calibration (calibrate_command.cpp, src/vision/).
+void AddCalibrateCommand(CLI::App& app);
+// `track`: the ball's centre in every frame of a calibrated video (track_command.cpp, src/vision/).
+void AddTrackCommand(CLI::App& app);
+// `analyse-track`: events and model fit of a ball track (analyse_track_command.cpp, src/vision/).
+void AddAnalyseTrackCommand(CLI::App& app);
 
 // `uphill bench <what>`: each benchmark adds itself to the bench subcommand.
 void AddBenchConvert(CLI::App& bench);
 void AddBenchFit(CLI::App& bench);  // bench_fit.cpp
 void AddBenchMotion(CLI::App& bench);  // bench_motion.cpp
+void AddBenchTrack(CLI::App& bench);  // bench_track.cpp
 
 }  // namespace uphill::cli

@@ -20,6 +20,9 @@ int main(int argc, char** argv) {
   uphill::cli::AddServeCommand(app);
   uphill::cli::AddSimulateCommand(app);
   uphill::cli::AddPaperFiguresCommand(app);
+  uphill::cli::AddCalibrateCommand(app);
+  uphill::cli::AddTrackCommand(app);
+  uphill::cli::AddAnalyseTrackCommand(app);
   uphill::cli::AddBenchCommand(app);
   try {
     app.parse(argc, argv);

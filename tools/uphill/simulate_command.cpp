@@ -172,7 +172,10 @@ void Run(const SimulateFlags& f) {
   } else if (f.method == "ode") {
     o.method = MotionMethod::kOde;
   } else if (f.method == "auto") {
-    o.method = o.mu > 0.0 ? MotionMethod::kOde : MotionMethod::kQuadrature;
+    // ode when the quadrature cannot: rolling resistance, or an initial speed on a spheroid on
+    // rods (whose quadrature handles a release from rest only).
+    const bool rods_spheroid = scene.body().kind == BodyKind::kSpheroid && scene.rod_radius() > 0.0;
+    o.method = o.mu > 0.0 || (rods_spheroid && o.v0 != 0.0) ? MotionMethod::kOde : MotionMethod::kQuadrature;
   } else {
     throw InputError("--method", "must be quadrature, ode or auto (got '" + f.method + "')");
   }
@@ -204,7 +207,7 @@ void AddSimulateCommand(CLI::App& app) {
   cmd->add_option("--at-x", flags->at_x, "sample positions, comma-separated, with unit");
   cmd->add_option("--dt", flags->dt, "sample every dt (with unit) up to the end of the motion");
   cmd->add_option("--t-end", flags->t_end, "with --dt: stop at this time (needed when the motion never ends)");
-  cmd->add_option("--method", flags->method, "quadrature, ode or auto (ode when --mu > 0)")->capture_default_str();
+  cmd->add_option("--method", flags->method, "quadrature, ode or auto (ode when --mu > 0, or --v0 != 0 for a spheroid on rods)")->capture_default_str();
   cmd->add_flag("--csv", flags->csv, "CSV output (SI, units in the header)");
   cmd->add_flag("--json", flags->json, "JSON output (SI; keys in README)");
   cmd->add_option("--length-unit", flags->length_unit, "length unit of the table: mm, cm, m, in")

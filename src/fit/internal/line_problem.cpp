@@ -82,6 +82,91 @@ Standardised Standardise(const LineData& data, const std::vector<double>& centre
   return s;
 }
 
+WeightedStandardised StandardiseWithUy(const LineData& data, bool use_uy) {
+  const std::size_t n = data.size();
+  std::vector<double> centre_weights;
+  if (use_uy) {
+    const double u_min = *std::min_element(data.u_y.begin(), data.u_y.end());
+    centre_weights.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double ratio = u_min / data.u_y[i];
+      centre_weights[i] = ratio * ratio;
+    }
+  }
+  WeightedStandardised out{Standardise(data, centre_weights, false, use_uy), {}};
+  if (use_uy) {
+    RequireRepresentable(out.s.uy, "u(Y)");
+    out.inv_sigma.resize(n);
+    for (std::size_t i = 0; i < n; ++i) out.inv_sigma[i] = 1.0 / out.s.uy[i];
+  }
+  return out;
+}
+
+FitReport StartReport(FitMethod method, std::size_t n, bool uses_stated_uncertainties,
+                      ErrorScaling primary_scaling, double outlier_threshold) {
+  FitReport report;
+  report.method = method;
+  report.n = n;
+  report.uses_stated_uncertainties = uses_stated_uncertainties;
+  report.primary_scaling = primary_scaling;
+  report.outlier_threshold = outlier_threshold;
+  return report;
+}
+
+StandardisedView ViewStandardised(const LineData& data, bool use_ux, bool use_uy) {
+  StandardisedView v;
+  v.n = data.size();
+  v.x = data.x.data();
+  v.y = data.y.data();
+  v.ux = use_ux ? data.u_x.data() : nullptr;
+  v.uy = use_uy ? data.u_y.data() : nullptr;
+  using Map = Eigen::Map<const Eigen::ArrayXd>;
+  long double sum_x = 0, sum_y = 0;
+  double x_min = v.x[0], x_max = v.x[0], y_min = v.y[0], y_max = v.y[0];
+  double u_min = use_uy ? v.uy[0] : 1.0, u_max = u_min;
+  ForEachChunk(v.n, [&](std::size_t i, Eigen::Index m) {
+    const Map x(v.x + i, m), y(v.y + i, m);
+    sum_x += x.sum();
+    sum_y += y.sum();
+    x_min = std::min(x_min, x.minCoeff());
+    x_max = std::max(x_max, x.maxCoeff());
+    y_min = std::min(y_min, y.minCoeff());
+    y_max = std::max(y_max, y.maxCoeff());
+    if (use_uy) {
+      const Map u(v.uy + i, m);
+      u_min = std::min(u_min, u.minCoeff());
+      u_max = std::max(u_max, u.maxCoeff());
+    }
+  });
+  const long double n = static_cast<long double>(v.n);
+  // The rounded mean lies within the data's range (clamped, should rounding push it out).
+  v.x0 = std::clamp(static_cast<double>(sum_x / n), x_min, x_max);
+  v.y0 = std::clamp(static_cast<double>(sum_y / n), y_min, y_max);
+  const auto scale = [](double lo, double hi, double centre) {
+    const double largest = std::max(hi - centre, centre - lo);
+    if (largest > 0.0 && std::isfinite(largest)) return PowerOfTwoBelow(largest);
+    if (centre != 0.0) return PowerOfTwoBelow(std::abs(centre));
+    return 1.0;
+  };
+  v.sx = scale(x_min, x_max, v.x0);
+  v.sy = scale(y_min, y_max, v.y0);
+  v.inv_sx = 1.0 / v.sx;
+  v.inv_sy = 1.0 / v.sy;
+  if (use_uy) {
+    // u² and 1/u² are monotone in u: the extremes decide. Name the first offending row.
+    const auto representable = [](double u) {
+      const double u2 = u * u;
+      return u2 > 0.0 && std::isfinite(u2) && std::isfinite(1.0 / u2);
+    };
+    if (!representable(u_min * v.inv_sy) || !representable(u_max * v.inv_sy)) {
+      std::vector<double> scaled(data.u_y);
+      for (double& u : scaled) u *= v.inv_sy;
+      RequireRepresentable(scaled, "u(Y)");
+    }
+  }
+  return v;
+}
+
 Eigen::Vector2d ClosedFormLine(const Standardised& s, const std::vector<double>& inv_sigma) {
   const Eigen::Index n = static_cast<Eigen::Index>(s.size());
   // Thin N×2 design and N-vector: O(N) memory; Householder QR never forms Q.
@@ -299,7 +384,7 @@ double UpperTailChiSquared(double chi2, int dof) {
 }
 
 void FinishReport(FitReport& report, const std::vector<std::string>& names,
-                  const Eigen::VectorXd& values, bool p_value_applies) {
+                  const Eigen::VectorXd& values, bool p_value_applies, bool rows_flagged) {
   const int p = static_cast<int>(values.size());
   report.dof = static_cast<int>(report.n) - p;
   report.exact = report.dof == 0;
@@ -325,10 +410,12 @@ void FinishReport(FitReport& report, const std::vector<std::string>& names,
     if (report.covariance_scaled) e.se_scaled = std::sqrt((*report.covariance_scaled)(i, i));
     report.parameters.push_back(e);
   }
-  report.outliers.clear();
-  for (RowResult& row : report.rows) {
-    row.outlier = std::abs(row.normalised) > report.outlier_threshold;
-    if (row.outlier) report.outliers.push_back(row.row);
+  if (!rows_flagged) {
+    report.outliers.clear();
+    for (RowResult& row : report.rows) {
+      row.outlier = std::abs(row.normalised) > report.outlier_threshold;
+      if (row.outlier) report.outliers.push_back(row.row);
+    }
   }
   if (report.exact) {
     std::string note = "exact fit: " + std::to_string(report.n) + " rows determine the " +

@@ -6,6 +6,7 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,6 +36,43 @@ struct Standardised {
 };
 Standardised Standardise(const LineData& data, const std::vector<double>& centre_weights,
                          bool keep_ux, bool keep_uy);
+
+// Standardise for a fit that weights rows by u(Y) when use_uy (WLS, robust with u(Y)): centred
+// at the weighted mean of X and Y with weights (u_min/u_i)² (there the centred intercept and
+// the slope are uncorrelated, so the design's two columns are orthogonal; the ratio keeps tiny
+// or huge u from overflowing), inv_sigma = 1/(u(Y_i)/sy) (RequireRepresentable checked). Without
+// u(Y): unit weights, inv_sigma empty.
+struct WeightedStandardised {
+  Standardised s;
+  std::vector<double> inv_sigma;
+};
+WeightedStandardised StandardiseWithUy(const LineData& data, bool use_uy);
+
+// A FitReport with what every line fit sets before solving.
+FitReport StartReport(FitMethod method, std::size_t n, bool uses_stated_uncertainties,
+                      ErrorScaling primary_scaling, double outlier_threshold);
+
+// The same standardised coordinates without copying the data, for fits of many rows: X and
+// Y are standardised on the fly, chunk by chunk (ForEachChunk), by the same operations
+// ((X_i − x0)·(1/sx) with 1/sx an exact power of two), so no N-sized buffer is allocated.
+// x0, y0 are plain means (one vectorised pass, which also finds the extremes for sx, sy and
+// the range of u(Y)/sy); any centre inside the data's range keeps X_i − x0 exact when the
+// data sit far from 0 (Sterbenz), and the fits' results do not depend on it beyond rounding.
+// Throws InputError (RequireRepresentable's) when u(Y)/sy is out of binary64 range.
+struct StandardisedView {
+  double x0 = 0.0, y0 = 0.0, sx = 1.0, sy = 1.0, inv_sx = 1.0, inv_sy = 1.0;
+  const double *x = nullptr, *y = nullptr, *ux = nullptr, *uy = nullptr;  // the raw columns
+  std::size_t n = 0;
+};
+StandardisedView ViewStandardised(const LineData& data, bool use_ux, bool use_uy);
+
+// Rows per chunk of the vectorised passes: 8 chunk-sized arrays stay in L1.
+inline constexpr std::size_t kChunk = 256;
+template <typename F>
+void ForEachChunk(std::size_t n, F&& f) {
+  for (std::size_t begin = 0; begin < n; begin += kChunk)
+    f(begin, static_cast<Eigen::Index>(std::min(kChunk, n - begin)));
+}
 
 // Weighted least-squares line through standardised data, by Householder QR of the design
 // [x_i·w_i, w_i] (w_i = inv_sigma_i, empty: 1). Returns (slope, intercept) in standardised units.
@@ -83,8 +121,10 @@ double UpperTailChiSquared(double chi2, int dof);
 // Fills parameters (with both standard errors), covariance_scaled, correlation, dof,
 // reduced_chi2, p_value (when p_value_applies), exact (+ note), the per-row outlier flags and
 // the outlier list. Expects method, n, chi2, covariance, rows, outlier_threshold set.
+// rows_flagged: the caller has set the rows' outlier flags and the outlier list itself (in its
+// own pass over the rows), so FinishReport does not walk the rows again.
 void FinishReport(FitReport& report, const std::vector<std::string>& names,
-                  const Eigen::VectorXd& values, bool p_value_applies);
+                  const Eigen::VectorXd& values, bool p_value_applies, bool rows_flagged = false);
 
 // "1.2345678901234567" (17 significant digits) for messages.
 std::string Num(double v);

@@ -1,0 +1,100 @@
+// Camera: the pinhole camera with lens distortion that films the apparatus, and its pose in the
+// apparatus frame of PHYSICS.md (O the rails' meeting point, x along the centre line toward the
+// rising end, y across, z up). Everything the vision layer computes goes through these few
+// functions, so that the renderer of synthetic clips, the calibration and the tracker agree on
+// one camera model: OpenCV's (cv::projectPoints, cv::undistortPoints).
+//
+// Conventions
+//  - Pixels: OpenCV's. (0, 0) is the centre of the top-left pixel, u to the right, v down.
+//    "Raw" pixel coordinates are those of the recorded (distorted) frame.
+//  - Intrinsics K = [fx 0 cx; 0 fy cy; 0 0 1] in pixels; distortion coefficients in OpenCV's
+//    order (k1, k2, p1, p2[, k3[, k4, k5, k6]]), dimensionless; empty means none.
+//  - Camera frame: OpenCV's (x right, y down, z along the optical axis), metres.
+//  - Pose: a point P of the apparatus frame (metres) is at rotation·P + translation in the
+//    camera frame.
+//  - Units: metres inside the library; the files (calibration/README.md) state theirs.
+//
+// Accuracy: projection is OpenCV's closed form (a few ulp). UndistortPixel inverts the lens
+// model iteratively; its round trip Project(Undistort(p)) = p holds to < 1e-6 px for the
+// distortions of real lenses within the image (tests/vision_camera_test.cpp).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace uphill::vision {
+
+struct CameraIntrinsics {
+  int width = 0, height = 0;              // image size, pixels
+  double fx = 0, fy = 0, cx = 0, cy = 0;  // pixels
+  std::vector<double> distortion;         // OpenCV order; empty: no distortion
+};
+
+struct CameraPose {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // apparatus -> camera
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();   // metres
+};
+
+// Raw pixel of a point in the camera frame (metres). Throws InputError ("point") unless the
+// point lies in front of the camera (z > 0).
+Eigen::Vector2d ProjectCameraPoint(const CameraIntrinsics& camera, const Eigen::Vector3d& point);
+
+// Raw pixel of a point of the apparatus frame (metres).
+Eigen::Vector2d ProjectApparatusPoint(const CameraIntrinsics& camera, const CameraPose& pose,
+                                      const Eigen::Vector3d& point);
+
+// The undistorted normalised image coordinates (X/Z, Y/Z in the camera frame) of a raw pixel:
+// the direction of its viewing ray is (x, y, 1).
+Eigen::Vector2d UndistortPixel(const CameraIntrinsics& camera, const Eigen::Vector2d& raw);
+
+// The camera's centre in the apparatus frame (metres): −rotationᵀ·translation.
+Eigen::Vector3d CameraCentre(const CameraPose& pose);
+
+// The pose of a camera at `centre` looking at `target` (apparatus frame, metres), turned about
+// its optical axis so that `up` points up in the image (v decreasing). Throws InputError
+// ("camera pose") when centre = target or the viewing direction is parallel to `up`.
+CameraPose LookAtPose(const Eigen::Vector3d& centre, const Eigen::Vector3d& target,
+                      const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ());
+
+// Batch forms of the above (one OpenCV call for all points: a renderer maps every pixel of a
+// frame at once). Same contracts and accuracy as the single-point functions.
+std::vector<Eigen::Vector2d> ProjectApparatusPoints(const CameraIntrinsics& camera,
+                                                    const CameraPose& pose,
+                                                    const std::vector<Eigen::Vector3d>& points);
+std::vector<Eigen::Vector2d> UndistortPixels(const CameraIntrinsics& camera,
+                                             const std::vector<Eigen::Vector2d>& raw);
+
+// Throws InputError("<context>.<quantity>", rule) unless the intrinsics are usable: width and
+// height > 0, fx, fy > 0 and finite, cx, cy finite, 0, 4, 5 or 8 finite distortion coefficients.
+void ValidateIntrinsics(const CameraIntrinsics& camera, const std::string& context);
+
+// Files (formats documented in calibration/README.md; written atomically). Readers throw
+// InputError naming the file, the key and the rule broken (missing key, wrong type, a unit that
+// does not match, fx ≤ 0, a rotation that is not orthonormal, ...).
+//   camera file  "format": "uphill-camera/1": intrinsics + calibration diagnostics
+//   scene file   "format": "uphill-scene/1": the camera file's intrinsics + the pose
+CameraIntrinsics ReadCameraFile(const std::string& path);
+struct SceneCalibration {
+  CameraIntrinsics camera;
+  CameraPose pose;
+};
+SceneCalibration ReadSceneFile(const std::string& path);
+
+// How a calibration was obtained, stored in the files for the person who checks them; the
+// readers accept and ignore it (the numbers above are all the vision layer uses).
+struct CalibrationSummary {
+  std::string method;                // e.g. "chessboard 9x6 inner corners, 20 mm squares"
+  double rms_px = -1;                // RMS reprojection error, pixels; < 0: not applicable
+  std::string verdict;               // "good", "poor", or "exact" for a synthetic camera
+  std::vector<std::string> reasons;  // why the verdict (plain sentences)
+  std::vector<std::string> inputs;   // one line per view or point: what was used, rejected, why
+};
+// Throw std::runtime_error naming the path when the file cannot be written; InputError
+// (ValidateIntrinsics, or a rotation that is not orthonormal) before writing anything.
+void WriteCameraFile(const std::string& path, const CameraIntrinsics& camera,
+                     const CalibrationSummary& summary);
+void WriteSceneFile(const std::string& path, const SceneCalibration& scene,
+                    const CalibrationSummary& summary);
+
+}  // namespace uphill::vision

@@ -1,0 +1,152 @@
+// TrackAnalysis: what a measured ball track says about the motion, and the model fitted to it.
+//
+// Input: a Track (track_table.hpp: t, x, z per frame, lost frames kept as missing) and the Scene
+// of the apparatus. Output, SI throughout (m, s):
+//
+// Events, from the data alone (then refined by the fit where the fit knows better):
+//  - release: when the ball starts to move. σ is the stated position uncertainty u_x. Walking
+//    forward, a frame is "out" when it leaves the band |x − m| ≤ k·σ around m, the median of the
+//    frames before it (at most the first `reference_frames` of them: robust to an outlier and to
+//    a slow start), and `confirm_frames` consecutive frames stay out on the same side: one noisy
+//    frame is not a release. The position is the mean of the frames before, ± their scatter/√n
+//    (σ/√n when fewer than 3); the time is refined by the model fit (t0 ± its standard error):
+//    the band only says when the ball had moved k·σ, later than the release.
+//  - direction: +1 "up" (away from O, x grows), −1 "down" (toward O).
+//  - turning points: reversals of x found by a zigzag with the same k·σ threshold and
+//    confirmation on x smoothed by a running median of 2·confirm − 1 frames (a glitch is not an
+//    extreme), each refined by a least-squares parabola through the raw frames around the
+//    extremum, frames 4σ off it dropped (its vertex: time and position with standard errors from
+//    the parabola's covariance).
+//  - rest: the final position when the ball comes to rest (a tail of at least `rest_frames`
+//    frames in a k·σ band, found like the release walking backward, its z steady too, and not at
+//    the fall-off). The body creeps into its rest with a finite deceleration, so the tail is
+//    fitted as x_r after a changepoint t_r and x_r + c·(t_r − t)² before (least squares, t_r
+//    profiled over the frame times): x_r ± its standard error from the scatter, t_r. This is a
+//    measured Y for the fit report. A ball that never leaves its band is at rest from the first
+//    frame: rest (the mean ± scatter/√n), no release, no fit.
+//    Position estimates (release, rest) use the frames within min(k, 3)·σ, not k·σ: the wider
+//    band also holds the first frames of the motion.
+//  - fall-off: the motion ends up at x_max: the last frames found reach x_max within k·σ plus
+//    two frame steps (the tracker loses the ball as it drops, or follows it down at x ≈ x_max).
+//    Time from the fitted model (t0 + time to reach x_max, ± propagated) when the fit succeeds,
+//    else the first frame that close to x_max ± one frame interval.
+//
+// The model fit: x(t) of uphill::Motion released from rest at x0 at time t0 (held at x0 before
+// t0; after the model's end, fall-off or reaching O, held at the end position: the falling
+// ball's x stays at x_max, the path being vertical there) fitted to the measured x(t) by Ceres
+// (Levenberg–Marquardt, Huber loss at `huber_sigmas`·σ on the residuals in units of σ), with
+// parameters x0, t0 and either
+//   kEffectiveG  an effective g (μ = 0, quadrature): absorbs the rolling resistance and any
+//                error of the kinetic factor 1 + I/(mR*²) into one time scale; evaluated as
+//                x(t; g) = x(t·sqrt(g/g_ref); g_ref) on one Motion, since without friction g
+//                only scales time;
+//   kMu          the rolling resistance μ at the given g (ODE method, μ ≥ 0).
+// After a turning point the motion is a release from rest at the turning point (v = 0 there),
+// so the fit window starts at the last turning point (an initial push is not modelled). With
+// kEffectiveG a ball that comes to rest cannot be modelled (μ = 0 never stops): the window ends
+// where the rest begins, and a note says to fit μ.
+// Derivatives: central differences (ceres::NumericDiffCostFunction). Motion is a numerical
+// solution (adaptive quadrature, bracketed Newton, or Odeint with event location), not a
+// function templated on the scalar type, so ceres::Jet cannot flow through it; its tolerance in
+// the fit (1e-12 quadrature, 1e-10 ODE) is far below the relative step 1e-5, so the differences
+// carry ~1e-5 relative error at most, plenty for a covariance. Motions are cached by their
+// parameters: one Jacobian needs 5 of them, shared by all residual blocks.
+// Bounds (Problem::SetParameterLowerBound/UpperBound): x0 stays on the side of X given by the
+// measured direction (up: (X, x_max), down: (x_low, X), with a margin of 1e-4·x_max so that no
+// difference step crosses X, where the model's direction flips), g_eff > 0, μ ≥ 0; a μ that
+// would hold the ball at x0 makes the evaluation fail (Ceres then shortens the step).
+// Covariance: ceres::Covariance (dense SVD) of (x0, t0, g or μ); standard errors unscaled (from
+// the stated σ) and scaled by sqrt(χ²/ν); χ² and the RMS residual from the raw residuals.
+//
+// Accuracy (tests/vision_analysis_test.cpp): on tracks simulated by Motion (a 1-inch ball,
+// θ = 3°, α = 40°) with 0.3 mm Gaussian noise at 120 frames/s and lost frames, the fitted x0,
+// t0, g or μ, the turning and rest positions and the fall-off time lie within 4 standard errors
+// of the truth, with standard errors of the expected size (x0 ≈ σ/√n_rest ≈ 0.04 mm, t0 ≈ 3 ms,
+// g ≈ 2 %); over 30 noise realisations the pulls (estimate − truth)/se have an RMS of 0.87–1.02
+// (x0, t0, g; x0, t0, μ; turning points): the standard errors are the real scatter.
+// Cost: ~0.1 s for 100 frames (g), the μ fit by the ODE similar.
+//
+// Errors: InputError for an empty track, a track with no frame found, fewer than 2 frames found,
+// or options out of range (u_x ≤ 0, g ≤ 0, k ≤ 0 …). A track that cannot be fitted (the ball
+// never moves, too few frames in the window, a scene the chosen model does not cover) is not an
+// error: fit.available is false and fit.unavailable says why.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/scene.hpp"
+#include "vision/track_table.hpp"
+
+namespace uphill::vision {
+
+enum class TrackFitParameter { kEffectiveG, kMu };
+
+struct TrackAnalysisOptions {
+  double g = 9.80665;                                // m/s², the reference g (kMu: the g used)
+  TrackFitParameter fit = TrackFitParameter::kEffectiveG;
+  double u_x = 0.5e-3;                               // stated position uncertainty σ, m, > 0
+  double band_sigmas = 5.0;                          // k of the k·σ bands
+  int confirm_frames = 3;                            // consecutive frames that confirm a change
+  int reference_frames = 25;                         // frames of the release band's median
+  int rest_frames = 10;                              // a final rest lasts at least this many frames
+  double huber_sigmas = 3.0;                         // Huber loss threshold, in σ
+};
+
+// A measured or fitted value with its standard uncertainty (none when not meaningful).
+struct Estimate {
+  double value = 0;
+  std::optional<double> u;
+};
+
+struct TrackEvent {
+  std::string kind;    // "release", "turning point", "comes to rest", "falls off", "reaches O"
+  Estimate t, x;       // s, m
+  std::string method;  // how it was measured, in words
+};
+
+struct FittedParameter {
+  std::string name;    // "x0", "t0", "g" or "mu"
+  std::string unit;    // SI unit: "m", "s", "m/s2", ""
+  double value = 0;
+  std::optional<double> se, se_scaled;  // unscaled (stated σ) and scaled by sqrt(χ²/ν)
+};
+
+struct TrackFit {
+  bool available = false;
+  std::string unavailable;              // why not, when not available
+  std::string fitted;                   // "g" or "mu"
+  std::vector<FittedParameter> parameters;  // x0, t0, g|mu
+  std::optional<Eigen::Matrix3d> covariance;  // unscaled, order as parameters
+  double chi2 = 0, reduced_chi2 = 0, rms_residual = 0;  // rms in m
+  int dof = 0;
+  std::vector<double> t, measured, predicted;  // the frames of the window, s and m
+  std::vector<int> rows;                        // their CSV rows
+  std::vector<TrackEvent> model_events;         // events of the fitted motion, absolute times
+  std::vector<std::pair<double, double>> curve; // (t, x) of the fitted model, dense, for figures
+  int iterations = 0;
+  std::string termination;                      // Ceres' summary line
+  std::vector<std::string> notes;
+
+  const FittedParameter* Parameter(const std::string& name) const;
+};
+
+struct TrackAnalysis {
+  std::string source;
+  TrackAnalysisOptions options;
+  int frames = 0, found = 0;
+  double frame_interval = 0;                 // median Δt between consecutive frames, s
+  std::optional<double> scatter_at_rest;     // SD of x at the initial (or final) rest, m
+  int direction = 0;                         // +1 up (away from O), −1 down, 0 never moves
+  std::optional<TrackEvent> release, rest, fall_off, reaches_o;  // reaches_o: rolls back to x_low
+  std::vector<TrackEvent> turning_points;
+  TrackFit fit;
+  std::vector<std::string> notes;
+  std::vector<std::pair<double, double>> measured;  // (t, x) of every frame found
+};
+
+TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAnalysisOptions& options = {});
+
+}  // namespace uphill::vision

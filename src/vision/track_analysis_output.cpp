@@ -1,0 +1,202 @@
+#include "vision/track_analysis_output.hpp"
+
+#include <filesystem>
+#include <sstream>
+
+#include "io/atomic_file.hpp"
+#include "model/number_text.hpp"
+
+namespace uphill::vision {
+namespace {
+
+nlohmann::json Optional(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
+
+nlohmann::json Finite(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json EventJson(const std::optional<TrackEvent>& e) {
+  if (!e) return nullptr;
+  return {{"kind", e->kind}, {"t", Finite(e->t.value)}, {"u_t", Optional(e->t.u)}, {"x", Finite(e->x.value)},
+          {"u_x", Optional(e->x.u)}, {"method", e->method}};
+}
+
+std::string Num(double v) { return Printf("%.10g", v); }
+
+// "123.456 ± 0.012" with the uncertainty's scale deciding the digits.
+std::string WithU(double value, const std::optional<double>& u, double factor, const char* unit) {
+  if (!std::isfinite(value)) return "never";
+  std::string text = Printf("%.6f", value * factor);
+  if (u) text = Printf("%.6f", value * factor) + " ± " + Printf("%.2g", *u * factor);
+  return text + " " + unit;
+}
+
+}  // namespace
+
+std::string TrackAnalysisTable(const TrackAnalysis& a) {
+  std::ostringstream out;
+  out << "track " << a.source << ": " << a.found << " of " << a.frames << " frames with the ball";
+  if (a.frame_interval > 0) out << ", " << Printf("%.4g", 1.0 / a.frame_interval) << " frames/s";
+  out << "; u_x = " << Printf("%.3g", a.options.u_x * 1e3) << " mm";
+  if (a.scatter_at_rest) out << " (scatter at rest " << Printf("%.3g", *a.scatter_at_rest * 1e3) << " mm)";
+  out << "\n";
+  out << "direction: " << (a.direction > 0 ? "up (away from O)" : a.direction < 0 ? "down (toward O)" : "none (never moves)")
+      << "\n";
+  out << "events                 t [s]                       x [mm]                     how\n";
+  const auto row = [&](const std::optional<TrackEvent>& e) {
+    if (!e) return;
+    char line[512];
+    std::snprintf(line, sizeof line, "  %-20s %-27s %-26s %s\n", e->kind.c_str(),
+                  WithU(e->t.value, e->t.u, 1.0, "s").c_str(), WithU(e->x.value, e->x.u, 1e3, "mm").c_str(),
+                  e->method.c_str());
+    out << line;
+  };
+  row(a.release);
+  for (const auto& e : a.turning_points) row(e);
+  row(a.rest);
+  row(a.fall_off);
+  row(a.reaches_o);
+  if (a.rest) out << "  measured Y (rest position) = " << WithU(a.rest->x.value, a.rest->x.u, 1e3, "mm") << "\n";
+  const TrackFit& f = a.fit;
+  if (!f.available) {
+    out << "model fit: not available: " << f.unavailable << "\n";
+  } else {
+    out << "model fit (x0, t0, " << f.fitted << "; Huber loss at " << Printf("%.3g", a.options.huber_sigmas)
+        << " u_x), " << f.t.size() << " frames:\n";
+    out << "  parameter      value            se (from u_x)    se (scaled by sqrt(chi2/dof))\n";
+    for (const auto& p : f.parameters) {
+      const double factor = p.unit == "m" ? 1e3 : 1.0;
+      const std::string unit = p.unit == "m" ? "mm" : p.unit.empty() ? "1" : p.unit;
+      char line[256];
+      std::snprintf(line, sizeof line, "  %-6s %-7s %-16s %-16s %s\n", p.name.c_str(), ("[" + unit + "]").c_str(),
+                    Printf("%.8g", p.value * factor).c_str(), p.se ? Printf("%.3g", *p.se * factor).c_str() : "-",
+                    p.se_scaled ? Printf("%.3g", *p.se_scaled * factor).c_str() : "-");
+      out << line;
+    }
+    out << "  chi2 = " << Printf("%.4g", f.chi2) << ", dof = " << f.dof << ", chi2/dof = " << Printf("%.4g", f.reduced_chi2)
+        << ", RMS residual = " << Printf("%.3g", f.rms_residual * 1e3) << " mm\n";
+    for (const auto& e : f.model_events)
+      out << "  model: " << e.kind << " at t = " << WithU(e.t.value, e.t.u, 1.0, "s")
+          << ", x = " << WithU(e.x.value, e.x.u, 1e3, "mm") << "\n";
+  }
+  for (const auto& note : f.notes) out << "  * " << note << "\n";
+  for (const auto& note : a.notes) out << "* " << note << "\n";
+  return out.str();
+}
+
+nlohmann::json TrackAnalysisJson(const TrackAnalysis& a) {
+  nlohmann::json j;
+  j["format"] = "uphill-track-analysis/1";
+  j["source"] = a.source;
+  j["frames"] = a.frames;
+  j["found"] = a.found;
+  j["frame_interval"] = a.frame_interval;
+  j["u_x"] = a.options.u_x;
+  j["band_sigmas"] = a.options.band_sigmas;
+  j["g"] = a.options.g;
+  j["scatter_at_rest"] = Optional(a.scatter_at_rest);
+  j["direction"] = a.direction;
+  j["release"] = EventJson(a.release);
+  j["turning_points"] = nlohmann::json::array();
+  for (const auto& e : a.turning_points) j["turning_points"].push_back(EventJson(e));
+  j["rest"] = EventJson(a.rest);
+  j["y_measured"] = a.rest ? nlohmann::json(a.rest->x.value) : nlohmann::json(nullptr);
+  j["u_y_measured"] = a.rest ? Optional(a.rest->x.u) : nlohmann::json(nullptr);
+  j["fall_off"] = EventJson(a.fall_off);
+  j["reaches_o"] = EventJson(a.reaches_o);
+  const TrackFit& f = a.fit;
+  nlohmann::json fit;
+  fit["available"] = f.available;
+  if (!f.available) fit["unavailable"] = f.unavailable;
+  fit["fitted"] = f.fitted;
+  fit["parameters"] = nlohmann::json::object();
+  for (const auto& p : f.parameters)
+    fit["parameters"][p.name] = {{"value", p.value}, {"se", Optional(p.se)}, {"se_scaled", Optional(p.se_scaled)},
+                                 {"unit", p.unit}};
+  if (f.covariance) {
+    nlohmann::json c = nlohmann::json::array(), r = nlohmann::json::array();
+    for (int i = 0; i < 3; ++i) {
+      nlohmann::json crow = nlohmann::json::array(), rrow = nlohmann::json::array();
+      for (int k = 0; k < 3; ++k) {
+        crow.push_back((*f.covariance)(i, k));
+        rrow.push_back((*f.covariance)(i, k) / std::sqrt((*f.covariance)(i, i) * (*f.covariance)(k, k)));
+      }
+      c.push_back(crow);
+      r.push_back(rrow);
+    }
+    fit["covariance"] = c;
+    fit["correlation"] = r;
+  } else {
+    fit["covariance"] = nullptr;
+    fit["correlation"] = nullptr;
+  }
+  if (f.available) {
+    fit["chi2"] = f.chi2;
+    fit["dof"] = f.dof;
+    fit["reduced_chi2"] = f.reduced_chi2;
+    fit["rms_residual"] = f.rms_residual;
+    fit["n"] = f.t.size();
+    fit["iterations"] = f.iterations;
+    fit["termination"] = f.termination;
+  }
+  fit["model_events"] = nlohmann::json::array();
+  for (const auto& e : f.model_events) fit["model_events"].push_back(EventJson(e));
+  fit["frames"] = nlohmann::json::array();
+  for (std::size_t i = 0; i < f.t.size(); ++i)
+    fit["frames"].push_back({{"row", f.rows[i]}, {"t", f.t[i]}, {"x", f.measured[i]}, {"predicted", f.predicted[i]},
+                             {"residual", f.measured[i] - f.predicted[i]}});
+  fit["notes"] = f.notes;
+  j["fit"] = fit;
+  j["notes"] = a.notes;
+  return j;
+}
+
+std::vector<report::GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& a) {
+  std::vector<report::GnuplotFigure> figures;
+  report::GnuplotFigure x;
+  x.name = "track_x_vs_t";
+  x.title = "Measured x(t) against the fitted model";
+  x.caption = "Each point is one video frame where the ball was found (x of its centre in the apparatus frame); "
+              "the line is the model motion fitted to them (x0, t0 and " +
+              (a.fit.fitted.empty() ? std::string("g or mu") : a.fit.fitted) + ").";
+  std::ostringstream data;
+  data << "# t_s x_mm (every frame with the ball)\n";
+  for (const auto& [t, xv] : a.measured) data << Num(t) << " " << Num(xv * 1e3) << "\n";
+  data << "\n\n# t_s x_mm (fitted model)\n";
+  for (const auto& [t, xv] : a.fit.curve) data << Num(t) << " " << Num(xv * 1e3) << "\n";
+  x.data = data.str();
+  std::ostringstream plot;
+  plot << "set xlabel 't (s)'\nset ylabel 'x, centre (mm)'\nset offsets graph 0.02, graph 0.02, graph 0.05, graph 0.05\n"
+       << "plot '" << x.name << ".dat' index 0 using 1:2 with points pt 7 ps 0.5 lc rgb '#1f4e79' title 'measured'";
+  if (!a.fit.curve.empty())
+    plot << ", \\\n  '" << x.name << ".dat' index 1 using 1:2 with lines lw 2 lc rgb '#d62728' title 'fitted model'";
+  x.plot = plot.str();
+  figures.push_back(x);
+  if (a.fit.available) {
+    report::GnuplotFigure r;
+    r.name = "track_residuals";
+    r.title = "Residuals of the model fit";
+    r.caption = "Measured minus fitted x for every frame of the fit window, with the stated u_x as error bars. "
+                "Structure (a trend, a wave) means the model misses something.";
+    std::ostringstream rd;
+    rd << "# t_s residual_mm u_x_mm\n";
+    for (std::size_t i = 0; i < a.fit.t.size(); ++i)
+      rd << Num(a.fit.t[i]) << " " << Num((a.fit.measured[i] - a.fit.predicted[i]) * 1e3) << " "
+         << Num(a.options.u_x * 1e3) << "\n";
+    r.data = rd.str();
+    r.plot = "set xlabel 't (s)'\nset ylabel 'measured - fitted x (mm)'\n"
+             "set offsets graph 0.02, graph 0.02, graph 0.1, graph 0.1\n"
+             "plot 0 with lines lc rgb '#777777' notitle, \\\n  '" +
+             r.name + ".dat' using 1:2:3 with yerrorbars pt 7 ps 0.5 lc rgb '#1f4e79' title sprintf('RMS %.3g mm', " +
+             Num(a.fit.rms_residual * 1e3) + ")";
+    figures.push_back(r);
+  }
+  return figures;
+}
+
+void WriteTrackAnalysis(const TrackAnalysis& analysis, const std::string& directory) {
+  std::filesystem::create_directories(directory);
+  io::WriteFileAtomically((std::filesystem::path(directory) / "track_analysis.json").string(),
+                          TrackAnalysisJson(analysis).dump(2) + "\n");
+  for (const auto& figure : TrackAnalysisFigures(analysis)) report::RenderFigure(figure, directory);
+}
+
+}  // namespace uphill::vision

@@ -1,0 +1,27 @@
+// The outputs of a TrackAnalysis (track_analysis.hpp), shared by `uphill analyse-track` and
+// `uphill track … --analyse`:
+//   TrackAnalysisTable    the events and the fit as a plain-text table, lengths in mm, times in s
+//   TrackAnalysisJson     track_analysis.json, format "uphill-track-analysis/1", SI units; keys
+//                         documented in data/README.md, "Track analysis output"
+//   TrackAnalysisFigures  track_x_vs_t (measured x(t) against the fitted model) and
+//                         track_residuals (measured − predicted, mm), drawn by gnuplot
+//   WriteTrackAnalysis    all of them into a directory (created if missing), each file atomically
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "report/gnuplot_figure.hpp"
+#include "vision/track_analysis.hpp"
+
+namespace uphill::vision {
+
+std::string TrackAnalysisTable(const TrackAnalysis& analysis);
+nlohmann::json TrackAnalysisJson(const TrackAnalysis& analysis);
+std::vector<report::GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& analysis);
+// Writes DIR/track_analysis.json and the figures (.dat, .gp, .svg, .png). Throws
+// std::runtime_error when a file cannot be written or gnuplot fails.
+void WriteTrackAnalysis(const TrackAnalysis& analysis, const std::string& directory);
+
+}  // namespace uphill::vision

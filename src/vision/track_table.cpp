@@ -1,0 +1,97 @@
+#include "vision/track_table.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "io/csv_table.hpp"
+#include "io/units.hpp"
+#include "model/input_error.hpp"
+#include "model/number_text.hpp"
+
+namespace uphill::vision {
+namespace {
+
+bool Blank(const std::string& cell) {
+  return std::all_of(cell.begin(), cell.end(), [](char c) { return c == ' ' || c == '\t' || c == '\r'; });
+}
+
+// A plain number (the format fixes the units), via the project's one number parser.
+double Number(const io::CsvTable& table, const io::CsvRow& row, int column) {
+  return io::ParseQuantity(row.cells[column], io::Dimension::kDimensionless,
+                           io::CellContext(table, row.row, table.header[column]));
+}
+
+void Require(bool ok, const io::CsvTable& table, const io::CsvRow& row, int column, const std::string& rule) {
+  if (!ok) throw InputError(io::CellContext(table, row.row, table.header[column]), rule);
+}
+
+Track FromTable(const io::CsvTable& table) {
+  const auto& columns = TrackColumns();
+  bool header_ok = table.header.size() >= columns.size();
+  for (std::size_t c = 0; header_ok && c < columns.size(); ++c) header_ok = table.header[c] == columns[c];
+  if (!header_ok)
+    throw InputError(table.source + ", row 1",
+                     "the header must start with frame,t,u,v,radius_px,x,z,quality (a track written by uphill track)");
+  enum { kFrame, kT, kU, kV, kRadius, kX, kZ, kQuality };
+  Track track;
+  track.source = table.source;
+  for (const io::CsvRow& row : table.rows) {
+    if (!row.error.empty()) throw InputError(table.source + ", row " + std::to_string(row.row), row.error);
+    TrackFrame f;
+    f.row = row.row;
+    const double frame = Number(table, row, kFrame);
+    Require(frame >= 0 && frame == std::floor(frame) && frame < 1e15, table, row, kFrame,
+            "must be a whole number >= 0 (got " + row.cells[kFrame] + ")");
+    f.frame = static_cast<long>(frame);
+    f.t = Number(table, row, kT);
+    if (!track.frames.empty()) {
+      const TrackFrame& previous = track.frames.back();
+      Require(f.frame > previous.frame, table, row, kFrame,
+              "frame numbers must increase (row " + std::to_string(previous.row) + " has frame " +
+                  std::to_string(previous.frame) + ")");
+      Require(f.t > previous.t, table, row, kT,
+              "times must increase (row " + std::to_string(previous.row) + " has t = " + ExactText(previous.t) + " s)");
+    }
+    int blank = 0;
+    for (int c = kU; c <= kZ; ++c) blank += Blank(row.cells[c]);
+    const bool quality_blank = Blank(row.cells[kQuality]);
+    f.quality = quality_blank ? 0.0 : Number(table, row, kQuality);
+    Require(f.quality >= 0.0 && f.quality <= 1.0, table, row, kQuality,
+            "must be in [0, 1] (got " + row.cells[kQuality] + ")");
+    if (blank == kZ - kU + 1) {
+      Require(f.quality == 0.0, table, row, kQuality,
+              "must be 0 in a frame without a position (u, v, radius_px, x, z are empty)");
+    } else {
+      for (int c = kU; c <= kZ; ++c)
+        Require(!Blank(row.cells[c]), table, row, c,
+                "is empty while other position fields are filled (a lost frame leaves u, v, radius_px, x, z all empty)");
+      Require(!quality_blank, table, row, kQuality, "is empty in a frame with a position");
+      f.u = Number(table, row, kU);
+      f.v = Number(table, row, kV);
+      f.radius_px = Number(table, row, kRadius);
+      Require(f.radius_px > 0.0, table, row, kRadius, "must be > 0 (got " + row.cells[kRadius] + ")");
+      f.x = Number(table, row, kX) * 1e-3;
+      f.z = Number(table, row, kZ) * 1e-3;
+      f.found = f.quality > 0.0;
+    }
+    track.frames.push_back(f);
+  }
+  return track;
+}
+
+}  // namespace
+
+const std::vector<std::string>& TrackColumns() {
+  static const std::vector<std::string> columns = {"frame", "t", "u", "v", "radius_px", "x", "z", "quality"};
+  return columns;
+}
+
+std::size_t Track::found_count() const {
+  return static_cast<std::size_t>(std::count_if(frames.begin(), frames.end(), [](const TrackFrame& f) { return f.found; }));
+}
+
+Track ReadTrack(std::istream& in, const std::string& source) { return FromTable(io::ReadCsv(in, source)); }
+
+Track ReadTrackFile(const std::string& path) { return FromTable(io::ReadCsvFile(path)); }
+
+}  // namespace uphill::vision

@@ -1,0 +1,53 @@
+// Track: the ball's measured positions, one row per video frame, as `uphill track` writes them
+// (and `uphill analyse-track` reads them).
+//
+// CSV format (the one `uphill track` writes, issue 5): the header starts exactly with
+//   frame,t,u,v,radius_px,x,z,quality
+// and may have more columns after these (ignored here). frame: integer ≥ 0, strictly increasing;
+// t: seconds from the container's timestamps, finite, strictly increasing; u, v: the projected
+// ball centre in raw pixels; radius_px: pixels, > 0; x, z: the centre in millimetres in the
+// apparatus frame (PHYSICS.md); quality: a confidence in [0, 1]. Cells are plain numbers (the
+// units are fixed by the format, not written in the cells).
+//
+// Lost frames: a frame where the ball was not found keeps its row with t filled, u … z empty and
+// quality 0. It is kept here as a frame with found = false: never interpolated, never invented.
+// A row with some of u … z empty and others filled, or with quality > 0 and empty positions, is
+// an error (the tracker either found the ball or did not). A frame with positions but quality 0
+// is read as lost (zero confidence), its numbers ignored.
+//
+// Errors: InputError naming the file, the spreadsheet row (header = row 1) and the column with
+// the rule broken, for the first bad row; the whole file is refused, since a track with a broken
+// row is not a track one should trust. Units: the Track holds SI (x, z in metres, t in seconds).
+#pragma once
+
+#include <istream>
+#include <string>
+#include <vector>
+
+namespace uphill::vision {
+
+struct TrackFrame {
+  int row = 0;         // spreadsheet row of the CSV (header = 1), for messages
+  long frame = 0;      // frame number, from 0
+  double t = 0;        // s
+  bool found = false;  // false: the ball was not found in this frame (fields below unused)
+  double u = 0, v = 0, radius_px = 0;  // raw pixels
+  double x = 0, z = 0;                  // m, apparatus frame
+  double quality = 0;                   // (0, 1] when found
+};
+
+struct Track {
+  std::string source;  // file name or "<stdin>"
+  std::vector<TrackFrame> frames;
+
+  std::size_t found_count() const;
+};
+
+// The exact leading columns of the format.
+const std::vector<std::string>& TrackColumns();
+
+Track ReadTrack(std::istream& in, const std::string& source);
+// Opens `path` ("-" reads stdin); InputError naming the file when it cannot be read.
+Track ReadTrackFile(const std::string& path);
+
+}  // namespace uphill::vision

@@ -1,0 +1,168 @@
+#include "vision/video_tracking.hpp"
+
+#include <time.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <optional>
+#include <sstream>
+
+#include "io/atomic_file.hpp"
+#include "model/input_error.hpp"
+
+namespace uphill::vision {
+namespace {
+
+double ThreadCpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+std::string Size(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+// The scene's centre path and the fitted outline and centre, drawn on a copy of the frame.
+void DrawOverlay(cv::Mat& frame, const BallTracker& tracker, const std::vector<cv::Point>& path, const BallObservation& b) {
+  cv::polylines(frame, path, false, cv::Scalar(255, 200, 0), 1, cv::LINE_AA, 4);
+  if (!b.found) {
+    cv::putText(frame, "ball not found", cv::Point(20, 40), cv::FONT_HERSHEY_SIMPLEX, 1.0, cv::Scalar(0, 0, 255), 2);
+    return;
+  }
+  std::vector<cv::Point> outline;
+  for (const Eigen::Vector2d& p : tracker.Outline(b.x, b.z, 72))
+    outline.emplace_back(static_cast<int>(std::lround(p.x() * 16)), static_cast<int>(std::lround(p.y() * 16)));
+  cv::polylines(frame, outline, true, cv::Scalar(0, 255, 0), 1, cv::LINE_AA, 4);
+  cv::drawMarker(frame, cv::Point(static_cast<int>(std::lround(b.u)), static_cast<int>(std::lround(b.v))),
+                 cv::Scalar(0, 255, 255), cv::MARKER_CROSS, 10, 1);
+  char text[96];
+  std::snprintf(text, sizeof text, "x = %.1f mm  z = %.1f mm  q = %.2f", b.x * 1e3, b.z * 1e3, b.quality);
+  cv::putText(frame, text, cv::Point(20, 40), cv::FONT_HERSHEY_SIMPLEX, 0.8, cv::Scalar(0, 255, 0), 2);
+}
+
+}  // namespace
+
+TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const SceneCalibration& calibration,
+                       const TrackVideoOptions& options) {
+  if (!std::filesystem::is_regular_file(video_path)) throw InputError(video_path, "no such video file");
+  cv::VideoCapture capture;
+  try {
+    capture.open(video_path, cv::CAP_FFMPEG);
+  } catch (const cv::Exception&) {
+  }
+  if (!capture.isOpened()) throw InputError(video_path, "is not a video that OpenCV/FFmpeg can read");
+  TrackResult result;
+  result.fps = capture.get(cv::CAP_PROP_FPS);
+  const double count = capture.get(cv::CAP_PROP_FRAME_COUNT);
+  result.declared_frames = count > 0 && std::isfinite(count) ? static_cast<long>(std::llround(count)) : 0;
+  const int width = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_WIDTH));
+  const int height = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_HEIGHT));
+  if (width != calibration.camera.width || height != calibration.camera.height)
+    throw InputError(options.calibration_name, "is for " + Size(calibration.camera.width, calibration.camera.height) +
+                                                   " px images but " + video_path + " has " + Size(width, height) +
+                                                   " px frames (calibrate the camera at the video's resolution)");
+  BallTracker tracker(scene, calibration, options.tracker);
+
+  std::optional<cv::VideoWriter> overlay;
+  std::vector<cv::Point> path;
+  if (!options.overlay_path.empty()) {
+    overlay.emplace(options.overlay_path, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('a', 'v', 'c', '1'),
+                    result.fps > 0 ? result.fps : 30.0, cv::Size(width, height));
+    if (!overlay->isOpened()) throw std::runtime_error(options.overlay_path + ": cannot open the overlay video for writing");
+    std::vector<Eigen::Vector3d> points;
+    for (int i = 0; i <= 200; ++i) {
+      const double x = scene.x_low() + (scene.x_max() - scene.x_low()) * i / 200.0;
+      points.emplace_back(x, 0, scene.At(x).z);
+    }
+    for (const Eigen::Vector2d& p : ProjectApparatusPoints(calibration.camera, calibration.pose, points))
+      path.emplace_back(static_cast<int>(std::lround(p.x() * 16)), static_cast<int>(std::lround(p.y() * 16)));
+  }
+
+  const double period = result.fps > 0 ? 1.0 / result.fps : 1.0 / 30.0;
+  cv::Mat frame;
+  bool read_error = false;
+  while (true) {
+    bool ok = false;
+    try {
+      ok = capture.read(frame);
+    } catch (const cv::Exception&) {
+      read_error = true;
+    }
+    if (!ok || frame.empty()) break;
+    TrackRow row;
+    row.frame = static_cast<int>(result.rows.size());
+    double t = capture.get(cv::CAP_PROP_POS_MSEC) * 1e-3;
+    if (!result.rows.empty() && !(t > result.rows.back().t)) {
+      t = result.rows.back().t + period;
+      ++result.extrapolated_times;
+    }
+    row.t = t;
+    const double cpu0 = ThreadCpuSeconds();
+    row.ball = tracker.Track(frame);
+    result.tracker_cpu_seconds += ThreadCpuSeconds() - cpu0;
+    if (overlay) {
+      DrawOverlay(frame, tracker, path, row.ball);
+      overlay->write(frame);
+    }
+    result.rows.push_back(row);
+    if (options.progress) options.progress(static_cast<int>(result.rows.size()), result.declared_frames);
+  }
+  if (result.rows.empty())
+    throw InputError(video_path, "has no frame that can be decoded (not a video, or corrupt from the start)");
+  int found = 0, last_found = -1;
+  for (const TrackRow& r : result.rows)
+    if (r.ball.found) ++found, last_found = r.frame;
+  if (found == 0)
+    throw InputError(video_path, "no ball found in any of its " + std::to_string(result.rows.size()) +
+                                     " frames along the rails' path (check the scene file and the body flags)");
+  const long read = static_cast<long>(result.rows.size());
+  if (read_error || (result.declared_frames > 0 && read < result.declared_frames - 1)) {
+    result.partial = true;
+    result.partial_reason = "the video ends after " + std::to_string(read) + " of the " +
+                            std::to_string(result.declared_frames) + " frames its container declares (truncated or corrupt)";
+  } else if (last_found + 1 < read) {
+    result.partial = true;
+    result.partial_reason = "the ball was lost after frame " + std::to_string(last_found) + " and not found again in the last " +
+                            std::to_string(read - last_found - 1) + " frames";
+  }
+  return result;
+}
+
+void WriteTrack(const std::string& csv_path, const TrackResult& result, const TrackSources& sources) {
+  std::ostringstream csv;
+  csv << "frame,t,u,v,radius_px,x,z,quality\n";
+  char line[256];
+  for (const TrackRow& r : result.rows) {
+    if (r.ball.found)
+      std::snprintf(line, sizeof line, "%d,%.6f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", r.frame, r.t, r.ball.u, r.ball.v,
+                    r.ball.radius_px, r.ball.x * 1e3, r.ball.z * 1e3, std::max(1e-4, r.ball.quality));
+    else
+      std::snprintf(line, sizeof line, "%d,%.6f,,,,,,0\n", r.frame, r.t);
+    csv << line;
+  }
+  int found = 0;
+  for (const TrackRow& r : result.rows) found += r.ball.found;
+  nlohmann::ordered_json side = {{"format", "uphill-track/1"},
+                                 {"video", sources.video},
+                                 {"camera", sources.camera},
+                                 {"scene", sources.scene},
+                                 {"body", sources.body},
+                                 {"frames", result.rows.size()},
+                                 {"declared_frames", result.declared_frames},
+                                 {"frames_with_ball", found},
+                                 {"fps", result.fps},
+                                 {"extrapolated_timestamps", result.extrapolated_times},
+                                 {"partial", result.partial}};
+  if (result.partial) side["partial_reason"] = result.partial_reason;
+  const std::filesystem::path folder = std::filesystem::path(csv_path).parent_path();
+  std::error_code ec;
+  if (!folder.empty()) std::filesystem::create_directories(folder, ec);
+  if (ec) throw std::runtime_error(folder.string() + ": cannot create the folder: " + ec.message());
+  io::WriteFileAtomically(csv_path, csv.str());
+  io::WriteFileAtomically(csv_path + ".json", side.dump(2) + "\n");
+}
+
+}  // namespace uphill::vision

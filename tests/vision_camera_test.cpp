@@ -1,0 +1,214 @@
+// The camera model (src/vision/camera.hpp): projection against a hand computation, the
+// undistortion round trip, the camera and scene files (round trip and refusals).
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "model/input_error.hpp"
+#include "vision/camera.hpp"
+#include "vision_test_support.hpp"
+
+namespace uphill::vision {
+namespace {
+
+namespace fs = std::filesystem;
+
+CameraIntrinsics Camera1280(std::vector<double> distortion) {
+  return {1280, 720, 1000, 1002, 641.5, 358.25, std::move(distortion)};
+}
+
+// A camera 1.2 m behind and 0.45 m above O, looking down the rails.
+CameraPose LabPose() { return LookAtPose({-0.6, 0.05, 0.5}, {0.5, 0, 0.1}); }
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("uphill_vision_camera_test_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+void WriteText(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+
+TEST(CameraModel, ProjectsWithoutDistortionAsThePinholeFormula) {
+  const CameraIntrinsics c = Camera1280({});
+  // (0.1, −0.05, 2) m: u = fx·x/z + cx = 1000·0.05 + 641.5 = 691.5, v = 1002·(−0.025) + 358.25 = 333.2
+  const Eigen::Vector2d p = ProjectCameraPoint(c, {0.1, -0.05, 2.0});
+  EXPECT_NEAR(p.x(), 691.5, 1e-9);
+  EXPECT_NEAR(p.y(), 333.2, 1e-9);
+  const Eigen::Vector2d n = UndistortPixel(c, p);
+  EXPECT_NEAR(n.x(), 0.05, 1e-12);
+  EXPECT_NEAR(n.y(), -0.025, 1e-12);
+}
+
+TEST(CameraModel, ProjectsWithRadialDistortionAsOpenCVsFormula) {
+  // k1 = −0.1, k2 = 0.02 at (x, y) = (0.3, 0.2): r² = 0.13, factor 1 − 0.013 + 0.02·0.0169
+  const CameraIntrinsics c = Camera1280({-0.1, 0.02, 0, 0, 0});
+  const double factor = 1 - 0.1 * 0.13 + 0.02 * 0.13 * 0.13;
+  const Eigen::Vector2d p = ProjectCameraPoint(c, {0.3, 0.2, 1.0});
+  EXPECT_NEAR(p.x(), 1000 * 0.3 * factor + 641.5, 1e-9);
+  EXPECT_NEAR(p.y(), 1002 * 0.2 * factor + 358.25, 1e-9);
+}
+
+TEST(CameraModel, UndistortionRoundTripIsBelowAMicroPixelOverTheWholeImage) {
+  for (const auto& distortion : std::vector<std::vector<double>>{
+           {}, {-0.1, 0.0, 0, 0}, {-0.3, 0.12, 0.001, -0.0015, -0.02}, {0.15, -0.05, 0, 0, 0.01}}) {
+    const CameraIntrinsics c = Camera1280(distortion);
+    std::vector<Eigen::Vector2d> pixels;
+    for (double u = 0; u <= c.width - 1; u += (c.width - 1) / 16.0)
+      for (double v = 0; v <= c.height - 1; v += (c.height - 1) / 9.0) pixels.emplace_back(u, v);
+    const std::vector<Eigen::Vector2d> rays = UndistortPixels(c, pixels);
+    double worst = 0;
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      const Eigen::Vector2d back = ProjectCameraPoint(c, {rays[i].x(), rays[i].y(), 1.0});
+      worst = std::max(worst, (back - pixels[i]).norm());
+      // The single-point form agrees with the batch form.
+      if (i % 37 == 0) {
+        EXPECT_LT((UndistortPixel(c, pixels[i]) - rays[i]).norm(), 1e-15);
+      }
+    }
+    EXPECT_LT(worst, 1e-6) << "distortion with " << distortion.size() << " coefficients";
+  }
+}
+
+TEST(CameraModel, ApparatusPointsProjectThroughThePose) {
+  const CameraIntrinsics c = Camera1280({-0.1, 0.01, 0, 0, 0});
+  const CameraPose pose = LabPose();
+  EXPECT_LT((CameraCentre(pose) - Eigen::Vector3d(-0.6, 0.05, 0.5)).norm(), 1e-12);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> x(0, 1), y(-0.1, 0.1), z(0, 0.3);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 50; ++i) points.emplace_back(x(rng), y(rng), z(rng));
+  const auto pixels = ProjectApparatusPoints(c, pose, points);
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_LT((ProjectApparatusPoint(c, pose, points[i]) - pixels[i]).norm(), 1e-12);
+    // The viewing ray of the pixel passes through the point.
+    const Eigen::Vector2d n = UndistortPixel(c, pixels[i]);
+    const Eigen::Vector3d ray = pose.rotation.transpose() * Eigen::Vector3d(n.x(), n.y(), 1).normalized();
+    const Eigen::Vector3d to_point = points[i] - CameraCentre(pose);
+    EXPECT_LT(to_point.cross(ray).norm(), 1e-9);  // distance of the point from the ray, metres
+  }
+}
+
+TEST(CameraModel, LookAtPoseLooksAtTheTargetWithUpUpward) {
+  const CameraIntrinsics c = Camera1280({});
+  const CameraPose pose = LookAtPose({0.6, -1.3, 0.4}, {0.55, 0, 0.12});
+  EXPECT_LT((pose.rotation * pose.rotation.transpose() - Eigen::Matrix3d::Identity()).norm(), 1e-14);
+  EXPECT_NEAR(pose.rotation.determinant(), 1, 1e-14);
+  // The target is on the optical axis: at the principal point.
+  EXPECT_LT((ProjectApparatusPoint(c, pose, {0.55, 0, 0.12}) - Eigen::Vector2d(c.cx, c.cy)).norm(), 1e-9);
+  // A point above the target is higher in the image (smaller v), +x is to the right from −y.
+  EXPECT_LT(ProjectApparatusPoint(c, pose, {0.55, 0, 0.2}).y(), c.cy - 10);
+  EXPECT_GT(ProjectApparatusPoint(c, pose, {0.65, 0, 0.12}).x(), c.cx + 10);
+  EXPECT_NE(InputErrorOf([] { LookAtPose({0, 0, 1}, {0, 0, 0}); }).find("parallel"), std::string::npos);
+  EXPECT_NE(InputErrorOf([] { LookAtPose({0, 0, 1}, {0, 0, 1}); }).find("differ"), std::string::npos);
+}
+
+TEST(CameraModel, PointsBehindTheCameraAreRefused) {
+  const CameraIntrinsics c = Camera1280({});
+  EXPECT_NE(InputErrorOf([&] { ProjectCameraPoint(c, {0, 0, -1}); }).find("in front of the camera"),
+            std::string::npos);
+  EXPECT_NE(InputErrorOf([&] { ProjectCameraPoint(c, {0, 0, 0}); }), "");
+  EXPECT_NE(InputErrorOf([&] { ProjectCameraPoint(c, {NAN, 0, 1}); }), "");
+}
+
+TEST(CameraFiles, CameraAndSceneRoundTripExactly) {
+  const fs::path dir = TempDir("round_trip");
+  const CameraIntrinsics c = Camera1280({-0.1234567890123, 0.01, 1e-4, -2e-4, 0.003});
+  CalibrationSummary summary;
+  summary.method = "test";
+  summary.rms_px = 0.2;
+  summary.verdict = "good";
+  WriteCameraFile((dir / "cam.json").string(), c, summary);
+  const CameraIntrinsics r = ReadCameraFile((dir / "cam.json").string());
+  EXPECT_EQ(r.width, c.width);
+  EXPECT_EQ(r.height, c.height);
+  EXPECT_EQ(r.fx, c.fx);
+  EXPECT_EQ(r.fy, c.fy);
+  EXPECT_EQ(r.cx, c.cx);
+  EXPECT_EQ(r.cy, c.cy);
+  EXPECT_EQ(r.distortion, c.distortion);
+
+  SceneCalibration scene{c, LabPose()};
+  WriteSceneFile((dir / "scene.json").string(), scene, summary);
+  const SceneCalibration s = ReadSceneFile((dir / "scene.json").string());
+  EXPECT_EQ(s.camera.fx, c.fx);
+  EXPECT_EQ(s.camera.distortion, c.distortion);
+  EXPECT_EQ(s.pose.rotation, scene.pose.rotation);
+  EXPECT_EQ(s.pose.translation, scene.pose.translation);
+  fs::remove_all(dir);
+}
+
+TEST(CameraFiles, BadFilesAreRefusedNamingFileKeyAndRule) {
+  const fs::path dir = TempDir("bad");
+  const std::string good_intrinsics =
+      R"("image_width_px": 1280, "image_height_px": 720, "fx_px": 1000, "fy_px": 1000,
+         "cx_px": 640, "cy_px": 360, "distortion": [-0.1, 0, 0, 0])";
+  struct Case {
+    std::string content, expected;
+  };
+  const std::vector<Case> cases = {
+      {"{", "is not valid JSON"},
+      {R"({"format": "uphill-scene/1", )" + good_intrinsics + "}", "format: must be \"uphill-camera/1\""},
+      {R"({"format": "uphill-camera/1", "image_width_px": 1280})", "image_height_px: is missing"},
+      {R"({"format": "uphill-camera/1", "image_width_px": 1280, "image_height_px": 720, "fx_px": -5,
+          "fy_px": 1000, "cx_px": 640, "cy_px": 360})", "fx: must be > 0"},
+      {R"({"format": "uphill-camera/1", "image_width_px": 1280.5, "image_height_px": 720, "fx_px": 1,
+          "fy_px": 1000, "cx_px": 640, "cy_px": 360})", "image_width_px: must be a positive whole number"},
+      {R"({"format": "uphill-camera/1", "image_width_px": 1280, "image_height_px": 720, "fx_mm": 5,
+          "fy_px": 1000, "cx_px": 640, "cy_px": 360})", "fx_mm: unit does not match"},
+      {R"({"format": "uphill-camera/1", "colour": 1, )" + good_intrinsics + "}", "colour: unknown key"},
+      {R"({"format": "uphill-camera/1", "image_width_px": 1280, "image_height_px": 720, "fx_px": 1000,
+          "fy_px": 1000, "cx_px": "640", "cy_px": 360})", "cx_px: must be a number"},
+      {R"({"format": "uphill-camera/1", "image_width_px": 1280, "image_height_px": 720, "fx_px": 1000,
+          "fy_px": 1000, "cx_px": 640, "cy_px": 360, "distortion": [0.1, 0.2]})",
+       "must hold 0, 4, 5 or 8 coefficients"},
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const std::string path = (dir / ("cam" + std::to_string(i) + ".json")).string();
+    WriteText(path, cases[i].content);
+    const std::string message = InputErrorOf([&] { ReadCameraFile(path); });
+    EXPECT_NE(message.find(path), std::string::npos) << message;
+    EXPECT_NE(message.find(cases[i].expected), std::string::npos) << "case " << i << ": " << message;
+  }
+  EXPECT_NE(InputErrorOf([&] { ReadCameraFile((dir / "absent.json").string()); }).find("cannot be opened"),
+            std::string::npos);
+
+  const std::string scene_head = R"({"format": "uphill-scene/1", "camera": {)" + good_intrinsics + "}, ";
+  const std::vector<Case> scene_cases = {
+      {scene_head + R"("pose": {"rotation": [[1,0,0],[0,1,0],[0,0,1.1]], "translation_m": [0,0,1]}})",
+       "rotation: is not orthonormal"},
+      {scene_head + R"("pose": {"rotation": [[1,0,0],[0,1,0],[0,0,-1]], "translation_m": [0,0,1]}})",
+       "rotation: is a reflection"},
+      {scene_head + R"("pose": {"rotation": [[1,0,0],[0,1,0],[0,0,1]], "translation_mm": [0,0,1]}})",
+       "translation_mm: unit does not match"},
+      {scene_head + R"("pose": {"rotation": [[1,0,0],[0,1,0]], "translation_m": [0,0,1]}})",
+       "rotation: must be 3 rows of 3 numbers"},
+      {scene_head + R"("pose": {"rotation": [[1,0,0],[0,1,0],[0,0,1]], "translation_m": [0,0,1]},
+          "camera_centre_m": [0, 0, 1]})",
+       "camera_centre_m: does not match the pose"},
+      {R"({"format": "uphill-scene/1", "pose": {}})", "camera: is missing"},
+  };
+  for (size_t i = 0; i < scene_cases.size(); ++i) {
+    const std::string path = (dir / ("scene" + std::to_string(i) + ".json")).string();
+    WriteText(path, scene_cases[i].content);
+    const std::string message = InputErrorOf([&] { ReadSceneFile(path); });
+    EXPECT_NE(message.find(scene_cases[i].expected), std::string::npos) << "case " << i << ": " << message;
+  }
+  // A camera without distortion is valid; a writer refuses invalid intrinsics before writing.
+  const std::string path = (dir / "plain.json").string();
+  WriteText(path, R"({"format": "uphill-camera/1", "image_width_px": 640, "image_height_px": 480,
+                      "fx_px": 500, "fy_px": 500, "cx_px": 320, "cy_px": 240})");
+  EXPECT_TRUE(ReadCameraFile(path).distortion.empty());
+  CameraIntrinsics bad = Camera1280({});
+  bad.fy = 0;
+  EXPECT_NE(InputErrorOf([&] { WriteCameraFile((dir / "never.json").string(), bad, {}); }), "");
+  EXPECT_FALSE(fs::exists(dir / "never.json"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace uphill::vision

@@ -1,0 +1,253 @@
+// The ball tracker on synthetic clips rendered at test time (src/vision/synthetic_clip.hpp):
+// accuracy against the exact ground truth, lost frames, partial and bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "model/input_error.hpp"
+#include "vision/synthetic_clip.hpp"
+#include "vision/video_tracking.hpp"
+
+namespace uphill::vision {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path TempDir() {
+  static const fs::path dir = [] {
+    const fs::path d = fs::temp_directory_path() / ("uphill_vision_track_test_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+// Removes the clips when the program ends.
+class RemoveTempDir : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(TempDir(), ec);
+  }
+};
+const auto* const kRemoveTempDir = ::testing::AddGlobalTestEnvironment(new RemoveTempDir);
+
+struct Errors {
+  double rms_uv = 0, rms_xz_mm = 0, max_uv = 0;
+  int compared = 0, truth_present = 0, found = 0;
+};
+
+// Frames where the ball is present and at least half its outline is visible are compared.
+Errors Compare(const std::vector<ClipTruth>& truth, const TrackResult& track) {
+  Errors e;
+  double s_uv = 0, s_xz = 0;
+  for (size_t i = 0; i < truth.size() && i < track.rows.size(); ++i) {
+    const ClipTruth& t = truth[i];
+    const BallObservation& b = track.rows[i].ball;
+    e.truth_present += t.present;
+    e.found += b.found;
+    if (!t.present || t.visibility < 0.5 || !b.found) continue;
+    const double duv2 = std::pow(b.u - t.u, 2) + std::pow(b.v - t.v, 2);
+    s_uv += duv2;
+    e.max_uv = std::max(e.max_uv, std::sqrt(duv2));
+    s_xz += (std::pow(b.x - t.x, 2) + std::pow(b.z - t.z, 2)) * 1e6;
+    ++e.compared;
+  }
+  if (e.compared) {
+    e.rms_uv = std::sqrt(s_uv / e.compared);
+    e.rms_xz_mm = std::sqrt(s_xz / e.compared);
+  }
+  std::printf("  compared %d frames: RMS (u, v) %.4f px (max %.4f), RMS (x, z) %.4f mm\n", e.compared, e.rms_uv,
+              e.max_uv, e.rms_xz_mm);
+  return e;
+}
+
+struct ClipRun {
+  std::vector<ClipTruth> truth;
+  TrackResult track;
+  Errors errors;
+};
+
+ClipRun RenderAndTrack(const ClipRenderer& renderer, const Scene& scene, const Motion& motion, const ClipSettings& s,
+                   const std::string& file, const TrackVideoOptions& options = {}) {
+  ClipRun run;
+  const std::string video = (TempDir() / file).string();
+  run.truth = RenderClip(renderer, motion, s, video);
+  run.track = TrackVideo(video, scene, renderer.calibration(), options);
+  run.errors = Compare(run.truth, run.track);
+  return run;
+}
+
+// Found wherever the ball is in the picture; compared in at least min_frames; within the bounds.
+void ExpectAccurate(const Errors& e, int min_frames, double max_rms_uv_px, double max_rms_xz_mm = 0.5) {
+  EXPECT_EQ(e.found, e.truth_present);
+  EXPECT_GE(e.compared, min_frames);
+  EXPECT_LE(e.rms_uv, max_rms_uv_px) << "max " << e.max_uv;
+  EXPECT_LE(e.rms_xz_mm, max_rms_xz_mm);
+}
+
+// f() throws InputError whose message contains each of `parts`.
+template <typename F>
+void ExpectInputError(F&& f, const std::vector<std::string>& parts) {
+  try {
+    f();
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    for (const std::string& part : parts) EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
+}
+
+// One renderer for the default 1280×720 view (the ray map and background cost ~2 s).
+class DefaultView : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    setup_ = std::make_unique<ClipSetup>(DefaultClipSetup(1280, 720));
+    renderer_ = std::make_unique<ClipRenderer>(setup_->scene, setup_->calibration, setup_->apparatus);
+  }
+  static void TearDownTestSuite() {
+    renderer_.reset();
+    setup_.reset();
+  }
+  static std::unique_ptr<ClipSetup> setup_;
+  static std::unique_ptr<ClipRenderer> renderer_;
+};
+std::unique_ptr<ClipSetup> DefaultView::setup_;
+std::unique_ptr<ClipRenderer> DefaultView::renderer_;
+
+TEST_F(DefaultView, CleanLosslessClipWithinATenthOfAPixel) {
+  ClipSettings s;
+  s.frames = 30;
+  s.release_time = -0.9;  // already rolling toward O, up to 10 px per frame
+  const Motion motion(setup_->scene, setup_->x0);
+  const ClipRun run = RenderAndTrack(*renderer_, setup_->scene, motion, s, "clean.avi");
+  ASSERT_EQ(run.track.rows.size(), run.truth.size());
+  ExpectAccurate(run.errors, 27, 0.1);
+  EXPECT_FALSE(run.track.partial) << run.track.partial_reason;
+  for (const TrackRow& r : run.track.rows) {
+    EXPECT_NEAR(r.t, r.frame / 30.0, 1e-3);
+    if (r.ball.found) {
+      EXPECT_GT(r.ball.quality, 0.5);
+    }
+  }
+}
+
+TEST_F(DefaultView, BlurNoiseFlickerAndH264WithinThreeTenthsOfAPixel) {
+  ClipSettings s;
+  s.frames = 30;
+  s.release_time = -0.9;
+  s.blur_samples = 6;
+  s.exposure = 1.0 / 60;
+  s.noise_sigma = 3;
+  s.flicker = 0.02;
+  s.seed = 7;
+  const Motion motion(setup_->scene, setup_->x0);
+  ExpectAccurate(RenderAndTrack(*renderer_, setup_->scene, motion, s, "noisy.mp4").errors, 27, 0.3);
+}
+
+TEST_F(DefaultView, InitialGuessAndLostBallKeepTheirRows) {
+  // Released beyond X: it rolls up the rails and drops between them; the last frames have no ball.
+  const double x_eq = *setup_->scene.x_eq(), x_max = setup_->scene.x_max();
+  const Motion motion(setup_->scene, x_eq + 0.5 * (x_max - x_eq));
+  ClipSettings s;
+  s.frames = static_cast<int>(std::ceil(motion.end_time() * s.fps)) + 6;
+  const std::string video = (TempDir() / "falls.avi").string();
+  const std::vector<ClipTruth> truth = RenderClip(*renderer_, motion, s, video);
+  ASSERT_FALSE(truth.back().present);
+  TrackVideoOptions options;
+  options.tracker.init_uv = Eigen::Vector2d(truth[0].u + 6, truth[0].v - 4);
+  const TrackResult track = TrackVideo(video, setup_->scene, setup_->calibration, options);
+  ASSERT_EQ(track.rows.size(), truth.size());
+  int absent = 0;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    if (truth[i].present) continue;
+    ++absent;
+    EXPECT_FALSE(track.rows[i].ball.found) << "frame " << i;
+    EXPECT_EQ(track.rows[i].ball.quality, 0.0);
+  }
+  EXPECT_GE(absent, 5);
+  EXPECT_TRUE(track.partial);
+  EXPECT_NE(track.partial_reason.find("lost"), std::string::npos) << track.partial_reason;
+  const Errors e = Compare(truth, track);
+  EXPECT_LE(e.rms_uv, 0.1);
+
+  const std::string csv = (TempDir() / "falls.csv").string();
+  WriteTrack(csv, track, {video, "cam.json", "scene.json", "sphere"});
+  std::ifstream in(csv);
+  std::string header, line, last;
+  std::getline(in, header);
+  EXPECT_EQ(header, "frame,t,u,v,radius_px,x,z,quality");
+  int lines = 0;
+  while (std::getline(in, line)) last = line, ++lines;
+  EXPECT_EQ(lines, static_cast<int>(truth.size()));
+  EXPECT_NE(last.find(",,,,,,0"), std::string::npos) << last;
+  std::ifstream side_in(csv + ".json");
+  const nlohmann::json side = nlohmann::json::parse(side_in);
+  EXPECT_EQ(side["format"], "uphill-track/1");
+  EXPECT_EQ(side["partial"], true);
+}
+
+TEST_F(DefaultView, TruncatedVideoIsPartial) {
+  ClipSettings s;
+  s.frames = 20;
+  const Motion motion(setup_->scene, setup_->x0);
+  const std::string video = (TempDir() / "truncated.avi").string();
+  RenderClip(*renderer_, motion, s, video);
+  fs::resize_file(video, fs::file_size(video) * 6 / 10);
+  const TrackResult track = TrackVideo(video, setup_->scene, setup_->calibration);
+  EXPECT_TRUE(track.partial);
+  EXPECT_LT(track.rows.size(), 20u);
+  EXPECT_NE(track.partial_reason.find("truncated"), std::string::npos) << track.partial_reason;
+}
+
+TEST_F(DefaultView, VideoWithoutBallIsAnError) {
+  const std::string video = (TempDir() / "empty.avi").string();
+  {
+    cv::VideoWriter w(video, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30, cv::Size(1280, 720));
+    cv::RNG rng(1);
+    const cv::Mat frame = ToFrame8(renderer_->RenderLinear({}), 1.0, 1.0, rng);
+    for (int i = 0; i < 5; ++i) w.write(frame);
+  }
+  ExpectInputError([&] { TrackVideo(video, setup_->scene, setup_->calibration); }, {"empty.avi", "no ball found"});
+}
+
+TEST(VisionTrack, SpheroidCleanClip) {
+  ClipSetup setup = DefaultClipSetup(1280, 720);
+  setup.scene = Scene(Body::Spheroid(0.015875, 0.0254), setup.scene.rails(), setup.scene.rod_radius());
+  const ClipRenderer renderer(setup.scene, setup.calibration, setup.apparatus);
+  const Motion motion(setup.scene, 0.97 * *setup.scene.x_eq());
+  ClipSettings s;
+  s.frames = 12;
+  s.release_time = -1.4;
+  ExpectAccurate(RenderAndTrack(renderer, setup.scene, motion, s, "spheroid.avi").errors, 10, 0.1);
+}
+
+TEST(VisionTrack, BadInputIsNamed) {
+  const ClipSetup setup = DefaultClipSetup(320, 180);
+  const std::string text = (TempDir() / "notes.mp4").string();
+  std::ofstream(text) << "this is not a video\n";
+  ExpectInputError([&] { TrackVideo(text, setup.scene, setup.calibration); }, {"notes.mp4", "not a video"});
+  EXPECT_THROW(TrackVideo((TempDir() / "missing.mp4").string(), setup.scene, setup.calibration), InputError);
+
+  // A calibration for another image size.
+  const std::string video = (TempDir() / "small.avi").string();
+  {
+    cv::VideoWriter w(video, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30, cv::Size(320, 180));
+    for (int i = 0; i < 3; ++i) w.write(cv::Mat(180, 320, CV_8UC3, cv::Scalar(90, 120, 150)));
+  }
+  const ClipSetup other = DefaultClipSetup(640, 360);
+  TrackVideoOptions options;
+  options.calibration_name = "scene.json";
+  ExpectInputError([&] { TrackVideo(video, other.scene, other.calibration, options); }, {"scene.json", "320x180"});
+  // A double cone is not tracked.
+  const Scene cone(Body::DoubleCone(0.05, 0.1), setup.scene.rails());
+  EXPECT_THROW(BallTracker(cone, setup.calibration), InputError);
+}
+
+}  // namespace
+}  // namespace uphill::vision

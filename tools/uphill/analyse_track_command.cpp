@@ -1,0 +1,70 @@
+// `uphill analyse-track TRACK.csv [scene flags] [--g] [--fit g|mu] [--u-x] [-o DIR]`: the events
+// of a measured ball track (release, direction, turning points, rest, fall-off) and the model
+// motion fitted to it (src/vision/track_analysis.hpp), as a table with units; with -o also
+// DIR/track_analysis.json and the figures track_x_vs_t and track_residuals.
+#include <iostream>
+
+#include "commands.hpp"
+#include "io/units.hpp"
+#include "model/input_error.hpp"
+#include "scene_flags.hpp"
+#include "vision/track_analysis.hpp"
+#include "vision/track_analysis_output.hpp"
+#include "vision/track_table.hpp"
+
+namespace uphill::cli {
+namespace {
+
+struct AnalyseTrackFlags {
+  SceneFlags scene;
+  std::string track, g = "9.80665m/s2", fit = "g", u_x = "0.5mm", output;
+  bool json = false;
+};
+
+void Run(const AnalyseTrackFlags& f) {
+  const Scene scene = io::ParseConfiguration(FlagSource(f.scene)).MakeScene();
+  vision::TrackAnalysisOptions o;
+  o.g = io::ParseQuantity(f.g, io::Dimension::kAcceleration, "--g");
+  if (!(o.g > 0.0)) throw InputError("--g", "must be > 0");
+  o.u_x = io::ParseQuantity(f.u_x, io::Dimension::kLength, "--u-x");
+  if (!(o.u_x > 0.0)) throw InputError("--u-x", "must be > 0 (the standard uncertainty of a tracked position)");
+  if (f.fit == "g") {
+    o.fit = vision::TrackFitParameter::kEffectiveG;
+  } else if (f.fit == "mu") {
+    o.fit = vision::TrackFitParameter::kMu;
+  } else {
+    throw InputError("--fit", "must be g (an effective g) or mu (rolling resistance), got '" + f.fit + "'");
+  }
+  const vision::Track track = vision::ReadTrackFile(f.track);
+  const vision::TrackAnalysis analysis = vision::AnalyseTrack(track, scene, o);
+  if (f.json) {
+    std::cout << vision::TrackAnalysisJson(analysis).dump(2) << "\n";
+  } else {
+    std::cout << vision::TrackAnalysisTable(analysis);
+  }
+  if (!f.output.empty()) {
+    vision::WriteTrackAnalysis(analysis, f.output);
+    if (!f.json) std::cout << "wrote " << f.output << "/track_analysis.json and the figures track_x_vs_t"
+                           << (analysis.fit.available ? ", track_residuals" : "") << " (.svg, .png, .gp, .dat)\n";
+  }
+}
+
+}  // namespace
+
+void AddAnalyseTrackCommand(CLI::App& app) {
+  auto flags = std::make_shared<AnalyseTrackFlags>();
+  CLI::App* cmd = app.add_subcommand(
+      "analyse-track", "Events (release, turning points, rest, fall-off) and the model fit of a ball track CSV");
+  cmd->add_option("track", flags->track, "track CSV written by `uphill track` ('-' reads stdin)")->required();
+  AddSceneFlags(cmd, &flags->scene);
+  cmd->add_option("--g", flags->g, "gravitational acceleration, e.g. 9.81m/s2 (with --fit g: the reference)")
+      ->capture_default_str();
+  cmd->add_option("--fit", flags->fit, "third fit parameter besides x0, t0: g (effective g) or mu")
+      ->capture_default_str();
+  cmd->add_option("--u-x", flags->u_x, "standard uncertainty of a tracked position, e.g. 0.3mm")->capture_default_str();
+  cmd->add_option("-o,--output", flags->output, "folder for track_analysis.json and the figures (created if needed)");
+  cmd->add_flag("--json", flags->json, "print track_analysis.json instead of the table");
+  cmd->callback([flags] { Run(*flags); });
+}
+
+}  // namespace uphill::cli

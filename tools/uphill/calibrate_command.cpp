@@ -1,0 +1,315 @@
+// `uphill calibrate`: the camera that films the apparatus (src/vision/calibration.hpp).
+//   calibrate camera IMAGES… --cols 9 --rows 6 --square 20mm -o cam.json
+//   calibrate scene --camera cam.json --points POINTS.csv -o scene.json [--frame FRAME.png]
+//   calibrate scene --camera cam.json --board-image TABLE.png --cols … --board-origin … -o scene.json
+//   calibrate target --cols 9 --rows 6 --square 20mm -o board.svg|board.png
+// The numbers are printed with their units; the files' formats are in calibration/README.md.
+#include <Eigen/Geometry>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "commands.hpp"
+#include "io/atomic_file.hpp"
+#include "io/csv_table.hpp"
+#include "io/units.hpp"
+#include "model/input_error.hpp"
+#include "vision/calibration.hpp"
+
+namespace uphill::cli {
+namespace {
+
+using vision::ChessboardTarget;
+
+struct TargetFlags {
+  int cols = 9, rows = 6;
+  std::string square;
+};
+
+struct CalibrateFlags {
+  TargetFlags target;
+  std::vector<std::string> images;
+  std::string camera, points, frame, output;
+  std::string board_image, board_origin, board_x_axis = "+x", board_y_axis = "-y";
+  bool fit_k3 = false;
+  std::string dpi = "300";
+};
+
+std::string Num(double v, int precision = 6) {
+  std::ostringstream out;
+  out.precision(precision);
+  out << v;
+  return out.str();
+}
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << v;
+  return out.str();
+}
+
+void Row(const std::string& name, const std::string& value) {
+  std::cout << "  " << std::left << std::setw(34) << name << value << "\n";
+}
+
+ChessboardTarget Target(const TargetFlags& f) {
+  if (f.square.empty()) throw InputError("--square", "is required (the side of one square, with unit, e.g. 20mm)");
+  ChessboardTarget t{f.cols, f.rows, io::ParseQuantity(f.square, io::Dimension::kLength, "--square")};
+  vision::ValidateTarget(t);
+  return t;
+}
+
+void AddTargetFlags(CLI::App* cmd, TargetFlags* f, bool square_required) {
+  cmd->add_option("--cols", f->cols, "inner corners across the board (a board of 10×7 squares has 9×6)")
+      ->capture_default_str();
+  cmd->add_option("--rows", f->rows, "inner corners down the board")->capture_default_str();
+  cmd->add_option("--square", f->square,
+                  std::string("side of one square, with unit, e.g. 20mm (measure the print)") +
+                      (square_required ? " (required)" : ""));
+}
+
+void PrintVerdict(const std::string& verdict, const std::vector<std::string>& reasons) {
+  std::cout << "verdict: " << verdict << "\n";
+  for (const auto& r : reasons) std::cout << "  * " << r << "\n";
+}
+
+// ---- camera ----
+
+void RunCamera(const CalibrateFlags& f) {
+  const ChessboardTarget target = Target(f.target);
+  if (f.images.empty()) throw InputError("IMAGES", "give the chessboard views (10 to 20 image files)");
+  vision::CameraCalibrationOptions options;
+  options.fit_k3 = f.fit_k3;
+  const vision::CameraCalibration c = vision::CalibrateCameraFromFiles(f.images, target, options);
+  const vision::CameraIntrinsics& k = c.camera;
+  std::cout << "camera calibration: " << c.views_used << " of " << c.views.size() << " views used, chessboard "
+            << target.cols << "×" << target.rows << " inner corners, " << Num(target.square * 1000) << " mm squares\n";
+  Row("image size", std::to_string(k.width) + " × " + std::to_string(k.height) + " px");
+  Row("fx (focal length, x)", Fixed(k.fx, 2) + " px   (± " + Num(c.std_dev_px(0), 2) + ")");
+  Row("fy (focal length, y)", Fixed(k.fy, 2) + " px   (± " + Num(c.std_dev_px(1), 2) + ")");
+  Row("cx (principal point, x)", Fixed(k.cx, 2) + " px   (± " + Num(c.std_dev_px(2), 2) + ")");
+  Row("cy (principal point, y)", Fixed(k.cy, 2) + " px   (± " + Num(c.std_dev_px(3), 2) + ")");
+  static const char* kNames[] = {"k1", "k2", "p1", "p2", "k3"};
+  for (size_t i = 0; i < k.distortion.size() && i < 5; ++i)
+    Row(std::string("distortion ") + kNames[i], Num(k.distortion[i], 5) + (i == 4 && !f.fit_k3 ? "   (fixed)" : ""));
+  Row("RMS reprojection error", Fixed(c.rms_px, 3) + " px");
+  Row("image coverage", Fixed(100 * c.coverage, 0) + " % (cells of a 5×5 grid with corners)");
+  std::cout << "  views:\n";
+  for (const auto& v : c.views) {
+    if (v.used)
+      std::cout << "    " << v.name << ": RMS " << Fixed(v.rms_px, 3) << " px, tilt " << Fixed(v.tilt_deg, 1)
+                << "°, distance " << Fixed(v.distance_m * 1000, 0) << " mm\n";
+    else
+      std::cout << "    " << v.name << ": rejected, " << v.rejected_because << "\n";
+  }
+  PrintVerdict(c.verdict, c.reasons);
+  vision::WriteCameraFile(f.output, k, c.Summary(target));
+  std::cout << "wrote " << f.output << "\n";
+}
+
+// ---- scene ----
+
+// POINTS.csv: u, v in pixels (columns `u`, `v` or `u_px`, `v_px`), x, y, z in the apparatus
+// frame with a length unit in the header (`x_mm`) or in every cell (`x` = "120mm"); optional
+// `name` (used in messages) and `note` (ignored).
+std::vector<vision::ScenePoint> ReadPoints(const std::string& path) {
+  const io::CsvTable table = io::ReadCsvFile(path);
+  int u = -1, v = -1, xyz[3] = {-1, -1, -1}, name = -1;
+  std::string xyz_unit[3];
+  for (size_t i = 0; i < table.header.size(); ++i) {
+    const std::string& h = table.header[i];
+    const int column = static_cast<int>(i);
+    const auto [stem, unit] = io::SplitUnitSuffix(h);
+    if (h == "u" || h == "u_px") {
+      u = column;
+    } else if (h == "v" || h == "v_px") {
+      v = column;
+    } else if ((stem == "x" || stem == "y" || stem == "z") &&
+               (unit.empty() || io::UnitFactor(io::Dimension::kLength, unit) > 0)) {
+      xyz[stem[0] - 'x'] = column;
+      xyz_unit[stem[0] - 'x'] = unit;
+    } else if (h == "name") {
+      name = column;
+    } else if (h != "note") {
+      throw InputError(io::CellContext(table, 1, h),
+                       "unknown column (expected u, v in pixels, x, y, z with a length unit as in x_mm, "
+                       "and optionally name, note)");
+    }
+  }
+  if (u < 0 || v < 0 || xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0)
+    throw InputError(table.source + ", row 1", "the header must have the columns u, v, x, y, z (e.g. u,v,x_mm,y_mm,z_mm)");
+  std::vector<vision::ScenePoint> points;
+  for (const io::CsvRow& row : table.rows) {
+    if (!row.error.empty()) throw InputError(table.source + ", row " + std::to_string(row.row), row.error);
+    vision::ScenePoint p;
+    const auto cell = [&](int column) -> const std::string& { return row.cells[column]; };
+    const auto where = [&](int column) { return io::CellContext(table, row.row, table.header[column]); };
+    p.label = table.source + ", row " + std::to_string(row.row);
+    if (name >= 0 && !cell(name).empty()) p.label += " (" + cell(name) + ")";
+    p.pixel = {io::ParseQuantity(cell(u), io::Dimension::kDimensionless, where(u)),
+               io::ParseQuantity(cell(v), io::Dimension::kDimensionless, where(v))};
+    for (int k = 0; k < 3; ++k)
+      p.position[k] = io::ParseQuantity(cell(xyz[k]), io::Dimension::kLength, where(xyz[k]), xyz_unit[k]);
+    points.push_back(p);
+  }
+  return points;
+}
+
+// "+x", "-y", "+z" etc.: a unit vector of the apparatus frame.
+Eigen::Vector3d Axis(const std::string& text, const std::string& flag) {
+  if (text.size() == 2 && (text[0] == '+' || text[0] == '-') && text[1] >= 'x' && text[1] <= 'z') {
+    Eigen::Vector3d a = Eigen::Vector3d::Zero();
+    a[text[1] - 'x'] = text[0] == '+' ? 1 : -1;
+    return a;
+  }
+  throw InputError(flag, "must be one of +x, -x, +y, -y, +z, -z (got '" + text + "')");
+}
+
+Eigen::Vector3d Point(const std::string& text, const std::string& flag) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');)
+    values.push_back(io::ParseQuantity(item, io::Dimension::kLength, flag));
+  if (values.size() != 3) throw InputError(flag, "must be x,y,z with units, e.g. 350mm,50mm,0mm");
+  return {values[0], values[1], values[2]};
+}
+
+cv::Mat ReadImage(const std::string& path, const std::string& flag) {
+  const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (image.empty()) throw InputError(flag + " " + path, "cannot be read as an image");
+  return image;
+}
+
+void RunScene(const CalibrateFlags& f) {
+  const vision::CameraIntrinsics camera = vision::ReadCameraFile(f.camera);
+  vision::SceneCalibrationResult r;
+  if (!f.board_image.empty()) {
+    if (!f.points.empty()) throw InputError("--points/--board-image", "give one of them, not both");
+    if (f.board_origin.empty()) throw InputError("--board-origin", "is required with --board-image");
+    const Eigen::Vector3d x = Axis(f.board_x_axis, "--board-x-axis"), y = Axis(f.board_y_axis, "--board-y-axis");
+    if (x.dot(y) != 0) throw InputError("--board-x-axis/--board-y-axis", "must be perpendicular");
+    r = vision::CalibrateSceneFromChessboard(camera, {f.board_image, ReadImage(f.board_image, "--board-image")},
+                                             Target(f.target), Point(f.board_origin, "--board-origin"), x, y);
+  } else {
+    if (f.points.empty()) throw InputError("--points", "is required (or --board-image)");
+    int frame_width = 0, frame_height = 0;
+    if (!f.frame.empty()) {
+      const cv::Mat frame = ReadImage(f.frame, "--frame");
+      frame_width = frame.cols;
+      frame_height = frame.rows;
+    }
+    try {
+      r = vision::CalibrateScene(camera, ReadPoints(f.points), frame_width, frame_height);
+    } catch (const InputError& e) {
+      // The library names rows (labels) or "points"/"frame"; say which file was meant.
+      const std::string& q = e.quantity();
+      if (q == "points") throw InputError(f.points + ": points", e.rule());
+      if (q == "frame") throw InputError("--frame " + f.frame, e.rule() + " (camera file " + f.camera + ")");
+      throw;
+    }
+  }
+  const vision::CameraPose& pose = r.scene.pose;
+  const Eigen::Vector3d centre = vision::CameraCentre(pose);
+  const Eigen::Vector3d axis = pose.rotation.row(2).transpose();
+  const double degree = std::numbers::pi / 180;
+  std::cout << "scene calibration: " << r.residuals.size() << " points, camera " << f.camera << "\n";
+  Row("camera centre (apparatus frame)", "x = " + Fixed(centre.x() * 1000, 1) + " mm, y = " +
+                                             Fixed(centre.y() * 1000, 1) + " mm, z = " + Fixed(centre.z() * 1000, 1) +
+                                             " mm");
+  Row("distance to O", Fixed(centre.norm() * 1000, 1) + " mm");
+  Row("viewing direction", "(" + Fixed(axis.x(), 4) + ", " + Fixed(axis.y(), 4) + ", " + Fixed(axis.z(), 4) + "): " +
+                               Fixed(std::asin(std::clamp(-axis.z(), -1.0, 1.0)) / degree, 1) +
+                               "° below horizontal, azimuth " + Fixed(std::atan2(axis.y(), axis.x()) / degree, 1) +
+                               "° from +x");
+  Row("RMS reprojection error", Fixed(r.rms_px, 3) + " px");
+  std::cout << "  residuals:\n";
+  for (const auto& p : r.residuals) std::cout << "    " << p.label << ": " << Fixed(p.error_px, 3) << " px\n";
+  PrintVerdict(r.verdict, r.reasons);
+  vision::WriteSceneFile(f.output, r.scene, r.Summary());
+  std::cout << "wrote " << f.output << "\n";
+}
+
+// ---- target ----
+
+std::string TargetSvg(const ChessboardTarget& t) {
+  const double s = t.square * 1000;  // mm
+  const int nx = t.cols + 1, ny = t.rows + 1;
+  const double w = (nx + 2) * s, h = (ny + 2) * s;
+  std::ostringstream svg;
+  svg << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      << "<!-- uphill calibrate target: " << t.cols << "x" << t.rows << " inner corners, " << Num(s)
+      << " mm squares. Print at 100 % (no scaling) and measure a square before calibrating. -->\n"
+      << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Num(w) << "mm\" height=\"" << Num(h)
+      << "mm\" viewBox=\"0 0 " << Num(w) << " " << Num(h) << "\">\n"
+      << "<rect width=\"" << Num(w) << "\" height=\"" << Num(h) << "\" fill=\"white\"/>\n";
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      if ((i + j) % 2 == 0)
+        svg << "<rect x=\"" << Num((i + 1) * s) << "\" y=\"" << Num((j + 1) * s) << "\" width=\"" << Num(s)
+            << "\" height=\"" << Num(s) << "\" fill=\"black\"/>\n";
+  svg << "</svg>\n";
+  return svg.str();
+}
+
+void RunTarget(const CalibrateFlags& f) {
+  const ChessboardTarget t = Target(f.target);
+  const std::string extension = std::filesystem::path(f.output).extension().string();
+  if (extension == ".svg") {
+    io::WriteFileAtomically(f.output, TargetSvg(t));
+    std::cout << "wrote " << f.output << ": print at 100 % (no \"fit to page\"), then measure a square: it must be "
+              << Num(t.square * 1000) << " mm (give the measured value to --square)\n";
+    return;
+  }
+  if (extension != ".png") throw InputError("-o", "must end in .svg or .png (got '" + f.output + "')");
+  const double dpi = io::ParseQuantity(f.dpi, io::Dimension::kDimensionless, "--dpi");
+  const int pixels = static_cast<int>(std::lround(t.square / 0.0254 * dpi));
+  const cv::Mat image = vision::ChessboardTargetImage(t, pixels);
+  std::vector<uchar> png;
+  cv::imencode(".png", image, png);
+  io::WriteFileAtomically(f.output, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+  std::cout << "wrote " << f.output << ": " << image.cols << " × " << image.rows << " px, " << pixels
+            << " px per square; print at " << Num(dpi) << " dpi so that a square measures " << Num(t.square * 1000)
+            << " mm (measure it and give the measured value to --square)\n";
+}
+
+}  // namespace
+
+void AddCalibrateCommand(CLI::App& app) {
+  auto flags = std::make_shared<CalibrateFlags>();
+  CLI::App* calibrate = app.add_subcommand("calibrate", "Camera calibration: intrinsics, pose in the apparatus, target");
+  calibrate->require_subcommand(1);
+
+  CLI::App* camera = calibrate->add_subcommand("camera", "Intrinsics and lens distortion from chessboard views");
+  camera->add_option("images", flags->images, "image files of the chessboard (10 to 20 views)")->required();
+  AddTargetFlags(camera, &flags->target, true);
+  camera->add_flag("--fit-k3", flags->fit_k3, "also fit the distortion coefficient k3 (wide-angle lenses)");
+  camera->add_option("-o,--output", flags->output, "camera file to write (JSON)")->required();
+  camera->callback([flags] { RunCamera(*flags); });
+
+  CLI::App* scene = calibrate->add_subcommand("scene", "Camera pose in the apparatus frame from points of known position");
+  scene->add_option("--camera", flags->camera, "camera file from `calibrate camera`")->required();
+  scene->add_option("--points", flags->points, "CSV: u,v (px), x,y,z with length unit (x_mm) per point");
+  scene->add_option("--frame", flags->frame, "a frame of the video: its size must be the camera's");
+  scene->add_option("--board-image", flags->board_image, "instead of --points: an image of a chessboard lying in the scene");
+  AddTargetFlags(scene, &flags->target, false);
+  scene->add_option("--board-origin", flags->board_origin, "with --board-image: first inner corner, x,y,z with units");
+  scene->add_option("--board-x-axis", flags->board_x_axis, "with --board-image: apparatus axis along the board's rows")
+      ->capture_default_str();
+  scene->add_option("--board-y-axis", flags->board_y_axis, "with --board-image: apparatus axis down the board's columns")
+      ->capture_default_str();
+  scene->add_option("-o,--output", flags->output, "scene file to write (JSON)")->required();
+  scene->callback([flags] { RunScene(*flags); });
+
+  CLI::App* target = calibrate->add_subcommand("target", "Write a chessboard target to print (SVG or PNG)");
+  AddTargetFlags(target, &flags->target, true);
+  target->add_option("--dpi", flags->dpi, "PNG only: printer resolution (dots per inch)")->capture_default_str();
+  target->add_option("-o,--output", flags->output, "file to write: .svg (exact size in mm) or .png")->required();
+  target->callback([flags] { RunTarget(*flags); });
+}
+
+}  // namespace uphill::cli

@@ -1,0 +1,142 @@
+// `uphill track VIDEO --camera cam.json --scene scene.json [scene flags] -o track.csv`: the ball's
+// centre in every frame (src/vision/video_tracking.hpp, ball_tracker.hpp), as the track CSV and
+// its sidecar JSON (data/README.md, "Track CSV"); optionally an overlay video and the analysis of
+// the track (src/vision/track_analysis.hpp, written beside the CSV as `uphill analyse-track` does).
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "io/configuration.hpp"
+#include "model/input_error.hpp"
+#include "scene_flags.hpp"
+#include "vision/camera.hpp"
+#include "vision/track_analysis.hpp"
+#include "vision/track_analysis_output.hpp"
+#include "vision/track_table.hpp"
+#include "vision/video_tracking.hpp"
+
+namespace uphill::cli {
+namespace {
+
+struct TrackFlags {
+  SceneFlags scene;
+  std::string video, camera, scene_file, out, init, overlay;
+  bool analyse = false, quiet = false;
+};
+
+// "u,v" in raw pixels (plain numbers: pixels are the image's own unit).
+Eigen::Vector2d ParsePixel(const std::string& text) {
+  const size_t comma = text.find(',');
+  if (comma == std::string::npos) throw InputError("--init", "must be u,v in raw pixels (got '" + text + "')");
+  try {
+    size_t used_u = 0, used_v = 0;
+    const std::string us = text.substr(0, comma), vs = text.substr(comma + 1);
+    const double u = std::stod(us, &used_u), v = std::stod(vs, &used_v);
+    if (used_u != us.size() || used_v != vs.size() || !std::isfinite(u) || !std::isfinite(v)) throw std::invalid_argument("");
+    return {u, v};
+  } catch (const std::exception&) {
+    throw InputError("--init", "must be u,v in raw pixels, two numbers (got '" + text + "')");
+  }
+}
+
+// The scene file carries the intrinsics it was calibrated with; they must be the camera file's.
+void RequireSameCamera(const vision::CameraIntrinsics& cam, const vision::CameraIntrinsics& in_scene,
+                       const TrackFlags& f) {
+  auto differs = [](double a, double b) { return std::abs(a - b) > 1e-9 * std::max(1.0, std::abs(a)); };
+  std::string what;
+  if (cam.width != in_scene.width || cam.height != in_scene.height) what = "image size";
+  else if (differs(cam.fx, in_scene.fx) || differs(cam.fy, in_scene.fy)) what = "focal length";
+  else if (differs(cam.cx, in_scene.cx) || differs(cam.cy, in_scene.cy)) what = "principal point";
+  else if (cam.distortion.size() != in_scene.distortion.size()) what = "distortion model";
+  else
+    for (size_t i = 0; i < cam.distortion.size(); ++i)
+      if (differs(cam.distortion[i], in_scene.distortion[i])) what = "distortion coefficients";
+  if (!what.empty())
+    throw InputError(f.scene_file, "was calibrated with another camera than " + f.camera + " (the " + what +
+                                       " differs): run `uphill calibrate scene` with this camera file");
+}
+
+void Run(const TrackFlags& f) {
+  if (f.camera.empty()) throw InputError("--camera", "is required (the camera file of `uphill calibrate camera`)");
+  if (f.scene_file.empty()) throw InputError("--scene", "is required (the scene file of `uphill calibrate scene`)");
+  if (f.out.empty()) throw InputError("-o", "is required (the track CSV to write)");
+  const io::Configuration configuration = io::ParseConfiguration(FlagSource(f.scene));
+  const Scene scene = configuration.MakeScene();
+  if (scene.body().kind == BodyKind::kDoubleCone)
+    throw InputError("--body", "tracking supports a sphere or a spheroid, not a double cone");
+  const vision::CameraIntrinsics camera = vision::ReadCameraFile(f.camera);
+  vision::SceneCalibration calibration = vision::ReadSceneFile(f.scene_file);
+  RequireSameCamera(camera, calibration.camera, f);
+  calibration.camera = camera;
+
+  vision::TrackVideoOptions options;
+  options.calibration_name = f.scene_file;
+  options.overlay_path = f.overlay;
+  if (!f.init.empty()) options.tracker.init_uv = ParsePixel(f.init);
+  const bool bar = !f.quiet && isatty(STDERR_FILENO);
+  const auto start = std::chrono::steady_clock::now();
+  if (bar)
+    options.progress = [start](int done, long total) {
+      if (done % 5 != 0 && done != total) return;
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (total > 0) {
+        const int width = 40, filled = static_cast<int>(width * std::min(1.0, static_cast<double>(done) / total));
+        std::fprintf(stderr, "\r[%s%s] %d/%ld frames, %.0f frames/s ", std::string(filled, '#').c_str(),
+                     std::string(width - filled, '.').c_str(), done, total, done / std::max(elapsed, 1e-9));
+      } else {
+        std::fprintf(stderr, "\r%d frames, %.0f frames/s ", done, done / std::max(elapsed, 1e-9));
+      }
+      std::fflush(stderr);
+    };
+  const vision::TrackResult result = vision::TrackVideo(f.video, scene, calibration, options);
+  if (bar) std::fprintf(stderr, "\n");
+  vision::WriteTrack(f.out, result, {f.video, f.camera, f.scene_file, scene.body().Name()});
+
+  int found = 0;
+  double quality = 0;
+  for (const auto& r : result.rows)
+    if (r.ball.found) ++found, quality += r.ball.quality;
+  std::cout << f.video << ": " << result.rows.size() << " frames, ball found in " << found << " (mean quality "
+            << (found ? quality / found : 0.0) << ")\n"
+            << "wrote " << f.out << " and " << f.out << ".json";
+  if (!f.overlay.empty()) std::cout << " and " << f.overlay;
+  std::cout << "\n";
+  if (result.partial) {
+    std::cerr << "uphill: " << f.video << ": partial track: " << result.partial_reason << "\n";
+    // A cut video is bad input; a ball that drops out of view at the end is how runs end.
+    if (result.partial_reason.find("truncated") != std::string::npos) ExitStatus() = 2;
+  }
+  if (f.analyse) {
+    // The same analysis as `uphill analyse-track OUT [scene flags] -o <OUT's folder>`, default options.
+    const vision::TrackAnalysis analysis = vision::AnalyseTrack(vision::ReadTrackFile(f.out), scene);
+    std::cout << "\n" << vision::TrackAnalysisTable(analysis);
+    const std::string folder = std::filesystem::path(f.out).parent_path().string();
+    vision::WriteTrackAnalysis(analysis, folder.empty() ? "." : folder);
+    std::cout << "wrote " << (folder.empty() ? "." : folder) << "/track_analysis.json and its figures\n";
+  }
+}
+
+}  // namespace
+
+void AddTrackCommand(CLI::App& app) {
+  auto flags = std::make_shared<TrackFlags>();
+  CLI::App* cmd = app.add_subcommand("track", "Ball centre in every frame of a calibrated video -> track CSV");
+  cmd->add_option("video", flags->video, "the video file (any format FFmpeg reads)")->required();
+  cmd->add_option("--camera", flags->camera, "camera file (uphill calibrate camera)");
+  cmd->add_option("--scene", flags->scene_file, "scene file: the camera's pose (uphill calibrate scene)");
+  AddSceneFlags(cmd, &flags->scene);
+  cmd->add_option("-o,--out", flags->out, "track CSV to write (and <csv>.json beside it)");
+  cmd->add_option("--init", flags->init, "u,v: raw pixel near the ball's centre in the first frame (optional)");
+  cmd->add_option("--overlay", flags->overlay, "write the video with the fitted outline drawn (.mp4)");
+  cmd->add_flag("--analyse", flags->analyse, "then analyse the track (release, rest, fall-off, model fit)");
+  cmd->add_flag("--quiet", flags->quiet, "no progress bar");
+  cmd->callback([flags] { Run(*flags); });
+}
+
+}  // namespace uphill::cli
