@@ -20,7 +20,7 @@ if ! command -v node > /dev/null 2>&1; then
   packages+=(nodejs npm)
 fi
 if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(python3-numpy python3-scipy python3-opencv)
+  packages+=(python3-numpy python3-scipy python3-statsmodels python3-opencv)
 fi
 
 missing=()

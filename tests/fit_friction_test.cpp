@@ -12,7 +12,7 @@
 #include "fit/friction_fit.hpp"
 #include "model/input_error.hpp"
 #include "model/propagation.hpp"
-#include "model/spheroid_on_line_rails.hpp"
+#include "oracle/friction_reference.hpp"
 
 namespace uphill {
 namespace {
@@ -195,33 +195,22 @@ TEST(Friction, CovarianceMatchesAnAnalyticGaussNewtonOne) {
   // x_rest(μ) = x_max·K/sqrt(PA² + K²), K = B + μ(1 + A²):
   // dx/dμ = x_max·PA²(1 + A²)/(PA² + K²)^(3/2). For Y = s·x_rest(μ) the Jacobian row is
   // (s·dx/dμ, x_rest); the covariance is (Σ JᵢᵀJᵢ/u_i²)⁻¹, and at the optimum Σ Jᵢ·r_i/u_i² = 0.
+  // The sums come from src/oracle (long double, the model's closed form, not the fit's path).
   for (const bool with_scale : {false, true}) {
     SCOPED_TRACE(with_scale ? "mu and s" : "mu");
     const FrictionData d = Synthetic(LabScenes(), 0.008, 2e-5, 7, with_scale ? 1.002 : 1.0);
     FrictionOptions options;
     options.fit_scale = with_scale;
     const FitReport fit = FitFriction(d, options);
-    const long double mu = fit.Parameter("mu").value;
-    const long double s = with_scale ? fit.Parameter("s").value : 1.0;
-    long double h00 = 0, h01 = 0, h11 = 0, g0 = 0, g1 = 0, scale0 = 0, scale1 = 0;
-    for (std::size_t i = 0; i < d.size(); ++i) {
-      const Rails& rails = d.scenes[i].rails();
-      const SpheroidOnLineRails<long double> path(kA, kB, rails.tan_theta, rails.tan_half_alpha);
-      const long double A2 = path.A() * path.A(), PA2 = path.P() * A2;
-      const long double K = rails.tan_theta + mu * (1 + A2);
-      const long double x = path.RestX(mu);
-      const long double j0 = s * path.x_max() * PA2 * (1 + A2) / std::pow(PA2 + K * K, 1.5L);
-      const long double j1 = x;
-      const long double w = 1.0L / (static_cast<long double>(d.u_y[i]) * d.u_y[i]);
-      const long double r = d.y[i] - s * x;
-      h00 += w * j0 * j0;
-      h01 += w * j0 * j1;
-      h11 += w * j1 * j1;
-      g0 += w * j0 * r;
-      g1 += w * j1 * r;
-      scale0 += w * std::fabs(j0 * d.y[i]);
-      scale1 += w * std::fabs(j1 * d.y[i]);
+    std::vector<double> tan_theta, tan_half_alpha;
+    for (const Scene& scene : d.scenes) {
+      tan_theta.push_back(scene.rails().tan_theta);
+      tan_half_alpha.push_back(scene.rails().tan_half_alpha);
     }
+    const oracle::FrictionNormalEquations e = oracle::FrictionAt(
+        {kA, kB, tan_theta, tan_half_alpha, d.y, d.u_y}, fit.Parameter("mu").value,
+        with_scale ? fit.Parameter("s").value : 1.0);
+    const long double h00 = e.h_mu_mu, h01 = e.h_mu_s, h11 = e.h_s_s;
     if (!with_scale) {
       EXPECT_TRUE(RelNear(fit.covariance(0, 0), static_cast<double>(1.0L / h00), 1e-9));
     } else {
@@ -229,9 +218,9 @@ TEST(Friction, CovarianceMatchesAnAnalyticGaussNewtonOne) {
       EXPECT_TRUE(RelNear(fit.covariance(0, 0), static_cast<double>(h11 / det), 1e-8));
       EXPECT_TRUE(RelNear(fit.covariance(1, 1), static_cast<double>(h00 / det), 1e-8));
       EXPECT_TRUE(RelNear(fit.covariance(0, 1), static_cast<double>(-h01 / det), 1e-8));
-      EXPECT_LT(std::fabs(g1), 1e-12 * scale1);
+      EXPECT_LT(std::fabs(e.g_s), 1e-12 * e.scale_s);
     }
-    EXPECT_LT(std::fabs(g0), 1e-12 * scale0);
+    EXPECT_LT(std::fabs(e.g_mu), 1e-12 * e.scale_mu);
   }
 }
 

@@ -20,6 +20,7 @@
 #include "fit/robust_line.hpp"
 #include "fit/york_line.hpp"
 #include "model/input_error.hpp"
+#include "oracle/line_references.hpp"
 
 #ifndef UPHILL_FIT_LARGE_N
 #define UPHILL_FIT_LARGE_N 1000000
@@ -116,113 +117,12 @@ void ExpectInputError(F&& f, const std::string& quantity) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Independent closed forms in long double (no centring tricks from the library).
+// Independent references: src/oracle (50-digit least squares, York's iteration in long double),
+// written without the fit layer's code.
 
-struct Closed {
-  long double k = 0, c = 0;
-  long double var_k = 0, var_c = 0, cov_kc = 0;  // unscaled (stated u; OLS: u = 1)
-  long double chi2 = 0;
-};
+using oracle::LineSolution;
 
-// Weighted normal equations, w_i = 1/u_i² (u empty: 1).
-Closed ClosedWeighted(const LineData& d, bool weighted) {
-  const std::size_t n = d.size();
-  long double sw = 0, swx = 0, swy = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const long double w = weighted ? 1.0L / (static_cast<long double>(d.u_y[i]) * d.u_y[i]) : 1.0L;
-    sw += w;
-    swx += w * d.x[i];
-    swy += w * d.y[i];
-  }
-  const long double xm = swx / sw, ym = swy / sw;
-  long double sxx = 0, sxy = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const long double w = weighted ? 1.0L / (static_cast<long double>(d.u_y[i]) * d.u_y[i]) : 1.0L;
-    sxx += w * (d.x[i] - xm) * (d.x[i] - xm);
-    sxy += w * (d.x[i] - xm) * (d.y[i] - ym);
-  }
-  Closed r;
-  r.k = sxy / sxx;
-  r.c = ym - r.k * xm;
-  r.var_k = 1.0L / sxx;
-  r.var_c = 1.0L / sw + xm * xm / sxx;
-  r.cov_kc = -xm / sxx;
-  for (std::size_t i = 0; i < n; ++i) {
-    const long double w = weighted ? 1.0L / (static_cast<long double>(d.u_y[i]) * d.u_y[i]) : 1.0L;
-    const long double e = d.y[i] - r.c - r.k * d.x[i];
-    r.chi2 += w * e * e;
-  }
-  return r;
-}
-
-// York et al. (2004), section III, for r_i = 0: iterate the slope, then eq. 13 for the errors.
-Closed ClosedYork(const LineData& d) {
-  const std::size_t n = d.size();
-  long double b = ClosedWeighted(d, true).k;
-  std::vector<long double> W(n), beta(n);
-  long double xb = 0, yb = 0, sw = 0;
-  for (int iteration = 0; iteration < 10000; ++iteration) {
-    sw = 0;
-    long double swx = 0, swy = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      W[i] = 1.0L / (static_cast<long double>(d.u_y[i]) * d.u_y[i] +
-                     b * b * static_cast<long double>(d.u_x[i]) * d.u_x[i]);
-      sw += W[i];
-      swx += W[i] * d.x[i];
-      swy += W[i] * d.y[i];
-    }
-    xb = swx / sw;
-    yb = swy / sw;
-    long double num = 0, den = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const long double U = d.x[i] - xb, V = d.y[i] - yb;
-      beta[i] = W[i] * (U * d.u_y[i] * d.u_y[i] + b * V * d.u_x[i] * d.u_x[i]);
-      num += W[i] * beta[i] * V;
-      den += W[i] * beta[i] * U;
-    }
-    const long double next = num / den;
-    const bool done = std::fabs(next - b) <= 1e-19L * std::fabs(b);
-    b = next;
-    if (done) break;
-  }
-  // Recompute W, means and β at the final slope, then the adjusted x_i = X̄ + β_i.
-  sw = 0;
-  long double swx = 0, swy = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    W[i] = 1.0L / (static_cast<long double>(d.u_y[i]) * d.u_y[i] +
-                   b * b * static_cast<long double>(d.u_x[i]) * d.u_x[i]);
-    sw += W[i];
-    swx += W[i] * d.x[i];
-    swy += W[i] * d.y[i];
-  }
-  xb = swx / sw;
-  yb = swy / sw;
-  long double swxa = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const long double U = d.x[i] - xb, V = d.y[i] - yb;
-    beta[i] = W[i] * (U * d.u_y[i] * d.u_y[i] + b * V * d.u_x[i] * d.u_x[i]);
-    swxa += W[i] * (xb + beta[i]);
-  }
-  const long double x_adj_mean = swxa / sw;
-  long double swuu = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const long double u = xb + beta[i] - x_adj_mean;
-    swuu += W[i] * u * u;
-  }
-  Closed r;
-  r.k = b;
-  r.c = yb - b * xb;
-  r.var_k = 1.0L / swuu;
-  r.var_c = 1.0L / sw + x_adj_mean * x_adj_mean * r.var_k;
-  r.cov_kc = -x_adj_mean * r.var_k;
-  for (std::size_t i = 0; i < n; ++i) {
-    const long double e = d.y[i] - r.c - r.k * d.x[i];
-    r.chi2 += W[i] * e * e;
-  }
-  return r;
-}
-
-void ExpectMatchesClosed(const FitReport& fit, const Closed& closed, double rel_values,
+void ExpectMatchesClosed(const FitReport& fit, const LineSolution& closed, double rel_values,
                          double rel_covariance) {
   EXPECT_TRUE(RelNear(fit.slope(), static_cast<double>(closed.k), rel_values));
   EXPECT_TRUE(RelNear(fit.intercept(), static_cast<double>(closed.c), rel_values));
@@ -359,7 +259,7 @@ TEST(PearsonYork, CeresAloneFromColdStartFindsTheSameLine) {
 
 TEST(PearsonYork, MatchesYorksIterationAndErrorFormulas) {
   const LineData d = PearsonYork();
-  ExpectMatchesClosed(FitErrorsInVariables(d), ClosedYork(d), 1e-13, 1e-12);
+  ExpectMatchesClosed(FitErrorsInVariables(d), oracle::YorkLine(d), 1e-13, 1e-12);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -653,23 +553,20 @@ TEST(HardCases, InvalidOptionsAreRefused) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Every method against an independent long-double closed form on random data.
+// Every method against the extended-precision oracles on random data.
 
-TEST(IndependentCheck, OlsWlsYorkMatchLongDoubleClosedForms) {
+TEST(IndependentCheck, OlsWlsYorkMatchTheExtendedPrecisionOracles) {
   for (std::uint64_t seed : {1u, 2u, 3u}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     const LineData d = Synthetic(40, -0.8 + static_cast<double>(seed), 3.0, seed, true);
-    Closed ols = ClosedWeighted(d, false);
+    const LineSolution ols = oracle::OrdinaryLeastSquares(d);
     ExpectMatchesClosed(FitOrdinaryLeastSquares(d), ols, 1e-13, 1e-12);
     // OLS scaled covariance: × s².
     const FitReport fit = FitOrdinaryLeastSquares(d);
-    const long double s2 = ols.chi2 / (d.size() - 2);
-    EXPECT_TRUE(
-        RelNear((*fit.covariance_scaled)(0, 0), static_cast<double>(ols.var_k * s2), 1e-12));
-    EXPECT_TRUE(
-        RelNear((*fit.covariance_scaled)(1, 1), static_cast<double>(ols.var_c * s2), 1e-12));
-    ExpectMatchesClosed(FitWeightedLeastSquares(d), ClosedWeighted(d, true), 1e-13, 1e-12);
-    ExpectMatchesClosed(FitErrorsInVariables(d), ClosedYork(d), 1e-12, 1e-11);
+    EXPECT_TRUE(RelNear((*fit.covariance_scaled)(0, 0), ols.ScaledVarK(), 1e-12));
+    EXPECT_TRUE(RelNear((*fit.covariance_scaled)(1, 1), ols.ScaledVarC(), 1e-12));
+    ExpectMatchesClosed(FitWeightedLeastSquares(d), oracle::WeightedLeastSquares(d), 1e-13, 1e-12);
+    ExpectMatchesClosed(FitErrorsInVariables(d), oracle::YorkLine(d), 1e-12, 1e-11);
   }
 }
 
@@ -736,8 +633,30 @@ TEST(IndependentCheck, RobustIsTheWeightedFitAtItsOwnFinalWeights) {
     LineData weighted = d;
     for (std::size_t i = 0; i < d.size(); ++i)
       weighted.u_y[i] = robust.rows[i].sigma / std::sqrt(robust.rows[i].weight);
-    ExpectMatchesClosed(robust, ClosedWeighted(weighted, true), 1e-10, 1e-10);
+    ExpectMatchesClosed(robust, oracle::WeightedLeastSquares(weighted), 1e-10, 1e-10);
   }
+}
+
+TEST(IndependentCheck, HuberMatchesTheNewtonOracle) {
+  // Truth: src/oracle's Newton iteration on Huber's objective in long double (and, without u(Y),
+  // its joint fixed point with σ = 1.4826·MAD), with the IRLS covariance at the final weights.
+  LineData d = Synthetic(400, 1.3, 0.7, 21, false);
+  for (std::size_t i = 0; i < d.size(); i += 37) d.y[i] += 12.0 * d.u_y[i];  // gross errors
+  const FitReport stated = FitRobust(d);
+  const LineSolution huber = oracle::HuberLine(d);
+  EXPECT_TRUE(RelNear(stated.slope(), huber.k, 1e-13));
+  EXPECT_TRUE(RelNear(stated.intercept(), huber.c, 1e-13));
+  EXPECT_TRUE(RelNear(stated.covariance(0, 0), huber.var_k, 1e-12));
+  EXPECT_TRUE(RelNear(stated.covariance(1, 1), huber.var_c, 1e-12));
+  EXPECT_TRUE(RelNear(stated.covariance(0, 1), huber.cov_kc, 1e-12));
+  EXPECT_TRUE(RelNear(stated.chi2, huber.chi2, 1e-12));
+  const LineData unstated{d.x, d.y, {}, {}};
+  const FitReport mad = FitRobust(unstated);
+  const LineSolution huber_mad = oracle::HuberLineMadScale(unstated);
+  EXPECT_TRUE(RelNear(mad.slope(), huber_mad.k, 1e-12));
+  EXPECT_TRUE(RelNear(mad.intercept(), huber_mad.c, 1e-12));
+  EXPECT_TRUE(RelNear(mad.rows[0].sigma, huber_mad.sigma, 1e-12));
+  EXPECT_TRUE(RelNear(mad.covariance(0, 0), huber_mad.var_k, 1e-11));
 }
 
 TEST(IndependentCheck, PValueAndInformationCriteria) {

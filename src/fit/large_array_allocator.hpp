@@ -2,10 +2,8 @@
 // that backs large arrays with transparent huge pages.
 //
 // Why: a fit of 10^6 rows returns 56 MB of RowResult. From the ordinary allocator that memory is
-// a fresh anonymous mapping faulted in 4 KiB at a time: on this project's benchmark machine (a
-// VM) 14 000 page faults cost ~30 ms - more than the whole York fit - and unmapping it ~5 ms.
-// In 2 MiB pages the same array faults 28 times (measured: ~7 ms to fault, zero and fill 56 MB,
-// 0.2 ms to unmap).
+// a fresh anonymous mapping faulted in 4 KiB at a time: 14 000 page faults, which on a virtual
+// machine cost more than the whole York fit. In 2 MiB pages the same array faults 28 times.
 //
 // Contract: below kHugePageThreshold bytes, ::operator new/delete (no change for small fits).
 // At or above it, an anonymous private mmap aligned to 2 MiB with madvise(MADV_HUGEPAGE); the
@@ -14,7 +12,7 @@
 // alignment slack of < 2 MiB of address space, never touched). Throws std::bad_alloc when mmap
 // fails. Stateless: all instances compare equal, so vectors move and swap freely.
 // Caveat: with defrag = madvise (the common default) the first large allocation in a fragmented
-// system may wait for the kernel to compact memory into huge pages (seen once: ~0.15 s for 56 MB).
+// system may wait for the kernel to compact memory into huge pages.
 #pragma once
 
 #include <sys/mman.h>

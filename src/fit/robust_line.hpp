@@ -30,8 +30,7 @@
 // likelihood). Primary scaling: unscaled.
 //
 // Cost: one residual block per row, so Ceres' bookkeeping is ~300 bytes per row, and Problem
-// construction, Solve's preprocessing and ceres::Covariance each take ~0.3-0.6 s for 10^6 rows:
-// ~1.5 s CPU in all, against ~0.5 s for WLS.
+// construction, Solve's preprocessing and ceres::Covariance each cost a pass over all blocks.
 #pragma once
 
 #include "fit/fit_options.hpp"

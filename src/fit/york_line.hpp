@@ -27,7 +27,7 @@
 // It is ceres::Covariance's, for every N: computed on the compressed problem, whose 3×2 Jacobian
 // has the singular values of the N×2 one, so the rank test and (JᵀJ)⁻¹ are the full problem's
 // (a test compares with ceres::Covariance of all N residuals: ≤ 1e-12). On the full problem
-// at 10^6 rows it would cost 0.17 s (DENSE_SVD) or 0.42 s (SPARSE_QR), 6-15× the whole fit.
+// ceres::Covariance would factor an N×2 Jacobian, several times the cost of the whole fit.
 // Both conventions are reported, as the literature does: unscaled (York's; primary) and scaled
 // by sqrt(MSWD) = sqrt(S/(N − 2)) (as e.g. scipy.odr's sd_beta and Isoplot's "external" errors).
 //
@@ -38,14 +38,10 @@
 // Requirements: u(Y_i) finite and > 0 (so every W_i is finite whatever the slope), u(X_i) finite
 // and ≥ 0 (0: that X is exact). All u(X) = 0 reduces to WLS. Otherwise as least_squares_line.hpp.
 //
-// Cost (`uphill bench fit`, one core, thread CPU time, whole call): 10^4 rows ≈ 0.2 ms,
-// 10^6 rows ≈ 25-28 ms (was 0.48 s), of which ~3 ms validation, ~1.5 ms centring, ~8 passes over
-// the rows of ~1.3 ms (seed, Ceres, Newton, per-row results; the row kernel is vectorised with
-// `omp simd` and, where the CPU has it, an AVX2 clone), and ~10 ms for writing the 56 MB of
-// per-row results (RowResult; transparent huge pages via LargeArrayAllocator, without which the
-// page faults alone take ~30 ms). No N-sized buffer besides the result. NumPy's vectorised York
-// iteration, which computes neither covariance nor per-row results, takes ~90 ms; scipy.odr
-// ~1.6 s: see README.md, "Benchmarks: fit".
+// Cost: O(N) per pass over the rows, about 8 passes (validation, centring, seed, Ceres, Newton,
+// per-row results; the row kernel is vectorised with `omp simd` and, where the CPU has it, an
+// AVX2 clone), plus writing the per-row results. No N-sized buffer besides the result. Measured
+// against NumPy's York iteration and scipy.odr by `uphill bench fit` (docs/benchmarks.md).
 #pragma once
 
 #include "fit/fit_options.hpp"

@@ -27,8 +27,8 @@
 // Accuracy (tests/vision_track_test.cpp, `uphill bench track`): on the synthetic clips of
 // synthetic_clip.hpp (1280×720 view of a 1 m apparatus, ball radius ~25 px) RMS (u, v) error
 // 0.03 px without blur and noise (tested ≤ 0.1 px), 0.06–0.08 px with motion blur, noise, flicker
-// and H.264 (tested ≤ 0.3 px); (x, z) 0.03–0.09 mm (tested ≤ 0.5 mm). Cost: 0.4–0.6 ms per frame
-// on one core. The camera and scene calibration's own errors add to these on real video.
+// and H.264 (tested ≤ 0.3 px); (x, z) 0.03–0.09 mm (tested ≤ 0.5 mm). Cost per frame: measured by
+// `uphill bench track` (docs/benchmarks.md). The camera and scene calibration's own errors add to these on real video.
 //
 // Hard cases: the near rail hides the lower edge (masked); the body leaves the frame or drops
 // between the rails (lost: found = false, quality 0; the next frames search the whole path

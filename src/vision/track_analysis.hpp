@@ -64,7 +64,7 @@
 // of the truth, with standard errors of the expected size (x0 ≈ σ/√n_rest ≈ 0.04 mm, t0 ≈ 3 ms,
 // g ≈ 2 %); over 30 noise realisations the pulls (estimate − truth)/se have an RMS of 0.87–1.02
 // (x0, t0, g; x0, t0, μ; turning points): the standard errors are the real scatter.
-// Cost: ~0.1 s for 100 frames (g), the μ fit by the ODE similar.
+// Cost: a Ceres fit whose residuals each integrate the motion (quadrature for g, the ODE for μ).
 //
 // Errors: InputError for an empty track, a track with no frame found, fewer than 2 frames found,
 // or options out of range (u_x ≤ 0, g ≤ 0, k ≤ 0 …). A track that cannot be fitted (the ball

@@ -14,9 +14,9 @@ Fits, each timed (thread CPU time like the C++ side, best of K repeats):
   odr         scipy.odr: ODR(RealData(X, Y, sx=u(X), sy=u(Y)), unilinear), started at OLS,
               ODRPACK's default tolerances (how it is normally used)
 
-Prints one JSON object on stdout: numpy/scipy versions and, per fit, seconds, slope, intercept
-(floats print with repr, so they round-trip exactly), for york the iterations, for odr
-ODRPACK's stop reason.
+Prints one JSON object on stdout: python/numpy/scipy versions and, per fit, seconds, peak_bytes
+(peak resident memory, peak_memory.py), slope, intercept (floats print with repr, so they
+round-trip exactly), for york the iterations, for odr ODRPACK's stop reason.
 
 Written as a fair, tuned NumPy baseline: float64 throughout, the York iteration on data centred
 once at their mean (so X near 1e9 does not cancel inside the loop: that is the textbook
@@ -27,18 +27,10 @@ lose digits for X far from 0 is what the 1e9-offset case of the benchmark shows.
 import argparse
 import json
 import sys
-import time
 
 import numpy as np
 
-
-def best_of(repeats, f):
-    best, result = float("inf"), None
-    for _ in range(repeats):
-        t0 = time.thread_time()
-        result = f()
-        best = min(best, time.thread_time() - t0)
-    return best, result
+from peak_memory import measure
 
 
 def fit_lstsq(x, y):
@@ -139,26 +131,28 @@ def main():
         sys.exit("expected a float64 array of shape (4, n)")
     data = data.reshape(4, -1)
     x, y, ux, uy = (np.ascontiguousarray(r) for r in data)
-    out = {"numpy": np.__version__, "n": int(x.size), "fits": {}}
+    out = {"versions": {"Python": sys.version.split()[0], "NumPy": np.__version__},
+           "n": int(x.size), "fits": {}}
     fits = out["fits"]
 
-    t, (k, c) = best_of(a.repeats, lambda: fit_lstsq(x, y))
-    fits["lstsq"] = {"seconds": t, "slope": k, "intercept": c}
-    t, (k, c) = best_of(a.repeats, lambda: fit_polyfit(x, y))
-    fits["polyfit"] = {"seconds": t, "slope": k, "intercept": c}
-    t, (k, c) = best_of(a.repeats, lambda: fit_wls_lstsq(x, y, uy))
-    fits["wls_lstsq"] = {"seconds": t, "slope": k, "intercept": c}
+    t, (k, c), peak = measure(a.repeats, lambda: fit_lstsq(x, y))
+    fits["lstsq"] = {"seconds": t, "peak_bytes": peak, "slope": k, "intercept": c}
+    t, (k, c), peak = measure(a.repeats, lambda: fit_polyfit(x, y))
+    fits["polyfit"] = {"seconds": t, "peak_bytes": peak, "slope": k, "intercept": c}
+    t, (k, c), peak = measure(a.repeats, lambda: fit_wls_lstsq(x, y, uy))
+    fits["wls_lstsq"] = {"seconds": t, "peak_bytes": peak, "slope": k, "intercept": c}
     # The York setup (centring, squares, buffers) is part of the fit's time.
-    t, (k, c, it) = best_of(a.repeats, lambda: York(x, y, ux, uy)())
-    fits["york"] = {"seconds": t, "slope": k, "intercept": c, "iterations": it}
+    t, (k, c, it), peak = measure(a.repeats, lambda: York(x, y, ux, uy)())
+    fits["york"] = {"seconds": t, "peak_bytes": peak, "slope": k, "intercept": c, "iterations": it}
     if not a.no_odr:
         try:
             import scipy
-            out["scipy"] = scipy.__version__
-            t, (k, c, why) = best_of(a.repeats, lambda: fit_odr(x, y, ux, uy))
-            fits["odr"] = {"seconds": t, "slope": k, "intercept": c, "stopreason": why}
+            out["versions"]["SciPy"] = scipy.__version__
+            t, (k, c, why), peak = measure(a.repeats, lambda: fit_odr(x, y, ux, uy))
+            fits["odr"] = {"seconds": t, "peak_bytes": peak, "slope": k, "intercept": c,
+                           "stopreason": why}
         except ImportError:
-            out["scipy"] = None
+            pass
     json.dump(out, sys.stdout)
     sys.stdout.write("\n")
 

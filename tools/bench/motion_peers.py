@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
-"""Peers for `uphill bench motion` (tools/uphill/bench_motion.cpp): the same trajectory problem
+"""Peers for `uphill bench motion` (src/bench/motion_benchmark.cpp): the same trajectory problem
 with SciPy and NumPy. Usage: motion_peers.py PROBLEM.txt, where PROBLEM.txt holds
 "a b tan_theta tan_half_alpha g x0" and then 200 lines "x t_reference" (the 50-digit reference
-of the C++ side). Prints one row per method and setting: "method|setting|microseconds|max_rel_err".
+of the C++ side). Prints a first line "versions|{JSON}", then one row per method and setting:
+"method|setting|microseconds|max_rel_err|peak_bytes" (peak resident memory, peak_memory.py).
 
 Problem: release from rest at x0 (beyond X) of a spheroid on line rails; t(x) = integral of
 dx/xdot. As in src/motion: psi - psi0 = u0 cosh(w) removes the release singularity, and
@@ -12,11 +13,14 @@ dt/dw = sqrt(K M / (g z_eq sinc(u0 ch^2) sinc(u0 sh^2))) is smooth (PHYSICS.md).
   numpy GL    12-node Gauss-Legendre per interval in s, x = x0 + s^2 (removes the release
               singularity; the x form of the integrand), vectorised over all intervals
 """
+import json
 import sys
 import time
 
 import numpy as np
 from scipy import integrate
+
+import peak_memory
 
 
 def load(path):
@@ -58,6 +62,9 @@ class Ellipse:
 
 
 def main():
+    import scipy
+    print("versions|" + json.dumps({"Python": sys.version.split()[0], "NumPy": np.__version__,
+                                    "SciPy": scipy.__version__}), flush=True)
     a, b, B, T, g, x0, xs, ref = load(sys.argv[1])
     e = Ellipse(a, b, B, T)
     u0 = float(e.u_of_x(x0))
@@ -79,6 +86,7 @@ def main():
     ws = w_of(xs)
 
     def timed(work):
+        peak_memory.reset_peak()
         best = 1e300
         for _ in range(3):
             n, start = 0, time.perf_counter()
@@ -89,16 +97,16 @@ def main():
                 if el > 0.2:
                     break
             best = min(best, el / n)
-        return best * 1e6, out
+        return best * 1e6, out, peak_memory.peak_bytes()
 
     def report(method, setting, work):
         try:
-            micros, got = timed(work)
+            micros, got, peak = timed(work)
         except Exception as exc:  # e.g. a tolerance the solver refuses
             print(f"# {method} {setting}: failed ({exc})", file=sys.stderr)
             return
         err = float(np.max(np.abs(got / ref - 1)))
-        print(f"{method}|{setting}|{micros:.3f}|{err:.3e}", flush=True)
+        print(f"{method}|{setting}|{micros:.3f}|{err:.3e}|{peak}", flush=True)
 
     tols = [10.0 ** -k for k in (3, 5, 7, 9, 11, 13)]
     for tol in tols:

@@ -14,9 +14,9 @@ Run by `uphill bench convert` as a subprocess (it is also usable by hand):
       (ddof 1) and the probabilistically symmetric 95 % interval from order statistics
       (np.partition), as uphill's propagation reports them.
 
-Prints one JSON object on stdout: timings (seconds, best of K repeats, thread CPU time like the
-C++ side: the throughput of one core, robust to other load on the machine) and, for mc, the
-statistics.
+Prints one JSON object on stdout: versions, timings (seconds, best of K repeats, thread CPU time
+like the C++ side: the throughput of one core, robust to other load on the machine), the peak
+resident memory (peak_bytes, peak_memory.py) and, for mc, the statistics.
 Written to be a fair, tuned NumPy baseline: float64 throughout, every ufunc writing with out= into
 arrays allocated once (no temporaries, no page faults in the timed region), atan of the ratios
 (cheaper than arctan2 here), one in-place partition per output for both ends of the interval.
@@ -24,9 +24,10 @@ arrays allocated once (no temporaries, no page faults in the timed region), atan
 import argparse
 import json
 import sys
-import time
 
 import numpy as np
+
+from peak_memory import measure
 
 LAB = {  # the lab spheroid and a plausible set of measurement uncertainties (metres)
     "L": (1.165, 0.002), "H": (0.300, 0.001), "D": (0.045, 0.0005),
@@ -116,15 +117,6 @@ def monte_carlo(trials, seed, case, w, coverage=0.95):
     return stats, int(trials - m)
 
 
-def best_of(repeats, fn):
-    best, result = float("inf"), None
-    for _ in range(repeats):
-        t0 = time.thread_time()
-        result = fn()
-        best = min(best, time.thread_time() - t0)
-    return best, result
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="mode", required=True)
@@ -140,21 +132,23 @@ def main():
     m.add_argument("--case", type=json.loads, default=LAB)
     m.add_argument("--repeats", type=int, default=3)
     args = ap.parse_args()
-    info = {"numpy": np.__version__, "python": sys.version.split()[0]}
+    info = {"versions": {"Python": sys.version.split()[0], "NumPy": np.__version__}}
     if args.mode == "convert":
         L, H, D = np.fromfile(args.input, dtype="<f8").reshape(3, -1)
         work = Work(L.size)
         convert(L, H, D, args.a, args.b, work)  # allocate and touch the work arrays once
-        seconds, (theta, alpha, X) = best_of(
+        seconds, (theta, alpha, X), peak = measure(
             args.repeats, lambda: convert(L, H, D, args.a, args.b, work))
         np.stack((theta, alpha, X)).astype("<f8").tofile(args.output)
-        info.update(mode="convert", n=int(L.size), seconds=seconds, repeats=args.repeats)
+        info.update(mode="convert", n=int(L.size), seconds=seconds, peak_bytes=peak,
+                    repeats=args.repeats)
     else:
         work = Work(args.trials)
         monte_carlo(args.trials, args.seed, args.case, work)  # allocate and touch once
-        seconds, (stats, rejected) = best_of(
+        seconds, (stats, rejected), peak = measure(
             args.repeats, lambda: monte_carlo(args.trials, args.seed, args.case, work))
-        info.update(mode="mc", trials=args.trials, seconds=seconds, repeats=args.repeats,
+        info.update(mode="mc", trials=args.trials, seconds=seconds, peak_bytes=peak,
+                    repeats=args.repeats,
                     rejected=rejected, stats=stats, inputs=args.case)
     json.dump(info, sys.stdout)
     sys.stdout.write("\n")

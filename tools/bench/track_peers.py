@@ -4,7 +4,8 @@ HoughCircles (circle nearest the previous one), on the same clips, decoding incl
 Usage: track_peers.py NAME VIDEO TRUTH_CSV R0 [NAME VIDEO TRUTH_CSV R0 ...]
   TRUTH_CSV: frame,t,x,z,u,v,visibility (synthetic_clip.hpp); R0: the ball's outline radius in
   the first frame, px. The trackers start from the true box of the first frame.
-Prints one line per method and clip: method clip fps rms_px frames_compared
+Prints a first line "versions Python X OpenCV Y", then one line per method and clip:
+method clip fps rms_px frames_compared peak_bytes (peak resident memory, peak_memory.py)
 fps: frames per CPU-second of the process (time.process_time(), cv2.setNumThreads(1)), as uphill's.
 RMS of (u, v) over the frames with the ball present and at least half visible, where the
 method reports a position (frames it misses are not counted; their number shows in frames).
@@ -15,6 +16,8 @@ import sys
 import time
 
 import cv2
+
+import peak_memory
 
 cv2.setNumThreads(1)
 
@@ -89,6 +92,7 @@ def score(truth, found):
 
 
 def main(args):
+    print("versions Python %s OpenCV %s" % (sys.version.split()[0], cv2.__version__), flush=True)
     for i in range(0, len(args), 4):
         name, video, truth_csv, r0 = args[i], args[i + 1], args[i + 2], float(args[i + 3])
         truth = read_truth(truth_csv)
@@ -97,9 +101,12 @@ def main(args):
                 ("KCF", lambda: run_tracker("KCF", video, u0, v0, r0)),
                 ("HoughCircles", lambda: run_hough(video, u0, v0, r0))]
         for method, run in runs:
+            peak_memory.reset_peak()
             found, seconds = run()
+            peak = peak_memory.peak_bytes()
             rms, n = score(truth, found)
-            print("%s %s %.3f %.6f %d" % (method, name, len(found) / seconds, rms, n), flush=True)
+            print("%s %s %.3f %.6f %d %d" % (method, name, len(found) / seconds, rms, n, peak),
+                  flush=True)
 
 
 if __name__ == "__main__":

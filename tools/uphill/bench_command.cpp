@@ -1,15 +1,107 @@
-// `uphill bench <what>`: benchmarks that print work-precision tables (never timed unit tests).
+// `uphill bench <what>`: the benchmarks of src/bench (speed against accuracy and memory, with
+// their peers, recorded in docs/benchmarks.md). This file only maps flags to their options.
+#include <iostream>
+#include <memory>
+
+#include "bench/convert_benchmark.hpp"
+#include "bench/fit_benchmark.hpp"
+#include "bench/motion_benchmark.hpp"
+#include "bench/track_benchmark.hpp"
 #include "commands.hpp"
 
 namespace uphill::cli {
+namespace {
 
-void AddBenchCommand(CLI::App& app) {
-  CLI::App* bench = app.add_subcommand("bench", "Benchmarks: speed against error, with peers");
+// The flags every benchmark has, and the command line for the record.
+void AddCommonFlags(CLI::App* cmd, bench::CommonOptions* common, const std::string& python_help) {
+  cmd->add_option("--python", common->python, python_help)->capture_default_str();
+  cmd->add_option("--doc", common->doc, "file to record the results in (default: the repository's docs/benchmarks.md)");
+  cmd->add_flag("--no-doc", common->no_doc, "do not record the results in docs/benchmarks.md");
+}
+
+std::string CommandLine(const std::vector<std::string>& arguments) {
+  std::string line = "uphill";
+  for (const std::string& a : arguments) line += " " + a;
+  return line;
+}
+
+void AddFit(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
+  auto o = std::make_shared<bench::FitBenchmarkOptions>();
+  CLI::App* cmd = bench.add_subcommand(
+      "fit", "Line and friction fits: time, accuracy and memory against extended precision and NumPy/SciPy");
+  cmd->add_option("--sizes", o->sizes, "rows of the straight-line cases")->delimiter(',')->capture_default_str();
+  cmd->add_option("--friction-sizes", o->friction_sizes, "rows of the friction-model cases")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--offset-rows", o->offset_rows, "rows of the X = 1e9 case (0: skip)")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "seed of the synthetic data")->capture_default_str();
+  cmd->add_option("--repeats", o->repeats, "timed repeats per fit (the best counts)")->capture_default_str();
+  AddCommonFlags(cmd, &o->common, "Python with NumPy/SciPy for the peers");
+  cmd->add_option("--peer-script", o->script, "path of tools/bench/fit_peers.py");
+  cmd->add_flag("--no-peers", o->no_peers, "skip the NumPy/SciPy peers");
+  cmd->add_flag("--no-odr", o->no_odr, "skip scipy.odr (slow at 10^6 rows)");
+  cmd->callback([o, argv] {
+    o->common.command = CommandLine(*argv);
+    bench::RunFitBenchmark(*o, std::cout);
+  });
+}
+
+void AddConvert(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
+  auto o = std::make_shared<bench::ConvertBenchmarkOptions>();
+  CLI::App* cmd = bench.add_subcommand(
+      "convert", "Conversion and Monte Carlo throughput per core, with accuracy and memory, against NumPy");
+  cmd->add_option("--configurations", o->configurations, "random configurations to convert")->capture_default_str();
+  cmd->add_option("--trials", o->trials, "Monte Carlo trials")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "seed of the configurations and of the Monte Carlo")->capture_default_str();
+  cmd->add_option("--repeats", o->repeats, "timed repeats per row (the best counts)")->capture_default_str();
+  AddCommonFlags(cmd, &o->common, "Python with NumPy for the comparison");
+  cmd->add_option("--numpy-script", o->script, "path of tools/bench/numpy_convert.py");
+  cmd->add_option("--reference", o->reference, "path of tests/data/physics_reference.json");
+  cmd->add_flag("--no-numpy", o->no_numpy, "skip the NumPy comparison");
+  cmd->callback([o, argv] {
+    o->common.command = CommandLine(*argv);
+    bench::RunConvertBenchmark(*o, std::cout);
+  });
+}
+
+void AddMotion(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
+  auto o = std::make_shared<bench::MotionBenchmarkOptions>();
+  CLI::App* cmd = bench.add_subcommand("motion", "Work-precision of the motion methods, against SciPy/NumPy");
+  cmd->add_option("-o,--out", o->out, "folder for the work-precision figure")->capture_default_str();
+  AddCommonFlags(cmd, &o->common, "Python with SciPy for the comparison");
+  cmd->add_option("--script", o->script, "path of tools/bench/motion_peers.py");
+  cmd->add_flag("--no-python", o->no_python, "skip the SciPy/NumPy comparison");
+  cmd->add_flag("--release-only", o->release_only, "only the ReleaseTimes rows (no Motion rows, no peers)");
+  cmd->callback([o, argv] {
+    o->common.command = CommandLine(*argv);
+    bench::RunMotionBenchmark(*o, std::cout);
+  });
+}
+
+void AddTrack(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
+  auto o = std::make_shared<bench::TrackBenchmarkOptions>();
+  CLI::App* cmd = bench.add_subcommand("track", "Ball tracking: fps against decoding, RMS error, OpenCV peers");
+  cmd->add_option("--cache", o->cache, "folder of the rendered clips (reused between runs)")->capture_default_str();
+  cmd->add_flag("--fresh", o->fresh, "render the clips again");
+  AddCommonFlags(cmd, &o->common, "Python with cv2 for the peers");
+  cmd->add_option("--script", o->script, "path of tools/bench/track_peers.py");
+  cmd->add_flag("--no-python", o->no_python, "skip the OpenCV peers");
+  cmd->callback([o, argv] {
+    o->common.command = CommandLine(*argv);
+    bench::RunTrackBenchmark(*o, std::cout);
+  });
+}
+
+}  // namespace
+
+void AddBenchCommand(CLI::App& app, const std::vector<std::string>& arguments) {
+  CLI::App* bench = app.add_subcommand("bench", "Benchmarks: speed against error and memory, with peers");
   bench->require_subcommand(1);
-  AddBenchConvert(*bench);
-  AddBenchFit(*bench);
-  AddBenchMotion(*bench);
-  AddBenchTrack(*bench);
+  const auto argv = std::make_shared<std::vector<std::string>>(arguments);
+  AddConvert(*bench, argv);
+  AddFit(*bench, argv);
+  AddMotion(*bench, argv);
+  AddTrack(*bench, argv);
 }
 
 }  // namespace uphill::cli

@@ -6,6 +6,8 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
 
 namespace uphill::cli {
 
@@ -13,7 +15,9 @@ namespace uphill::cli {
 int& ExitStatus();
 
 void AddConvertCommand(CLI::App& app);
-void AddBenchCommand(CLI::App& app);
+// `bench`: the benchmarks of src/bench (bench_command.cpp); `arguments` (argv without the
+// program name) go into the benchmarks' record.
+void AddBenchCommand(CLI::App& app, const std::vector<std::string>& arguments);
 // `fit` and `report` (fit_command.cpp).
 void AddFitCommand(CLI::App& app);
 // `serve`: the measurement-entry web page (serve_command.cpp, src/server/).
@@ -28,11 +32,5 @@ void AddCalibrateCommand(CLI::App& app);
 void AddTrackCommand(CLI::App& app);
 // `analyse-track`: events and model fit of a ball track (analyse_track_command.cpp, src/vision/).
 void AddAnalyseTrackCommand(CLI::App& app);
-
-// `uphill bench <what>`: each benchmark adds itself to the bench subcommand.
-void AddBenchConvert(CLI::App& bench);
-void AddBenchFit(CLI::App& bench);  // bench_fit.cpp
-void AddBenchMotion(CLI::App& bench);  // bench_motion.cpp
-void AddBenchTrack(CLI::App& bench);  // bench_track.cpp
 
 }  // namespace uphill::cli

@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
   uphill::cli::AddCalibrateCommand(app);
   uphill::cli::AddTrackCommand(app);
   uphill::cli::AddAnalyseTrackCommand(app);
-  uphill::cli::AddBenchCommand(app);
+  uphill::cli::AddBenchCommand(app, std::vector<std::string>(argv + 1, argv + argc));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

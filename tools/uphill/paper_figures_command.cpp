@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <iostream>
 
-#include "bench_support.hpp"
+#include "bench/support.hpp"
 #include "commands.hpp"
 #include "io/atomic_file.hpp"
 #include "io/experiment.hpp"

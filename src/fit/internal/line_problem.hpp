@@ -86,7 +86,7 @@ SolverInfo RunCeres(const FitOptions& options, bool seeded, ceres::Problem* prob
 // that raises the cost beyond rounding is undone. `costs` are the cost functions of the problem
 // (each with θ as its only parameter block), evaluated directly (CostFunction::Evaluate: the
 // same autodiff/numeric code Ceres uses, without Problem::Evaluate's per-call setup, which
-// costs ~0.5 s for 10^6 residual blocks). Why: Ceres' termination tests look at the cost,
+// walks every residual block). Why: Ceres' termination tests look at the cost,
 // which is flat to ~sqrt(ε) relative at a minimum, so Ceres stops with parameters good to
 // ~1e-9; the gradient Jᵀr is accurate to ~ε (summed in long double), and so is its zero.
 // With a robust loss (applied to each cost function's squared norm s, as Ceres does) the step

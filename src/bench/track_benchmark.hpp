@@ -1,0 +1,24 @@
+// `uphill bench track`: speed and accuracy of the ball tracker (src/vision) on synthetic clips
+// with exact ground truth, against decoding alone and OpenCV's trackers (tools/bench/
+// track_peers.py). What it measures and how: docs/bench.md; its latest results:
+// docs/benchmarks.md.
+#pragma once
+
+#include <ostream>
+#include <string>
+
+#include "bench/options.hpp"
+
+namespace uphill::bench {
+
+struct TrackBenchmarkOptions {
+  CommonOptions common;
+  std::string cache = "/tmp/uphill-bench-track";  // rendered clips, reused between runs
+  std::string script;                             // default: tools/bench/track_peers.py found upward
+  bool no_python = false;
+  bool fresh = false;  // render the clips again
+};
+
+void RunTrackBenchmark(const TrackBenchmarkOptions& options, std::ostream& out);
+
+}  // namespace uphill::bench
