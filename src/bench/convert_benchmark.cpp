@@ -124,12 +124,7 @@ void RunConvertBenchmark(const ConvertBenchmarkOptions& f, std::ostream& out) {
   if (f.configurations < 1000) throw InputError("--configurations", "must be at least 1000");
   if (f.trials < 100) throw InputError("--trials", "must be at least 100");
   if (f.repeats < 1) throw InputError("--repeats", "must be at least 1");
-  Section section;
-  section.name = "convert";
-  section.command = f.common.command;
-  section.machine = DescribeMachine();
-  section.versions = BuildVersions();
-  section.method = kMethod;
+  Section section = StartSection("convert", f.common.command, kMethod);
   const std::string reference = f.reference.empty() ? FindUpward("tests/data/physics_reference.json") : f.reference;
   const BatchKernel kernel = BatchKernel::kAuto;
   std::string lab = "Monte Carlo case (the lab spheroid, metres):";

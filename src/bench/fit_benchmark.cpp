@@ -216,12 +216,7 @@ void RunFitBenchmark(const FitBenchmarkOptions& f, std::ostream& out) {
     if (n < 3) throw InputError("--sizes", "every size must be at least 3");
   for (std::uint64_t n : f.friction_sizes)
     if (n < 3) throw InputError("--friction-sizes", "every size must be at least 3");
-  Section section;
-  section.name = "fit";
-  section.command = f.common.command;
-  section.machine = DescribeMachine();
-  section.versions = BuildVersions();
-  section.method = kMethod;
+  Section section = StartSection("fit", f.common.command, kMethod);
 
   std::string script = f.script.empty() ? FindUpward("tools/bench/fit_peers.py") : f.script;
   const std::string why_not = PeerUnavailable(f.no_peers ? "--no-peers" : "", f.common.python, script,

@@ -76,12 +76,7 @@ constexpr const char* kMethod =
 }  // namespace
 
 void RunMotionBenchmark(const MotionBenchmarkOptions& f, std::ostream& out) {
-  Section section;
-  section.name = "motion";
-  section.command = f.common.command;
-  section.machine = DescribeMachine();
-  section.versions = BuildVersions();
-  section.method = kMethod;
+  Section section = StartSection("motion", f.common.command, kMethod);
   const Rails rails = Rails::FromAngles(kThetaDeg * M_PI / 180, kAlphaDeg * M_PI / 180);
   const Scene scene(Body::Spheroid(kA, kB), rails);
   const double x0 = 1.05 * *scene.x_eq();

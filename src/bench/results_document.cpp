@@ -69,6 +69,16 @@ std::string Table::Markdown() const {
   return md;
 }
 
+Section StartSection(const std::string& name, const std::string& command, const std::string& method) {
+  Section section;
+  section.name = name;
+  section.command = command;
+  section.machine = DescribeMachine();
+  section.versions = BuildVersions();
+  section.method = method;
+  return section;
+}
+
 std::string SectionMarkdown(const Section& s) {
   std::ostringstream md;
   md << Begin(s.name) << "\n## `uphill bench " << s.name << "`\n\n";

@@ -53,6 +53,10 @@ struct Section {
   std::vector<std::string> notes;    // e.g. peers skipped, and why
 };
 
+// A section named `name` with the command line, the machine as it is now and the build's
+// versions filled in.
+Section StartSection(const std::string& name, const std::string& command, const std::string& method);
+
 std::string SectionMarkdown(const Section& section);
 
 // Replaces (or adds, in name order) the section in the file at `path`, atomically. Throws

@@ -3,8 +3,8 @@
 // exchanging arrays with it.
 //
 // Peak memory. Every benchmark row states the peak resident set size (RSS) of the process that
-// did the work, measured the same way on both sides: before the row, the kernel's high-water mark
-// VmHWM is reset to the current RSS (writing "5" to /proc/self/clear_refs, Linux ≥ 4.0); after
+// did the work, measured the same way on both sides: before the row, the allocator returns freed
+// memory (malloc_trim) and the kernel's high-water mark VmHWM is reset to the current RSS (writing "5" to /proc/self/clear_refs, Linux ≥ 4.0); after
 // it, VmHWM is read from /proc/self/status. The figure therefore includes the program itself and
 // the row's input data as they were resident when the row started (as a user's process would
 // hold them), plus whatever the work allocated and touched. The Python peers do the same
@@ -34,7 +34,8 @@ double ProcessCpuSeconds();
 // Monotonic wall-clock time.
 double WallSeconds();
 
-// Resets the process's peak RSS to its current RSS; false where the kernel does not allow it.
+// Returns freed heap memory to the system (malloc_trim) and resets the process's peak RSS to its
+// current RSS; false where the kernel does not allow it.
 bool ResetPeakResident();
 // The process's peak RSS since the last reset (VmHWM), bytes; 0 if unknown.
 std::uint64_t PeakResidentBytes();

@@ -139,13 +139,8 @@ constexpr const char* kMethod =
 }  // namespace
 
 void RunTrackBenchmark(const TrackBenchmarkOptions& f, std::ostream& out) {
-  Section section;
-  section.name = "track";
-  section.command = f.common.command;
-  section.machine = DescribeMachine();
-  section.versions = BuildVersions();
+  Section section = StartSection("track", f.common.command, kMethod);
   section.versions.emplace_back("OpenCV (C++)", CV_VERSION);
-  section.method = kMethod;
   // One core's work: OpenCV's parallel loops off; FFmpeg's decoder threads are counted by the
   // process clock (OPENCV_FFMPEG_CAPTURE_OPTIONS reaches only the demuxer in OpenCV 4.6).
   setenv("OPENCV_FFMPEG_CAPTURE_OPTIONS", "threads;1", 1);
