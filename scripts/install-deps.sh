@@ -3,6 +3,7 @@
 # The README's two Quick-start commands and .ci/run all go through this one script.
 #   bash scripts/install-deps.sh          build + test dependencies
 #   bash scripts/install-deps.sh --bench  also NumPy/SciPy for the benchmarks' comparisons
+#   bash scripts/install-deps.sh --package  also debootstrap, for scripts/test-deb.sh
 set -euo pipefail
 
 packages=(
@@ -12,6 +13,8 @@ packages=(
   libcpp-httplib-dev chromium
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
   libopencv-calib3d-dev
+  # dpkg-shlibdeps for `cpack -G DEB`; man for the test of the installed manual pages
+  dpkg-dev man-db
 )
 # The browser test of `uphill serve` (tests/e2e) runs on node + npm and Debian's chromium. A
 # machine that already has Node (e.g. a newer one from elsewhere) keeps it: Debian's npm would
@@ -19,9 +22,13 @@ packages=(
 if ! command -v node > /dev/null 2>&1; then
   packages+=(nodejs npm)
 fi
-if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(python3-numpy python3-scipy python3-statsmodels python3-opencv)
-fi
+for option in "$@"; do
+  case "$option" in
+    --bench) packages+=(python3-numpy python3-scipy python3-statsmodels python3-opencv) ;;
+    --package) packages+=(debootstrap) ;;
+    *) echo "install-deps: unknown option '$option' (--bench, --package)" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${packages[@]}"; do

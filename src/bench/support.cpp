@@ -95,6 +95,12 @@ std::string FindUpward(const std::string& relative) {
       dir = dir.parent_path();
     }
   }
+  // An installed program: the repository's files are installed under PREFIX/share/uphill with the
+  // same relative paths, found relative to PREFIX/bin (so any prefix works, also a moved one).
+  if (!exe.empty()) {
+    const fs::path installed = exe.parent_path() / UPHILL_PKGDATADIR_FROM_BINDIR / relative;
+    if (fs::exists(installed, ec)) return installed.lexically_normal().string();
+  }
   return "";
 }
 

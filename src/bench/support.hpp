@@ -81,7 +81,8 @@ ProcessRun RunProcess(const std::vector<std::string>& argv, const std::string& s
                       const std::string& stderr_path = "");
 
 // A file of the repository (e.g. "tools/bench/numpy_convert.py"), found by walking up from the
-// executable's directory and from the working directory; "" if not found.
+// executable's directory and from the working directory, then in the installed PREFIX/share/uphill
+// (relative to the installed program); "" if not found.
 std::string FindUpward(const std::string& relative);
 // The repository's root directory (the one holding tools/bench/), "" if not found.
 std::string RepositoryRoot();

@@ -3,6 +3,7 @@
 
 #include "commands.hpp"
 #include "model/input_error.hpp"
+#include "self_documentation.hpp"
 
 namespace uphill::cli {
 int& ExitStatus() {
@@ -12,9 +13,9 @@ int& ExitStatus() {
 }  // namespace uphill::cli
 
 int main(int argc, char** argv) {
-  CLI::App app{"uphill: analysis toolkit for the rolling-uphill rail apparatus"};
+  CLI::App app{"uphill: analysis toolkit for the rolling-uphill rail apparatus", "uphill"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "uphill 0.1.0");
+  app.set_version_flag("--version", "uphill " UPHILL_VERSION);
   uphill::cli::AddConvertCommand(app);
   uphill::cli::AddFitCommand(app);
   uphill::cli::AddServeCommand(app);
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   uphill::cli::AddTrackCommand(app);
   uphill::cli::AddAnalyseTrackCommand(app);
   uphill::cli::AddBenchCommand(app, std::vector<std::string>(argv + 1, argv + argc));
+  uphill::cli::AddSelfDocumentationFlags(app, "uphill " UPHILL_VERSION);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
