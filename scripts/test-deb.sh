@@ -8,8 +8,9 @@
 #   sudo bash scripts/test-deb.sh            (root: debootstrap, chroot and mount need it)
 #
 # Manual / optional CI step, not part of scripts/test.sh: it needs the network to the Debian
-# mirror and takes minutes (the first run bootstraps ~300 MB; the bootstrapped base is kept in
-# $UPHILL_DEB_TEST_CACHE, default /var/tmp/uphill-deb-test, and copied for every later run).
+# mirror and takes minutes (the first run bootstraps Debian and downloads ~430 packages; the
+# bootstrapped base and the downloaded packages are kept in $UPHILL_DEB_TEST_CACHE, default
+# /var/tmp/uphill-deb-test, and every run starts from a fresh copy of the base).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mirror=${UPHILL_DEBIAN_MIRROR:-http://deb.debian.org/debian}
@@ -35,8 +36,10 @@ fi
 
 root=$(mktemp -d "$cache/run-XXXXXX")
 cleanup() {
-  for m in dev/pts dev proc; do mountpoint -q "$root/$m" && umount -l "$root/$m"; done
-  rm -rf "$root"
+  for m in var/cache/apt/archives dev/pts dev proc; do
+    if mountpoint -q "$root/$m"; then umount -l "$root/$m"; fi
+  done
+  rm -rf --one-file-system "$root"  # never into a mount still attached
 }
 trap cleanup EXIT
 cp -a "$base/." "$root/"
@@ -50,6 +53,9 @@ cp /etc/resolv.conf "$root/etc/resolv.conf"
 mount -t proc proc "$root/proc"
 mount --bind /dev "$root/dev"
 mount --bind /dev/pts "$root/dev/pts"
+# Downloaded packages are kept between runs (the system itself is fresh every time).
+mkdir -p "$cache/archives/partial"
+mount --bind "$cache/archives" "$root/var/cache/apt/archives"
 mkdir -p "$root/tmp/debs"
 cp "${debs[@]}" "$root/tmp/debs/"
 
@@ -65,7 +71,7 @@ chroot "$root" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin DEBIAN_FRONTEN
 
 echo "== the installed program, as a user in their home folder"
 chroot "$root" /usr/bin/env -i PATH=/usr/bin:/bin LANG=C.UTF-8 bash -euo pipefail -c '
-  useradd --create-home lab
+  /usr/sbin/useradd --create-home --shell /bin/bash lab
   su lab -c "
     set -euo pipefail
     cd ~
