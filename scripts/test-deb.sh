@@ -77,9 +77,12 @@ chroot "$root" /usr/bin/env -i PATH=/usr/bin:/bin LANG=C.UTF-8 bash -euo pipefai
     cd ~
     command -v uphill
     uphill --version
-    uphill convert --body spheroid --a 15.875mm --b 25.4mm --L 1165mm --H 300mm --D 120mm --mu 0.05 | head -8
-    uphill convert --batch /usr/share/uphill/data/convert_batch.csv --csv --mc-trials 1000 | head -3
-    uphill fit /usr/share/uphill/data/series2-fixed-L --mc-trials 1000 | head -5
+    uphill convert --body spheroid --a 15.875mm --b 25.4mm --L 1165mm --H 300mm --D 120mm --mu 0.05 > one.txt
+    head -8 one.txt
+    uphill convert --batch /usr/share/uphill/data/convert_batch.csv --csv --mc-trials 1000 > batch.csv
+    head -3 batch.csv
+    uphill fit /usr/share/uphill/data/series2-fixed-L --mc-trials 1000 > fit.txt
+    head -4 fit.txt
     uphill report /usr/share/uphill/data/series2-fixed-L -o report --mc-trials 1000
     test -s report/report.html && test -s report/fit_y_vs_x.png
     uphill paper-figures -o figures > /dev/null && test -s figures/series2-fixed-L/fit_y_vs_x.svg
