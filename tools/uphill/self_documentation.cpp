@@ -174,11 +174,10 @@ std::string ProgramSections() {
             "every column header names its unit; JSON output is always SI (metres, radians, seconds).") +
        "\n";
   s += ".SH EXIT STATUS\n.TP\n0\nSuccess.\n.TP\n1\n";
-  s += Roff("Internal error (a bug: please report it with the command line), or an environment problem "
-            "such as a file that cannot be written or gnuplot missing.") +
-       "\n.TP\n2\n";
-  s += Roff("Bad input: a one-line message names the flag, or the file, row and column, and the rule broken. "
-            "In a batch the other rows are still processed and printed.") +
+  s += Roff("An internal error: a bug. Please report it with the command line.") + "\n.TP\n2\n";
+  s += Roff("Bad input or environment: a flag, a file, a row or a column (the one-line message names it "
+            "and the rule broken), or what the program needs from the machine (gnuplot, a writable output "
+            "folder, a free port). In a batch the other rows are still processed and printed.") +
        "\n";
   s += ".SH FILES\n.TP\n" + Italic("PREFIX/share/uphill/data/") + "\n";
   s += Roff("Sample inputs: two synthetic experiments laid out like the seed paper's series "
