@@ -15,6 +15,7 @@ packages=(
   libopencv-calib3d-dev
   # dpkg-shlibdeps for `cpack -G DEB`; man for the test of the installed manual pages
   dpkg-dev man-db
+  librandom123-dev povray ffmpeg
 )
 # The browser test of `uphill serve` (tests/e2e) runs on node + npm and Debian's chromium. A
 # machine that already has Node (e.g. a newer one from elsewhere) keeps it: Debian's npm would
