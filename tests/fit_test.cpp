@@ -11,11 +11,13 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <ceres/ceres.h>
 
 #include "fit/least_squares_line.hpp"
+#include "fit/line_rows.hpp"
 #include "fit/model_comparison.hpp"
 #include "fit/robust_line.hpp"
 #include "fit/york_line.hpp"
@@ -678,6 +680,55 @@ TEST(IndependentCheck, PValueAndInformationCriteria) {
   EXPECT_TRUE(RelNear(*ols.bic, m2ll + 3.0 * std::log(n), 1e-13));
   // Comparing a stated-σ fit with an estimated-σ one is refused.
   ExpectInputError([&] { CompareModels(ols, wls); }, "fits");
+}
+
+TEST(Diagnostics, RowsOnDemandAreTheStoredRowsBitForBit) {
+  // LineRowResults (line_rows.hpp) computes the rows of a fit run with keep_rows = false: they must
+  // be the very numbers the fit stores with keep_rows = true, and the fit's summaries (χ², the
+  // outlier and down-weighted lists) must not depend on whether rows are kept.
+  LineData d = Synthetic(3000, 1.7, -0.4, 31, true);
+  for (std::size_t i = 0; i < d.size(); i += 97) d.y[i] += 9.0 * d.u_y[i];  // outliers
+  const LineData no_u{d.x, d.y, {}, {}};
+  FitOptions stream;
+  stream.keep_rows = false;
+  RobustOptions robust_stream, robust_mad;
+  robust_stream.fit.keep_rows = false;
+  robust_mad.loss = RobustLoss::kCauchy;
+  RobustOptions robust_mad_stream = robust_mad;
+  robust_mad_stream.fit.keep_rows = false;
+  const std::vector<std::tuple<std::string, const LineData*, FitReport, FitReport>> cases = {
+      {"OLS", &d, FitOrdinaryLeastSquares(d), FitOrdinaryLeastSquares(d, stream)},
+      {"WLS", &d, FitWeightedLeastSquares(d), FitWeightedLeastSquares(d, stream)},
+      {"York", &d, FitErrorsInVariables(d), FitErrorsInVariables(d, stream)},
+      {"Huber", &d, FitRobust(d), FitRobust(d, robust_stream)},
+      {"Cauchy, estimated scale", &no_u, FitRobust(no_u, robust_mad), FitRobust(no_u, robust_mad_stream)}};
+  for (const auto& [name, data, kept, streamed] : cases) {
+    SCOPED_TRACE(name);
+    ASSERT_EQ(kept.rows.size(), data->size());
+    EXPECT_TRUE(streamed.rows.empty());
+    EXPECT_EQ(streamed.chi2, kept.chi2);
+    EXPECT_EQ(streamed.outliers, kept.outliers);
+    EXPECT_FALSE(kept.outliers.empty());
+    ASSERT_EQ(streamed.downweighted.size(), kept.downweighted.size());
+    EXPECT_EQ(streamed.slope(), kept.slope());
+    const LineRowResults rows(streamed, *data);
+    ASSERT_EQ(rows.size(), kept.rows.size());
+    std::size_t flagged = 0;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const RowResult a = rows[i], &b = kept.rows[i];
+      ASSERT_EQ(a.row, b.row);
+      ASSERT_EQ(a.fitted, b.fitted) << i;
+      ASSERT_EQ(a.residual, b.residual) << i;
+      ASSERT_EQ(a.sigma, b.sigma) << i;
+      ASSERT_EQ(a.normalised, b.normalised) << i;
+      ASSERT_EQ(a.weight, b.weight) << i;
+      ASSERT_EQ(a.outlier, b.outlier) << i;
+      flagged += a.outlier;
+    }
+    EXPECT_EQ(flagged, kept.outliers.size());
+  }
+  const LineData other{{1.0, 2.0, 3.0}, {1.0, 2.5, 2.9}, {}, {}};
+  EXPECT_THROW(LineRowResults(std::get<2>(cases[0]), other), std::invalid_argument);
 }
 
 TEST(Diagnostics, RowsCarryResidualsAndOutlierFlags) {

@@ -141,7 +141,7 @@ std::optional<nlohmann::json> RunPeers(const FitBenchmarkOptions& f, const std::
   WriteFloat64(dir / "in.f64", {&d.x, &d.y, &d.u_x, &d.u_y});
   const std::string command = OneCorePython(f.common.python) + " " + ShellQuote(script) + " " +
                               ShellQuote((dir / "in.f64").string()) + " --repeats " + std::to_string(f.repeats) +
-                              (f.no_odr ? " --no-odr" : "");
+                              (f.no_odr ? " --no-odr" : "") + (f.no_rlm ? " --no-rlm" : "");
   std::string out;
   if (!Capture(command, &out)) throw std::runtime_error("the peer script failed: " + script);
   return nlohmann::json::parse(out);
@@ -172,17 +172,32 @@ std::vector<Measured> MeasureLines(const FitBenchmarkOptions& f, const LineData&
     m.dev = MaxRelDev(LineValues(report), ref);
     return m;
   };
-  out.push_back(measure("ols", [&] { return FitOrdinaryLeastSquares(d); }, ols_ref));
-  out.push_back(measure("wls", [&] { return FitWeightedLeastSquares(d); }, wls_ref));
-  out.push_back(measure("york", [&] { return FitErrorsInVariables(d); }, york_ref));
-  if (robust)
-    out.push_back(measure("robust", [&] { return FitRobust(d); }, ReferenceValues(oracle::HuberLine(d), false)));
+  // The rows computed in the fit's last pass, not stored: what `uphill fit --xy` does (line_rows.hpp).
+  FitOptions streamed;
+  streamed.keep_rows = false;
+  out.push_back(measure("ols", [&] { return FitOrdinaryLeastSquares(d, streamed); }, ols_ref));
+  out.push_back(measure("wls", [&] { return FitWeightedLeastSquares(d, streamed); }, wls_ref));
+  out.push_back(measure("york", [&] { return FitErrorsInVariables(d, streamed); }, york_ref));
+  std::vector<double> huber_ref, huber_mad_ref;
+  const LineData without_u{d.x, d.y, {}, {}};
+  if (robust) {
+    RobustOptions robust_options;
+    robust_options.fit.keep_rows = false;
+    huber_ref = ReferenceValues(oracle::HuberLine(d), false);
+    huber_mad_ref = ReferenceValues(oracle::HuberLineMadScale(without_u), false);
+    out.push_back(measure("robust", [&] { return FitRobust(d, robust_options); }, huber_ref));
+    out.push_back(measure("rob. MAD", [&] { return FitRobust(without_u, robust_options); }, huber_mad_ref));
+  }
   if (peers) {
     out[0].peers.push_back(Peer(*peers, "lstsq", "numpy lstsq", ols_ref));
     out[0].peers.push_back(Peer(*peers, "polyfit", "numpy polyfit", ols_ref));
     out[1].peers.push_back(Peer(*peers, "wls_lstsq", "numpy lstsq (w)", wls_ref));
     out[2].peers.push_back(Peer(*peers, "york", "numpy York", york_ref));
     if (peers->at("fits").contains("odr")) out[2].peers.push_back(Peer(*peers, "odr", "scipy.odr", york_ref));
+    if (robust && peers->at("fits").contains("rlm")) {
+      out[3].peers.push_back(Peer(*peers, "rlm", "statsmodels RLM", huber_ref));
+      out[4].peers.push_back(Peer(*peers, "rlm_mad", "statsmodels RLM", huber_mad_ref));
+    }
   }
   return out;
 }

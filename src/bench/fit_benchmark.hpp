@@ -23,6 +23,7 @@ struct FitBenchmarkOptions {
   std::string script;  // default: tools/bench/fit_peers.py found upward
   bool no_peers = false;
   bool no_odr = false;
+  bool no_rlm = false;
 };
 
 // Prints the tables to `out` as they are measured and records them (results_document.hpp).

@@ -39,6 +39,11 @@ struct FitOptions {
   double function_tolerance = 1e-14;
   double gradient_tolerance = 0.0;
   double parameter_tolerance = 1e-14;
+  // Fill FitReport::rows (one RowResult per input row). The line fits compute every row's
+  // residual and normalised residual either way (χ², the outlier and down-weighted lists need
+  // them); false leaves them unstored, for callers with many rows, who read them on demand through
+  // LineRowResults (line_rows.hpp): the same numbers, without holding 56 bytes per row.
+  bool keep_rows = true;
 };
 
 }  // namespace uphill

@@ -77,6 +77,25 @@ struct DownWeightedRow {
   double normalised = 0.0;  // its normalised residual
 };
 
+// How a straight-line fit's per-row results follow from its data, in the standardised coordinates
+// the fit solved in (X = x0 + sx·x, Y = y0 + sy·y; sx, sy powers of two): set by the line fits,
+// evaluated by LineRowResults (line_rows.hpp) and by the fits themselves, so both give the same
+// numbers.
+struct LineRowModel {
+  bool valid = false;
+  double x0 = 0.0, y0 = 0.0, inv_sx = 1.0, inv_sy = 1.0, sy = 1.0;
+  double k = 0.0, c = 0.0;  // slope and intercept in standardised units
+  // σ_i: one σ for all rows (OLS: the residual SD, 0 for an exact fit; robust without u(Y): the
+  // robust scale), u(Y_i) (WLS; robust with u(Y)), or York's sqrt(u(Y_i)² + k²u(X_i)²).
+  enum class Sigma { kCommon, kUy, kYork };
+  Sigma sigma = Sigma::kCommon;
+  double sigma_common = 0.0;  // kCommon: σ in Y's units
+  // The robust weight ρ'(s_i) of the loss (1 for the non-robust fits), δ in units of σ.
+  enum class Weight { kOne, kHuber, kCauchy };
+  Weight weight = Weight::kOne;
+  double loss_scale = 0.0;
+};
+
 struct SolverInfo {
   bool converged = false;  // Ceres terminated with CONVERGENCE
   int iterations = 0;      // Ceres iterations (successful and unsuccessful steps)
@@ -105,7 +124,8 @@ struct FitReport {
   bool exact = false;
 
   double outlier_threshold = 3.0;
-  RowResults rows;
+  RowResults rows;                            // empty when FitOptions::keep_rows is false
+  LineRowModel row_model;                     // line fits: the rows on demand (line_rows.hpp)
   std::vector<std::size_t> outliers;          // rows with outlier = true, ascending
   std::vector<DownWeightedRow> downweighted;  // robust fit only, ascending row
   std::vector<std::string> notes;             // caveats in plain words (exact fit, bounds, ...)

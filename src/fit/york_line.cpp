@@ -2,14 +2,12 @@
 
 #include <Eigen/Core>
 #include <algorithm>
-#include <bit>
 #include <cmath>
-#include <cstdint>
 #include <limits>
-#include <numbers>
 
 #include "fit/internal/compressed_cost.hpp"
 #include "fit/internal/line_problem.hpp"
+#include "fit/internal/log_sum.hpp"
 #include "fit/model_comparison.hpp"
 #include "model/input_error.hpp"
 
@@ -74,7 +72,8 @@ class YorkCost final : public CompressedLineCost {
   struct RowPass {
     long double chi2 = 0, sum_log_sigma2 = 0;
   };
-  RowPass Rows(const double* theta, double outlier_threshold, FitReport* report) const;
+  // keep_rows: also store the rows in report->rows (FitOptions::keep_rows).
+  RowPass Rows(const double* theta, double outlier_threshold, bool keep_rows, FitReport* report) const;
 
  private:
   bool RowSums(const double* theta, bool with_hessian, LineSums* sums) const override {
@@ -91,10 +90,10 @@ class YorkCost final : public CompressedLineCost {
   }
 
   // What the per-row results need of a chunk: e_i, σ_i = sqrt(uy² + k²ux²), e_i/σ_i, and
-  // Σ ln σ_i² (as Σ exponent·ln 2 + ln Π mantissa: no log per row).
+  // Σ ln σ_i² (log_sum.hpp: no log per row). The same formulas as row_model.hpp's York rows.
   struct RowOut {
     double *e, *sigma, *z, *var;
-    long double sum_log_var = 0;
+    LogSum log_var;
   };
 
   // Adds the chunk's sums to acc (the Newton terms when kNewton). Not inlined, nor is
@@ -126,7 +125,7 @@ class YorkCost final : public CompressedLineCost {
     for (std::size_t j = 0; j < m; ++j) {
       const Terms t = RowTerms<false>(x[j], y[j], ux[j], uy[j], x0, y0, isx, isy, k, c);
       s0 += t.w, s1 += t.wxi, s2 += t.wxi2, s3 += t.we, s4 += t.wexi, s5 += t.wee;
-      const double root_w = std::sqrt(t.w);
+      const double root_w = std::sqrt(t.w);  // t.w = 1/var, as row_model.hpp
       e_out[j] = t.e;
       var_out[j] = t.var;
       sigma_out[j] = t.var * root_w;  // sqrt(var) to an ulp or two, without a second division
@@ -134,26 +133,7 @@ class YorkCost final : public CompressedLineCost {
     }
     acc[0] += s0, acc[1] += s1, acc[2] += s2, acc[3] += s3;
     acc[4] += s4, acc[5] += s5;
-    // Σ ln var as Σ exponent·ln 2 + ln Π mantissa (no log per row): var = mantissa·2^exponent
-    // with the mantissa in [1, 2), and a product of ≤ 1024 of them < 2^1024. A subnormal var
-    // (exponent field 0) takes the per-row logarithm instead.
-    std::int64_t exponents = 0;
-    double mantissas = 1.0;
-    bool subnormal = false;
-    for (std::size_t j = 0; j < m; ++j) {
-      const std::uint64_t bits = std::bit_cast<std::uint64_t>(var_out[j]);
-      const std::int64_t exponent = static_cast<std::int64_t>(bits >> 52);  // var > 0
-      exponents += exponent - 1023;
-      subnormal |= exponent == 0;
-      mantissas *= std::bit_cast<double>((bits & 0x000FFFFFFFFFFFFFull) | 0x3FF0000000000000ull);
-    }
-    if (!subnormal) {
-      out->sum_log_var += static_cast<long double>(exponents) * std::numbers::ln2_v<long double> +
-                          std::log(static_cast<long double>(mantissas));
-    } else {
-      for (std::size_t j = 0; j < m; ++j)
-        out->sum_log_var += std::log(static_cast<long double>(var_out[j]));
-    }
+    out->log_var.Add(var_out, m);
   }
 
   static void ToSums(const long double acc[8], double k, bool with_hessian, LineSums* s) {
@@ -174,25 +154,26 @@ class YorkCost final : public CompressedLineCost {
   Constants q_;
 };
 
-YorkCost::RowPass YorkCost::Rows(const double* theta, double outlier_threshold,
+YorkCost::RowPass YorkCost::Rows(const double* theta, double outlier_threshold, bool keep_rows,
                                  FitReport* report) const {
   RowPass out;
   long double acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   double e[kRows], sigma[kRows], z[kRows], var[kRows];
-  RowOut chunk{e, sigma, z, var};
+  RowOut chunk{e, sigma, z, var, {}};
   const double sy = v_.sy;
   RowResults& rows = report->rows;
   rows.clear();
-  rows.reserve(v_.n);  // written once, below (resize would write every row twice)
+  if (keep_rows) rows.reserve(v_.n);  // written once, below (resize would write every row twice)
   for (std::size_t i = 0; i < v_.n; i += kRows) {
     const std::size_t m = std::min(kRows, v_.n - i);
     ChunkRows(i, m, theta[0], theta[1], acc, &chunk);
     for (std::size_t j = 0; j < m; ++j) {
       const std::size_t index = i + j;
-      const double residual = sy * e[j];  // exact: sy = 2^n
       const bool outlier = std::abs(z[j]) > outlier_threshold;
-      rows.push_back(
-          RowResult{index, v_.y[index] - residual, residual, sy * sigma[j], z[j], 1.0, outlier});
+      if (keep_rows) {
+        const double residual = sy * e[j];  // exact: sy = 2^n
+        rows.push_back(RowResult{index, v_.y[index] - residual, residual, sy * sigma[j], z[j], 1.0, outlier});
+      }
       if (outlier) report->outliers.push_back(index);
     }
   }
@@ -201,7 +182,7 @@ YorkCost::RowPass YorkCost::Rows(const double* theta, double outlier_threshold,
   Remember(theta, sums, false);
   out.chi2 = acc[5];
   // ln σ_i² = ln σ_s² + 2 ln sy.
-  out.sum_log_sigma2 = chunk.sum_log_var + 2.0L * static_cast<long double>(v_.n) *
+  out.sum_log_sigma2 = chunk.log_var.value() + 2.0L * static_cast<long double>(v_.n) *
                                                std::log(static_cast<long double>(sy));
   return out;
 }
@@ -222,9 +203,8 @@ bool AtRoundingLevel(const LineSums* sums, const Eigen::Vector2d& theta) {
 }  // namespace
 
 FitReport FitErrorsInVariables(const LineData& data, const FitOptions& options) {
-  ValidateLineData(data, UncertaintyUse::kXY, "York's fit");
+  const StandardisedView view = ValidateAndView(data, UncertaintyUse::kXY, "York's fit");
   const std::size_t n = data.size();
-  const StandardisedView view = ViewStandardised(data, true, true);
 
   ceres::Problem problem;  // owns the cost function
   auto* cost = new YorkCost(view);
@@ -244,22 +224,27 @@ FitReport FitErrorsInVariables(const LineData& data, const FitOptions& options) 
   // Newton's polish; its last step (< 1e-6 relative) is checked by the rows' pass below.
   report.solver.refinement_steps = RefineNewton(*cost, theta.data(), kUnverifiedStep);
 
-  YorkCost::RowPass pass = cost->Rows(theta.data(), options.outlier_threshold, &report);
+  YorkCost::RowPass pass = cost->Rows(theta.data(), options.outlier_threshold, options.keep_rows, &report);
   if (!AtRoundingLevel(cost->Sums(theta.data()), theta)) {
     // Not yet at the minimum to rounding: polish with checked steps, and redo the rows.
     report.outliers.clear();
     report.solver.refinement_steps += RefineNewton(*cost, theta.data());
-    pass = cost->Rows(theta.data(), options.outlier_threshold, &report);
+    pass = cost->Rows(theta.data(), options.outlier_threshold, options.keep_rows, &report);
   }
   const auto covariance_theta = CeresCovariance(&problem, theta.data(), 2);
   if (!covariance_theta)
     throw InputError("X",
                      "the values are too close together for a slope in binary64 "
                      "(rank-deficient design)");
-  const Standardised s{view.x0, view.y0, view.sx, view.sy, {}, {}, {}, {}};
+  const Standardisation s{view.x0, view.y0, view.sx, view.sy};
   const LineParameters line = Unstandardise(s, theta, *covariance_theta);
   report.covariance = line.covariance;
   report.chi2 = static_cast<double>(pass.chi2);
+  LineRowModel& model = report.row_model;
+  model.valid = true;
+  model.x0 = view.x0, model.y0 = view.y0, model.inv_sx = view.inv_sx, model.inv_sy = view.inv_sy;
+  model.sy = view.sy, model.k = theta(0), model.c = theta(1);
+  model.sigma = LineRowModel::Sigma::kYork;
   if (std::all_of(data.u_x.begin(), data.u_x.end(), [](double u) { return u == 0.0; }))
     report.notes.push_back("all u(X) are 0: York's line is the WLS line");
   FinishReport(report, {"k", "c"}, Eigen::Vector2d(line.k, line.c), true, true);

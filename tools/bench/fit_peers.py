@@ -3,7 +3,7 @@
 
 Run by `uphill bench fit` as a subprocess (also usable by hand):
 
-  fit_peers.py IN.f64 [--repeats K] [--no-odr]
+  fit_peers.py IN.f64 [--repeats K] [--no-odr] [--no-rlm]
       IN.f64: raw little-endian float64 array of shape (4, n), C order, holding X, Y, u(X), u(Y) (rows of the fit).
 
 Fits, each timed (thread CPU time like the C++ side, best of K repeats):
@@ -13,6 +13,14 @@ Fits, each timed (thread CPU time like the C++ side, best of K repeats):
   york        York et al. (2004) iteration, vectorised (below), to |Δk| ≤ 1e-15·|k|
   odr         scipy.odr: ODR(RealData(X, Y, sx=u(X), sy=u(Y)), unilinear), started at OLS,
               ODRPACK's default tolerances (how it is normally used)
+  rlm         statsmodels RLM with HuberT(t = 1.345) on the rows divided by u(Y) (design
+              [X/u, 1/u], response Y/u) with the scale fixed at 1: it minimises
+              Σ ρ_H((Y − c − kX)/u(Y)), ρ_H(z) = z²/2 for |z| ≤ t, t|z| − t²/2 beyond - half of
+              uphill's Huber objective with σ_i = u(Y_i) and δ = 1.345, the same minimiser; IRLS
+              with its default tolerance (1e-8 on the deviance)
+  rlm_mad     statsmodels RLM with HuberT(1.345) and its default scale, 1.4826·MAD of the residuals
+              (scale_est = "mad", center 0) updated every iteration: the fixed point of uphill's
+              robust fit without u(Y)
 
 Prints one JSON object on stdout: python/numpy/scipy versions and, per fit, seconds, peak_bytes
 (peak resident memory, peak_memory.py), slope, intercept (floats print with repr, so they
@@ -113,6 +121,28 @@ class York:
         return k, float(self.y0 + c_centred - k * self.x0), it
 
 
+def fit_rlm(x, y, uy):
+    import statsmodels.api as sm
+    from statsmodels.robust.norms import HuberT
+    design = np.empty((x.size, 2))
+    np.divide(x, uy, out=design[:, 0])
+    np.divide(1.0, uy, out=design[:, 1])
+    model = sm.RLM(y / uy, design, M=HuberT(t=1.345))
+    model.scale = 1.0  # init (truthy) keeps this scale; update_scale=False holds it
+    result = model.fit(init="fixed", update_scale=False)
+    return float(result.params[0]), float(result.params[1])
+
+
+def fit_rlm_mad(x, y):
+    import statsmodels.api as sm
+    from statsmodels.robust.norms import HuberT
+    design = np.empty((x.size, 2))
+    design[:, 0] = x
+    design[:, 1] = 1.0
+    result = sm.RLM(y, design, M=HuberT(t=1.345)).fit()
+    return float(result.params[0]), float(result.params[1])
+
+
 def fit_odr(x, y, ux, uy):
     from scipy import odr
     beta0 = list(np.polyfit(x, y, 1))
@@ -125,6 +155,7 @@ def main():
     p.add_argument("input")
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--no-odr", action="store_true")
+    p.add_argument("--no-rlm", action="store_true")
     a = p.parse_args()
     data = np.fromfile(a.input, dtype="<f8")
     if data.size % 4:
@@ -151,6 +182,16 @@ def main():
             t, (k, c, why), peak = measure(a.repeats, lambda: fit_odr(x, y, ux, uy))
             fits["odr"] = {"seconds": t, "peak_bytes": peak, "slope": k, "intercept": c,
                            "stopreason": why}
+        except ImportError:
+            pass
+    if not a.no_rlm:
+        try:
+            import statsmodels
+            out["versions"]["statsmodels"] = statsmodels.__version__
+            t, (k, c), peak = measure(a.repeats, lambda: fit_rlm(x, y, uy))
+            fits["rlm"] = {"seconds": t, "peak_bytes": peak, "slope": k, "intercept": c}
+            t, (k, c), peak = measure(a.repeats, lambda: fit_rlm_mad(x, y))
+            fits["rlm_mad"] = {"seconds": t, "peak_bytes": peak, "slope": k, "intercept": c}
         except ImportError:
             pass
     json.dump(out, sys.stdout)

@@ -40,6 +40,7 @@ void AddFit(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& ar
   cmd->add_option("--peer-script", o->script, "path of tools/bench/fit_peers.py");
   cmd->add_flag("--no-peers", o->no_peers, "skip the NumPy/SciPy peers");
   cmd->add_flag("--no-odr", o->no_odr, "skip scipy.odr (slow at 10^6 rows)");
+  cmd->add_flag("--no-rlm", o->no_rlm, "skip statsmodels' RLM (slow at 10^6 rows)");
   cmd->callback([o, argv] {
     o->common.command = CommandLine(*argv);
     bench::RunFitBenchmark(*o, std::cout);

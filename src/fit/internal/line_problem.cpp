@@ -1,7 +1,6 @@
 #include "fit/internal/line_problem.hpp"
 
 #include <Eigen/Cholesky>
-#include <Eigen/QR>
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
@@ -20,86 +19,10 @@ std::string Num(double v) {
   return out.str();
 }
 
-double WeightedMean(const std::vector<double>& v, const std::vector<double>& w) {
-  const std::size_t n = v.size();
-  long double sw = 0, swv = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const long double wi = w.empty() ? 1.0L : w[i];
-    sw += wi;
-    swv += wi * v[i];
-  }
-  const double first = static_cast<double>(swv / sw);
-  long double swd = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const long double wi = w.empty() ? 1.0L : w[i];
-    swd += wi * (static_cast<long double>(v[i]) - first);
-  }
-  return static_cast<double>(first + swd / sw);
-}
-
 double PowerOfTwoBelow(double v) {
   int e = 0;
   std::frexp(v, &e);  // v = f·2^e, f ∈ [0.5, 1)
   return std::ldexp(1.0, e - 1);
-}
-
-namespace {
-
-// Power of two near the largest |v_i − centre|, or near |centre| (or 1) when all v equal it.
-double SpreadScale(const std::vector<double>& v, double centre) {
-  double largest = 0.0;
-  for (double vi : v) largest = std::max(largest, std::abs(vi - centre));
-  if (largest > 0.0 && std::isfinite(largest)) return PowerOfTwoBelow(largest);
-  if (centre != 0.0) return PowerOfTwoBelow(std::abs(centre));
-  return 1.0;
-}
-
-}  // namespace
-
-Standardised Standardise(const LineData& data, const std::vector<double>& centre_weights,
-                         bool keep_ux, bool keep_uy) {
-  Standardised s;
-  const std::size_t n = data.size();
-  s.x0 = WeightedMean(data.x, centre_weights);
-  s.y0 = WeightedMean(data.y, centre_weights);
-  s.sx = SpreadScale(data.x, s.x0);
-  s.sy = SpreadScale(data.y, s.y0);
-  s.x.resize(n);
-  s.y.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    // One rounding each (the subtraction); the division by a power of two is exact.
-    s.x[i] = (data.x[i] - s.x0) / s.sx;
-    s.y[i] = (data.y[i] - s.y0) / s.sy;
-  }
-  if (keep_ux) {
-    s.ux.resize(n);
-    for (std::size_t i = 0; i < n; ++i) s.ux[i] = data.u_x[i] / s.sx;
-  }
-  if (keep_uy) {
-    s.uy.resize(n);
-    for (std::size_t i = 0; i < n; ++i) s.uy[i] = data.u_y[i] / s.sy;
-  }
-  return s;
-}
-
-WeightedStandardised StandardiseWithUy(const LineData& data, bool use_uy) {
-  const std::size_t n = data.size();
-  std::vector<double> centre_weights;
-  if (use_uy) {
-    const double u_min = *std::min_element(data.u_y.begin(), data.u_y.end());
-    centre_weights.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const double ratio = u_min / data.u_y[i];
-      centre_weights[i] = ratio * ratio;
-    }
-  }
-  WeightedStandardised out{Standardise(data, centre_weights, false, use_uy), {}};
-  if (use_uy) {
-    RequireRepresentable(out.s.uy, "u(Y)");
-    out.inv_sigma.resize(n);
-    for (std::size_t i = 0; i < n; ++i) out.inv_sigma[i] = 1.0 / out.s.uy[i];
-  }
-  return out;
 }
 
 FitReport StartReport(FitMethod method, std::size_t n, bool uses_stated_uncertainties,
@@ -113,52 +36,84 @@ FitReport StartReport(FitMethod method, std::size_t n, bool uses_stated_uncertai
   return report;
 }
 
-StandardisedView ViewStandardised(const LineData& data, bool use_ux, bool use_uy) {
+namespace {
+
+// Sum (long double), extremes and the smallest positive value of a column, in one vectorised
+// pass (this file is built with -fopenmp-simd). A NaN makes the sum NaN.
+struct ColumnScan {
+  long double sum = 0;
+  double min = std::numeric_limits<double>::infinity(), max = -std::numeric_limits<double>::infinity();
+  double min_positive = std::numeric_limits<double>::infinity();
+};
+
+[[gnu::noinline, gnu::target_clones("avx2", "default")]] void ScanChunk(const double* v, std::size_t m,
+                                                                       ColumnScan* scan) {
+  double sum = 0, lo = scan->min, hi = scan->max, lo_positive = scan->min_positive;
+  const double inf = std::numeric_limits<double>::infinity();
+#pragma omp simd reduction(+ : sum) reduction(min : lo, lo_positive) reduction(max : hi)
+  for (std::size_t j = 0; j < m; ++j) {
+    sum += v[j];
+    lo = v[j] < lo ? v[j] : lo;
+    hi = v[j] > hi ? v[j] : hi;
+    const double positive = v[j] > 0.0 ? v[j] : inf;
+    lo_positive = positive < lo_positive ? positive : lo_positive;
+  }
+  scan->sum += sum;
+  scan->min = lo, scan->max = hi, scan->min_positive = lo_positive;
+}
+
+ColumnScan Scan(const std::vector<double>& v) {
+  ColumnScan scan;
+  constexpr std::size_t kRows = 1024;
+  for (std::size_t i = 0; i < v.size(); i += kRows) ScanChunk(v.data() + i, std::min(kRows, v.size() - i), &scan);
+  return scan;
+}
+
+// The bounds of line_data.cpp: values within ±1e100, uncertainties in [1e-100, 1e100] (or 0 where allowed).
+constexpr double kLargest = 1e100, kSmallestUncertainty = 1e-100;
+
+bool ValuesOk(const ColumnScan& s) {
+  return std::isfinite(static_cast<double>(s.sum)) && s.min >= -kLargest && s.max <= kLargest;
+}
+
+bool UncertaintiesOk(const ColumnScan& s, bool zero_allowed) {
+  if (!std::isfinite(static_cast<double>(s.sum)) || s.max > kLargest) return false;
+  if (!zero_allowed) return s.min >= kSmallestUncertainty;
+  return s.min >= 0.0 && (s.min_positive >= kSmallestUncertainty || !std::isfinite(s.min_positive));
+}
+
+// Power of two near the largest |v − centre| of [lo, hi], or near |centre| (or 1) when all equal it.
+double ScaleOf(double lo, double hi, double centre) {
+  const double largest = std::max(hi - centre, centre - lo);
+  if (largest > 0.0 && std::isfinite(largest)) return PowerOfTwoBelow(largest);
+  if (centre != 0.0) return PowerOfTwoBelow(std::abs(centre));
+  return 1.0;
+}
+
+// The view from the columns' scans (u(Y)'s when use_uy).
+StandardisedView ViewFromScans(const LineData& data, const ColumnScan& x, const ColumnScan& y, bool use_ux,
+                               const ColumnScan* uy) {
   StandardisedView v;
   v.n = data.size();
   v.x = data.x.data();
   v.y = data.y.data();
   v.ux = use_ux ? data.u_x.data() : nullptr;
-  v.uy = use_uy ? data.u_y.data() : nullptr;
-  using Map = Eigen::Map<const Eigen::ArrayXd>;
-  long double sum_x = 0, sum_y = 0;
-  double x_min = v.x[0], x_max = v.x[0], y_min = v.y[0], y_max = v.y[0];
-  double u_min = use_uy ? v.uy[0] : 1.0, u_max = u_min;
-  ForEachChunk(v.n, [&](std::size_t i, Eigen::Index m) {
-    const Map x(v.x + i, m), y(v.y + i, m);
-    sum_x += x.sum();
-    sum_y += y.sum();
-    x_min = std::min(x_min, x.minCoeff());
-    x_max = std::max(x_max, x.maxCoeff());
-    y_min = std::min(y_min, y.minCoeff());
-    y_max = std::max(y_max, y.maxCoeff());
-    if (use_uy) {
-      const Map u(v.uy + i, m);
-      u_min = std::min(u_min, u.minCoeff());
-      u_max = std::max(u_max, u.maxCoeff());
-    }
-  });
+  v.uy = uy ? data.u_y.data() : nullptr;
   const long double n = static_cast<long double>(v.n);
   // The rounded mean lies within the data's range (clamped, should rounding push it out).
-  v.x0 = std::clamp(static_cast<double>(sum_x / n), x_min, x_max);
-  v.y0 = std::clamp(static_cast<double>(sum_y / n), y_min, y_max);
-  const auto scale = [](double lo, double hi, double centre) {
-    const double largest = std::max(hi - centre, centre - lo);
-    if (largest > 0.0 && std::isfinite(largest)) return PowerOfTwoBelow(largest);
-    if (centre != 0.0) return PowerOfTwoBelow(std::abs(centre));
-    return 1.0;
-  };
-  v.sx = scale(x_min, x_max, v.x0);
-  v.sy = scale(y_min, y_max, v.y0);
+  v.x0 = std::clamp(static_cast<double>(x.sum / n), x.min, x.max);
+  v.y0 = std::clamp(static_cast<double>(y.sum / n), y.min, y.max);
+  v.sx = ScaleOf(x.min, x.max, v.x0);
+  v.sy = ScaleOf(y.min, y.max, v.y0);
   v.inv_sx = 1.0 / v.sx;
   v.inv_sy = 1.0 / v.sy;
-  if (use_uy) {
+  if (uy) {
     // u² and 1/u² are monotone in u: the extremes decide. Name the first offending row.
     const auto representable = [](double u) {
       const double u2 = u * u;
       return u2 > 0.0 && std::isfinite(u2) && std::isfinite(1.0 / u2);
     };
-    if (!representable(u_min * v.inv_sy) || !representable(u_max * v.inv_sy)) {
+    if (!representable(uy->min * v.inv_sy) || !representable(uy->max * v.inv_sy)) {
       std::vector<double> scaled(data.u_y);
       for (double& u : scaled) u *= v.inv_sy;
       RequireRepresentable(scaled, "u(Y)");
@@ -167,21 +122,43 @@ StandardisedView ViewStandardised(const LineData& data, bool use_ux, bool use_uy
   return v;
 }
 
-Eigen::Vector2d ClosedFormLine(const Standardised& s, const std::vector<double>& inv_sigma) {
-  const Eigen::Index n = static_cast<Eigen::Index>(s.size());
-  // Thin N×2 design and N-vector: O(N) memory; Householder QR never forms Q.
-  Eigen::MatrixX2d design(n, 2);
-  Eigen::VectorXd rhs(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double w = inv_sigma.empty() ? 1.0 : inv_sigma[static_cast<std::size_t>(i)];
-    design(i, 0) = s.x[static_cast<std::size_t>(i)] * w;
-    design(i, 1) = w;
-    rhs(i) = s.y[static_cast<std::size_t>(i)] * w;
-  }
-  return design.householderQr().solve(rhs);
+}  // namespace
+
+StandardisedView ViewStandardised(const LineData& data, bool use_ux, bool use_uy) {
+  const ColumnScan uy = use_uy ? Scan(data.u_y) : ColumnScan{};
+  return ViewFromScans(data, Scan(data.x), Scan(data.y), use_ux, use_uy ? &uy : nullptr);
 }
 
-SolverInfo RunCeres(const FitOptions& options, bool seeded, ceres::Problem* problem) {
+StandardisedView ValidateAndView(const LineData& data, UncertaintyUse use, const std::string& method) {
+  const std::size_t n = data.x.size();
+  const bool need_uy = use == UncertaintyUse::kY || use == UncertaintyUse::kXY ||
+                       (use == UncertaintyUse::kOptionalY && !data.u_y.empty());
+  const bool need_ux = use == UncertaintyUse::kXY;
+  bool ok = data.y.size() == n && n >= 2 && (!need_uy || data.u_y.size() == n) && (!need_ux || data.u_x.size() == n);
+  ColumnScan x, y, uy, ux;
+  if (ok) {
+    x = Scan(data.x);
+    y = Scan(data.y);
+    ok = ValuesOk(x) && ValuesOk(y) && x.min != x.max;
+  }
+  if (ok && need_uy) {
+    uy = Scan(data.u_y);
+    ok = UncertaintiesOk(uy, false);
+  }
+  if (ok && need_ux) {
+    ux = Scan(data.u_x);
+    ok = UncertaintiesOk(ux, true);
+  }
+  if (!ok) {
+    ValidateLineData(data, use, method);  // names the row and the rule
+    throw std::logic_error("ValidateAndView: the scan refused data that ValidateLineData accepts");
+  }
+  return ViewFromScans(data, x, y, need_ux, need_uy ? &uy : nullptr);
+}
+
+namespace {
+
+ceres::Solver::Options SolverOptions(const FitOptions& options) {
   ceres::Solver::Options solver;
   solver.minimizer_type = ceres::TRUST_REGION;
   solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
@@ -193,14 +170,25 @@ SolverInfo RunCeres(const FitOptions& options, bool seeded, ceres::Problem* prob
   solver.parameter_tolerance = options.parameter_tolerance;
   solver.num_threads = 1;  // the fits are cheap per row; threads would compete with callers
   solver.logging_type = ceres::SILENT;
-  // See below (stationary start): enough invalid steps for the trust region to shrink to
+  // See RunCeres (stationary start): enough invalid steps for the trust region to shrink to
   // min_trust_region_radius, which Ceres reports as CONVERGENCE, without an error log line.
   solver.max_num_consecutive_invalid_steps = 100;
   solver.minimizer_progress_to_stdout = false;
+  return solver;
+}
+
+}  // namespace
+
+void ValidateFitOptions(const FitOptions& options) {
   if (!(options.outlier_threshold > 0.0))
     throw InputError("outlier threshold",
                      "must be > 0 (got " + Num(options.outlier_threshold) + ")");
-  if (std::string error; !solver.IsValid(&error)) throw InputError("fit options", error);
+  if (std::string error; !SolverOptions(options).IsValid(&error)) throw InputError("fit options", error);
+}
+
+SolverInfo RunCeres(const FitOptions& options, bool seeded, ceres::Problem* problem) {
+  ValidateFitOptions(options);
+  const ceres::Solver::Options solver = SolverOptions(options);
   ceres::Solver::Summary summary;
   ceres::Solve(solver, problem, &summary);
   // Started at a point that is stationary to rounding (a converged closed-form seed), every
@@ -351,7 +339,7 @@ std::optional<Eigen::MatrixXd> CeresCovariance(ceres::Problem* problem, const do
   return Eigen::MatrixXd(c);
 }
 
-LineParameters Unstandardise(const Standardised& s, const Eigen::Vector2d& theta,
+LineParameters Unstandardise(const Standardisation& s, const Eigen::Vector2d& theta,
                              const Eigen::Matrix2d& covariance_theta) {
   // k = (sy/sx)·θ0;  c = y0 + sy·θ1 − k·x0. The intercept at the centre, y0 + sy·θ1, is
   // uncorrelated (or nearly) with k, so the x0²·var(k) term carries the ill-conditioning of c

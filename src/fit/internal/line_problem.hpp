@@ -17,44 +17,22 @@
 
 namespace uphill::fit_internal {
 
-// Weighted mean Σw·v/Σw (w empty: unit weights), two passes: the second adds the mean of the
-// deviations from the first, which removes the rounding of the first to a few ulp even when
-// |mean| ≫ spread (X ≈ 1e9 with spread 1). Accumulates in long double.
-double WeightedMean(const std::vector<double>& v, const std::vector<double>& w);
-
 // 2^e with 2^e ≤ v < 2^(e+1), v > 0 finite: scaling by it is exact in binary.
 double PowerOfTwoBelow(double v);
 
-// The data in standardised coordinates: X = x0 + sx·x, Y = y0 + sy·y. x0, y0 are weighted
-// means (centre_weights, empty = unit); sx, sy powers of two near the largest deviation, so the
-// only rounding is that of X_i − x0 and Y_i − y0.
-struct Standardised {
+// Standardised coordinates: X = x0 + sx·x, Y = y0 + sy·y, sx and sy powers of two near the
+// largest deviation, so that the only rounding is that of X_i − x0 and Y_i − y0.
+struct Standardisation {
   double x0 = 0.0, y0 = 0.0, sx = 1.0, sy = 1.0;
-  std::vector<double> x, y;    // standardised values
-  std::vector<double> ux, uy;  // u(X)/sx, u(Y)/sy, or empty when not used
-  std::size_t size() const { return x.size(); }
 };
-Standardised Standardise(const LineData& data, const std::vector<double>& centre_weights,
-                         bool keep_ux, bool keep_uy);
-
-// Standardise for a fit that weights rows by u(Y) when use_uy (WLS, robust with u(Y)): centred
-// at the weighted mean of X and Y with weights (u_min/u_i)² (there the centred intercept and
-// the slope are uncorrelated, so the design's two columns are orthogonal; the ratio keeps tiny
-// or huge u from overflowing), inv_sigma = 1/(u(Y_i)/sy) (RequireRepresentable checked). Without
-// u(Y): unit weights, inv_sigma empty.
-struct WeightedStandardised {
-  Standardised s;
-  std::vector<double> inv_sigma;
-};
-WeightedStandardised StandardiseWithUy(const LineData& data, bool use_uy);
 
 // A FitReport with what every line fit sets before solving.
 FitReport StartReport(FitMethod method, std::size_t n, bool uses_stated_uncertainties,
                       ErrorScaling primary_scaling, double outlier_threshold);
 
-// The same standardised coordinates without copying the data, for fits of many rows: X and
-// Y are standardised on the fly, chunk by chunk (ForEachChunk), by the same operations
-// ((X_i − x0)·(1/sx) with 1/sx an exact power of two), so no N-sized buffer is allocated.
+// The standardised coordinates without copying the data: the fits standardise X and Y on the
+// fly in their row loops ((X_i − x0)·(1/sx) with 1/sx an exact power of two), so no N-sized
+// buffer is allocated.
 // x0, y0 are plain means (one vectorised pass, which also finds the extremes for sx, sy and
 // the range of u(Y)/sy); any centre inside the data's range keeps X_i − x0 exact when the
 // data sit far from 0 (Sterbenz), and the fits' results do not depend on it beyond rounding.
@@ -66,17 +44,13 @@ struct StandardisedView {
 };
 StandardisedView ViewStandardised(const LineData& data, bool use_ux, bool use_uy);
 
-// Rows per chunk of the vectorised passes: 8 chunk-sized arrays stay in L1.
-inline constexpr std::size_t kChunk = 256;
-template <typename F>
-void ForEachChunk(std::size_t n, F&& f) {
-  for (std::size_t begin = 0; begin < n; begin += kChunk)
-    f(begin, static_cast<Eigen::Index>(std::min(kChunk, n - begin)));
-}
+// ValidateLineData and ViewStandardised in one vectorised scan of each column (sum, extremes):
+// the common case, valid data, costs one read of the data; invalid data get ValidateLineData's
+// message naming the row. u(X) is viewed for kXY, u(Y) for kY, kXY and (when given) kOptionalY.
+StandardisedView ValidateAndView(const LineData& data, UncertaintyUse use, const std::string& method);
 
-// Weighted least-squares line through standardised data, by Householder QR of the design
-// [x_i·w_i, w_i] (w_i = inv_sigma_i, empty: 1). Returns (slope, intercept) in standardised units.
-Eigen::Vector2d ClosedFormLine(const Standardised& s, const std::vector<double>& inv_sigma);
+// Throws InputError for invalid options (outlier threshold ≤ 0, invalid Ceres settings).
+void ValidateFitOptions(const FitOptions& options);
 
 // Ceres' Levenberg-Marquardt with the options' tolerances, silent, one thread. Throws
 // std::runtime_error if Ceres returns no usable solution.
@@ -109,7 +83,7 @@ struct LineParameters {
   double k = 0.0, c = 0.0;
   Eigen::Matrix2d covariance;  // of (k, c)
 };
-LineParameters Unstandardise(const Standardised& s, const Eigen::Vector2d& theta,
+LineParameters Unstandardise(const Standardisation& s, const Eigen::Vector2d& theta,
                              const Eigen::Matrix2d& covariance_theta);
 
 // Throws InputError unless every standardised uncertainty can be squared and inverted in binary64
