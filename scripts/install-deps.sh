@@ -9,7 +9,7 @@ set -euo pipefail
 packages=(
   g++ cmake ninja-build ccache pkg-config
   libeigen3-dev libceres-dev nlohmann-json3-dev libgtest-dev libcli11-dev libboost-dev
-  libcsv-dev gnuplot-nox
+  libcsv-dev libfast-float-dev gnuplot-nox
   libcpp-httplib-dev chromium
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
   libopencv-calib3d-dev

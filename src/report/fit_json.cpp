@@ -1,5 +1,12 @@
 #include "report/fit_json.hpp"
 
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <optional>
+
+#include "fit/line_rows.hpp"
+
 namespace uphill::report {
 namespace {
 
@@ -25,7 +32,10 @@ bool IsLine(const FitReport& r) {
 
 }  // namespace
 
-ordered_json FitToJson(const FitReport& r) {
+namespace {
+
+// FitToJson's object; with_rows = false leaves "rows" an empty array (WriteFitJson streams them).
+ordered_json FitJson(const FitReport& r, bool with_rows) {
   ordered_json j;
   j["method"] = MethodName(r.method);
   const ErrorScaling primary = r.primary_scaling;
@@ -55,9 +65,10 @@ ordered_json FitToJson(const FitReport& r) {
   j["exact"] = r.exact;
   j["outlier_threshold"] = r.outlier_threshold;
   ordered_json rows = ordered_json::array();
-  for (const auto& row : r.rows)
-    rows.push_back({{"row", row.row}, {"fitted", row.fitted}, {"residual", row.residual}, {"sigma", row.sigma},
-                    {"normalised_residual", row.normalised}, {"weight", row.weight}, {"outlier", row.outlier}});
+  if (with_rows)
+    for (const RowResult& row : r.rows)
+      rows.push_back({{"row", row.row}, {"fitted", row.fitted}, {"residual", row.residual}, {"sigma", row.sigma},
+                      {"normalised_residual", row.normalised}, {"weight", row.weight}, {"outlier", row.outlier}});
   j["rows"] = rows;
   j["outliers"] = r.outliers;
   ordered_json down = ordered_json::array();
@@ -68,6 +79,82 @@ ordered_json FitToJson(const FitReport& r) {
   j["solver"] = {{"converged", r.solver.converged}, {"iterations", r.solver.iterations},
                  {"termination", r.solver.termination}, {"seconds", r.solver.seconds}};
   return j;
+}
+
+}  // namespace
+
+ordered_json FitToJson(const FitReport& r) { return FitJson(r, true); }
+
+namespace {
+
+// A double as nlohmann::json prints it: shortest round-trip digits, ".0" on integral values.
+char* Number(char* at, double v) {
+  if (!std::isfinite(v)) {
+    std::memcpy(at, "null", 4);
+    return at + 4;
+  }
+  char* end = std::to_chars(at, at + 32, v).ptr;
+  bool plain_integer = true;
+  for (const char* p = at; p < end; ++p) plain_integer &= (*p >= '0' && *p <= '9') || *p == '-';
+  if (plain_integer) *end++ = '.', *end++ = '0';
+  return end;
+}
+
+char* Text(char* at, const char* text) {
+  const std::size_t n = std::strlen(text);
+  std::memcpy(at, text, n);
+  return at + n;
+}
+
+// {"row":i,"fitted":…,"residual":…,"sigma":…,"normalised_residual":…,"weight":…,"outlier":…}
+char* RowObject(char* at, const RowResult& row) {
+  at = Text(at, "{\"row\":");
+  at = std::to_chars(at, at + 24, row.row).ptr;
+  at = Number(Text(at, ",\"fitted\":"), row.fitted);
+  at = Number(Text(at, ",\"residual\":"), row.residual);
+  at = Number(Text(at, ",\"sigma\":"), row.sigma);
+  at = Number(Text(at, ",\"normalised_residual\":"), row.normalised);
+  at = Number(Text(at, ",\"weight\":"), row.weight);
+  return Text(at, row.outlier ? ",\"outlier\":true}" : ",\"outlier\":false}");
+}
+
+}  // namespace
+
+void WriteFitJson(std::ostream& out, const FitReport& r, const LineData& data, bool with_rows) {
+  const ordered_json whole = FitJson(r, false);
+  ordered_json head = ordered_json::object(), tail = ordered_json::object();
+  bool before = true;
+  for (const auto& [key, value] : whole.items()) {
+    if (key == "rows") {
+      before = false;
+      continue;
+    }
+    (before ? head : tail)[key] = value;
+  }
+  std::string text = head.dump(2);
+  text.resize(text.size() - 2);  // the closing "\n}"
+  out << text << ",\n  \"rows\": [";
+  // Rows from the report when it kept them, else computed on demand; written in blocks.
+  const std::size_t n = !r.rows.empty() ? r.rows.size() : (with_rows && r.row_model.valid ? data.size() : 0);
+  std::optional<LineRowResults> on_demand;
+  if (r.rows.empty() && n > 0) on_demand.emplace(r, data);
+  std::string block;
+  constexpr std::size_t kBlock = 1 << 16;
+  block.reserve(kBlock + 512);
+  char row_text[512];
+  for (std::size_t i = 0; i < (with_rows ? n : 0); ++i) {
+    block += i ? ",\n    " : "\n    ";
+    const RowResult row = on_demand ? (*on_demand)[i] : r.rows[i];
+    block.append(row_text, RowObject(row_text, row));
+    if (block.size() >= kBlock) {
+      out.write(block.data(), static_cast<std::streamsize>(block.size()));
+      block.clear();
+    }
+  }
+  out.write(block.data(), static_cast<std::streamsize>(block.size()));
+  out << (with_rows && n > 0 ? "\n  ]," : "],");
+  const std::string rest = tail.dump(2);
+  out << rest.substr(1) << "\n";  // tail's keys after its "{"
 }
 
 ordered_json AnalysisToJson(const ExperimentAnalysis& a) {

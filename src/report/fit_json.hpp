@@ -9,7 +9,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <ostream>
+
 #include "fit/fit_report.hpp"
+#include "fit/line_data.hpp"
 #include "report/analysis.hpp"
 
 namespace uphill::report {
@@ -17,6 +20,14 @@ namespace uphill::report {
 inline constexpr const char* kFitJsonFormat = "uphill-fit/1";
 
 nlohmann::ordered_json FitToJson(const FitReport& report);
+
+// FitToJson(report).dump(2) written to `out`, with the per-row entries of `rows` streamed from
+// the fit and its data (LineRowResults, fit/line_rows.hpp) when the fit did not keep them
+// (FitOptions::keep_rows = false): one compact object per line, never one JSON tree of N
+// objects, so that memory does not grow with N. with_rows = false writes "rows": [] (the
+// summaries, outliers and down-weighted rows stay). Numbers are printed shortest round-trip, as
+// nlohmann::json prints them.
+void WriteFitJson(std::ostream& out, const FitReport& report, const LineData& data, bool with_rows = true);
 nlohmann::ordered_json AnalysisToJson(const ExperimentAnalysis& analysis);
 
 }  // namespace uphill::report

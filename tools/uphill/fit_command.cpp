@@ -21,18 +21,11 @@ struct FitFlags {
   std::string xy;
   std::string method = "ols";
   bool json = false;
+  bool no_rows = false;
   std::uint64_t mc_trials = 100000;
   std::string output;
 };
 
-// Reads X,Y[,uX,uY] (io/xy_table.hpp); rows that cannot be read are reported on stderr and left out.
-LineData LineDataOf(const io::XyTable& table) {
-  for (const std::string& error : table.row_errors) {
-    std::cerr << "uphill: " << error << " (row left out)\n";
-    ExitStatus() = 2;
-  }
-  return LineData{table.x, table.y, table.u_x, table.u_y};
-}
 
 void PrintFitText(const FitReport& r) {
   std::cout << "method: " << MethodName(r.method) << ", n = " << r.n << ", dof = " << r.dof << "\n";
@@ -50,24 +43,44 @@ void PrintFitText(const FitReport& r) {
   for (const auto& n : r.notes) std::cout << "  note: " << n << "\n";
 }
 
+void RequireMethod(const std::string& method) {
+  if (method != "ols" && method != "wls" && method != "york" && method != "robust")
+    throw InputError("--method", "must be ols, wls, york or robust (got '" + method + "')");
+}
+
+// The per-row results are not kept: the JSON output streams them from the data (line_rows.hpp).
 FitReport FitXy(const std::string& method, const LineData& data) {
-  if (method == "ols") return FitOrdinaryLeastSquares(data);
-  if (method == "wls") return FitWeightedLeastSquares(data);
-  if (method == "york") return FitErrorsInVariables(data);
-  if (method == "robust") return FitRobust(data);
-  throw InputError("--method", "must be ols, wls, york or robust (got '" + method + "')");
+  FitOptions options;
+  options.keep_rows = false;
+  if (method == "ols") return FitOrdinaryLeastSquares(data, options);
+  if (method == "wls") return FitWeightedLeastSquares(data, options);
+  if (method == "york") return FitErrorsInVariables(data, options);
+  if (method == "robust") {
+    RobustOptions robust;
+    robust.fit = options;
+    return FitRobust(data, robust);
+  }
+  RequireMethod(method);
+  return {};
 }
 
 void RunXy(const FitFlags& f) {
-  const io::XyTable table = io::ReadXyFile(f.xy);
+  RequireMethod(f.method);  // before the file is read
+  // X,Y[,uX,uY] (io/xy_table.hpp): a row that cannot be read is named on stderr as it is met and
+  // left out; the fit uses the others (exit status 2 tells).
+  io::XyTable table = io::ReadXyFile(f.xy, [](const std::string& error) {
+    std::cerr << "uphill: " << error << " (row left out)\n";
+    ExitStatus() = 2;
+  });
+  const LineData data{std::move(table.x), std::move(table.y), std::move(table.u_x), std::move(table.u_y)};
   FitReport r;
   try {
-    r = FitXy(f.method, LineDataOf(table));
+    r = FitXy(f.method, data);
   } catch (const InputError& e) {
     throw InputError(table.Locate(e.quantity()), e.rule());  // name the file's row and column
   }
   if (f.json) {
-    std::cout << report::FitToJson(r).dump(2) << "\n";
+    report::WriteFitJson(std::cout, r, data, !f.no_rows);
   } else {
     PrintFitText(r);
   }
@@ -104,6 +117,7 @@ void AddFitCommand(CLI::App& app) {
   fit->add_option("--xy", flags->xy, "CSV with header X,Y and optionally uX,uY (plain numbers, same units)");
   fit->add_option("--method", flags->method, "with --xy: ols | wls | york | robust")->capture_default_str();
   fit->add_flag("--json", flags->json, "JSON output (see README: stable keys)");
+  fit->add_flag("--no-rows", flags->no_rows, "with --xy --json: leave the per-row entries out (\"rows\": [])");
   fit->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials per row for u(X)")->capture_default_str();
   fit->callback([flags] {
     if (flags->xy.empty() == flags->experiment.empty())
