@@ -2,15 +2,20 @@
 // of a measured ball track (release, direction, turning points, rest, fall-off) and the model
 // motion fitted to it (src/vision/track_analysis.hpp), as a table with units; with -o also
 // DIR/track_analysis.json and the figures track_x_vs_t and track_residuals.
-#include <iostream>
+#include <memory>
 
 #include "commands.hpp"
+#include "scene_flags.hpp"
+#include "vision_program.hpp"
+#if UPHILL_VISION_PROGRAM
+#include <iostream>
+
 #include "io/units.hpp"
 #include "model/input_error.hpp"
-#include "scene_flags.hpp"
 #include "vision/track_analysis.hpp"
 #include "vision/track_analysis_output.hpp"
 #include "vision/track_table.hpp"
+#endif
 
 namespace uphill::cli {
 namespace {
@@ -21,6 +26,7 @@ struct AnalyseTrackFlags {
   bool json = false;
 };
 
+#if UPHILL_VISION_PROGRAM
 void Run(const AnalyseTrackFlags& f) {
   const Scene scene = io::ParseConfiguration(FlagSource(f.scene)).MakeScene();
   vision::TrackAnalysisOptions o;
@@ -48,6 +54,12 @@ void Run(const AnalyseTrackFlags& f) {
                            << (analysis.fit.available ? ", track_residuals" : "") << " (.svg, .png, .gp, .dat)\n";
   }
 }
+
+#else  // uphill: the work runs in uphill-vision (vision_program.hpp)
+
+void Run(const AnalyseTrackFlags&) { RunInVisionProgram(); }
+
+#endif
 
 }  // namespace
 

@@ -8,6 +8,7 @@
 #include "bench/motion_benchmark.hpp"
 #include "bench/track_benchmark.hpp"
 #include "commands.hpp"
+#include "vision_program.hpp"
 
 namespace uphill::cli {
 namespace {
@@ -89,7 +90,11 @@ void AddTrack(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& 
   cmd->add_flag("--no-python", o->no_python, "skip the OpenCV peers");
   cmd->callback([o, argv] {
     o->common.command = CommandLine(*argv);
+#if UPHILL_VISION_PROGRAM
     bench::RunTrackBenchmark(*o, std::cout);
+#else
+    RunInVisionProgram();
+#endif
   });
 }
 

@@ -4,27 +4,31 @@
 //   calibrate scene --camera cam.json --board-image TABLE.png --cols … --board-origin … -o scene.json
 //   calibrate target --cols 9 --rows 6 --square 20mm -o board.svg|board.png
 // The numbers are printed with their units; the files' formats are in calibration/README.md.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "vision_program.hpp"
+#if UPHILL_VISION_PROGRAM
 #include <Eigen/Geometry>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <memory>
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
-#include "commands.hpp"
 #include "io/atomic_file.hpp"
 #include "io/csv_table.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "vision/calibration.hpp"
+#endif
 
 namespace uphill::cli {
 namespace {
-
-using vision::ChessboardTarget;
 
 struct TargetFlags {
   int cols = 9, rows = 6;
@@ -39,6 +43,19 @@ struct CalibrateFlags {
   bool fit_k3 = false;
   std::string dpi = "300";
 };
+
+void AddTargetFlags(CLI::App* cmd, TargetFlags* f, bool square_required) {
+  cmd->add_option("--cols", f->cols, "inner corners across the board (a board of 10×7 squares has 9×6)")
+      ->capture_default_str();
+  cmd->add_option("--rows", f->rows, "inner corners down the board")->capture_default_str();
+  cmd->add_option("--square", f->square,
+                  std::string("side of one square, with unit, e.g. 20mm (measure the print)") +
+                      (square_required ? " (required)" : ""));
+}
+
+#if UPHILL_VISION_PROGRAM
+
+using vision::ChessboardTarget;
 
 std::string Num(double v, int precision = 6) {
   std::ostringstream out;
@@ -62,15 +79,6 @@ ChessboardTarget Target(const TargetFlags& f) {
   ChessboardTarget t{f.cols, f.rows, io::ParseQuantity(f.square, io::Dimension::kLength, "--square")};
   vision::ValidateTarget(t);
   return t;
-}
-
-void AddTargetFlags(CLI::App* cmd, TargetFlags* f, bool square_required) {
-  cmd->add_option("--cols", f->cols, "inner corners across the board (a board of 10×7 squares has 9×6)")
-      ->capture_default_str();
-  cmd->add_option("--rows", f->rows, "inner corners down the board")->capture_default_str();
-  cmd->add_option("--square", f->square,
-                  std::string("side of one square, with unit, e.g. 20mm (measure the print)") +
-                      (square_required ? " (required)" : ""));
 }
 
 void PrintVerdict(const std::string& verdict, const std::vector<std::string>& reasons) {
@@ -276,6 +284,14 @@ void RunTarget(const CalibrateFlags& f) {
             << " px per square; print at " << Num(dpi) << " dpi so that a square measures " << Num(t.square * 1000)
             << " mm (measure it and give the measured value to --square)\n";
 }
+
+#else  // uphill: the work runs in uphill-vision (vision_program.hpp)
+
+void RunCamera(const CalibrateFlags&) { RunInVisionProgram(); }
+void RunScene(const CalibrateFlags&) { RunInVisionProgram(); }
+void RunTarget(const CalibrateFlags&) { RunInVisionProgram(); }
+
+#endif
 
 }  // namespace
 

@@ -4,6 +4,7 @@
 #include "commands.hpp"
 #include "model/input_error.hpp"
 #include "self_documentation.hpp"
+#include "vision_program.hpp"
 
 namespace uphill::cli {
 int& ExitStatus() {
@@ -12,7 +13,9 @@ int& ExitStatus() {
 }
 }  // namespace uphill::cli
 
+// The same main for `uphill` and `uphill-vision` (vision_program.hpp).
 int main(int argc, char** argv) {
+  uphill::cli::RememberArguments(argc, argv);
   CLI::App app{"uphill: analysis toolkit for the rolling-uphill rail apparatus", "uphill"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "uphill " UPHILL_VERSION);

@@ -2,6 +2,13 @@
 // centre in every frame (src/vision/video_tracking.hpp, ball_tracker.hpp), as the track CSV and
 // its sidecar JSON (data/README.md, "Track CSV"); optionally an overlay video and the analysis of
 // the track (src/vision/track_analysis.hpp, written beside the CSV as `uphill analyse-track` does).
+#include <memory>
+#include <string>
+
+#include "commands.hpp"
+#include "scene_flags.hpp"
+#include "vision_program.hpp"
+#if UPHILL_VISION_PROGRAM
 #include <unistd.h>
 
 #include <chrono>
@@ -11,15 +18,14 @@
 #include <iostream>
 #include <sstream>
 
-#include "commands.hpp"
 #include "io/configuration.hpp"
 #include "model/input_error.hpp"
-#include "scene_flags.hpp"
 #include "vision/camera.hpp"
 #include "vision/track_analysis.hpp"
 #include "vision/track_analysis_output.hpp"
 #include "vision/track_table.hpp"
 #include "vision/video_tracking.hpp"
+#endif
 
 namespace uphill::cli {
 namespace {
@@ -29,6 +35,8 @@ struct TrackFlags {
   std::string video, camera, scene_file, out, init, overlay;
   bool analyse = false, quiet = false;
 };
+
+#if UPHILL_VISION_PROGRAM
 
 // "u,v" in raw pixels (plain numbers: pixels are the image's own unit).
 Eigen::Vector2d ParsePixel(const std::string& text) {
@@ -121,6 +129,12 @@ void Run(const TrackFlags& f) {
     std::cout << "wrote " << (folder.empty() ? "." : folder) << "/track_analysis.json and its figures\n";
   }
 }
+
+#else  // uphill: the work runs in uphill-vision (vision_program.hpp)
+
+void Run(const TrackFlags&) { RunInVisionProgram(); }
+
+#endif
 
 }  // namespace
 
