@@ -185,4 +185,42 @@ Configuration ParseConfiguration(const FieldSource& source) {
   return c;
 }
 
+std::optional<Dimension> NumericFieldDimension(std::string_view name) {
+  if (name.rfind("u_", 0) == 0) name.remove_prefix(2);
+  for (const FieldSpec& f : kUncertainFields)
+    if (name == f.name) return f.dimension;
+  return std::nullopt;
+}
+
+bool SetNumericField(Configuration& c, std::string_view name, double si) {
+  const bool is_u = name.rfind("u_", 0) == 0;
+  if (is_u) {
+    name.remove_prefix(2);
+    if (si < 0.0) return false;  // Reader::Get refuses it, naming the cell
+  }
+  const auto set = [&](Uncertain& m, double v) { (is_u ? m.u : m.value) = v; };
+  if (name == "R") {
+    if (c.body_kind == BodyKind::kSpheroid) return false;
+    set(c.across, si);
+    if (c.body_kind == BodyKind::kSphere) set(c.along, si);
+  } else if (name == "a" || name == "b") {
+    if (c.body_kind != BodyKind::kSpheroid) return false;
+    set(name == "a" ? c.across : c.along, si);
+  } else if (name == "h") {
+    if (c.body_kind != BodyKind::kDoubleCone) return false;
+    set(c.along, si);
+  } else if (name == "L" || name == "H" || name == "D") {
+    if (!c.from_apparatus) return false;
+    set(name == "L" ? c.L : name == "H" ? c.H : c.D, si);
+  } else if (name == "theta" || name == "alpha") {
+    if (c.from_apparatus) return false;
+    set(name == "theta" ? c.theta : c.alpha, si);
+  } else if (name == "rod_diameter") {
+    set(c.rod_radius, si / 2);
+  } else {
+    return false;
+  }
+  return true;
+}
+
 }  // namespace uphill::io

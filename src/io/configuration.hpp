@@ -19,8 +19,10 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "io/units.hpp"
 #include "model/body.hpp"
 #include "model/propagation.hpp"
 #include "model/rails.hpp"
@@ -69,5 +71,16 @@ Configuration ParseConfiguration(const FieldSource& source);
 
 // The field names ParseConfiguration understands (for "unknown column" checks).
 const std::vector<std::string>& ConfigurationFieldNames();
+
+// For batches whose rows differ only in numbers (io's batch conversion): the dimension of a
+// numeric field (R, a, b, h, L, H, D, theta, alpha, rod_diameter and their u_<name>), or
+// nullopt for the others (body, label, L_convention).
+std::optional<Dimension> NumericFieldDimension(std::string_view name);
+// Sets numeric field `name` of a configuration that ParseConfiguration returned to the value
+// `si` (SI units), exactly as ParseConfiguration would have read it from a row that differs only
+// there. False when the field has no place in this configuration or the value is one that
+// ParseConfiguration refuses on reading (a negative uncertainty): parse that row instead. The
+// geometry is not checked here (Configuration::MakeScene does it).
+bool SetNumericField(Configuration& configuration, std::string_view name, double si);
 
 }  // namespace uphill::io

@@ -104,7 +104,7 @@ ConversionResult Convert(const Configuration& configuration, const ConversionOpt
   if (configuration.HasUncertainty())
     r.propagation = Propagate(configuration.MakeUncertainRails(), configuration.MakeUncertainBody(),
                               configuration.rod_radius, options.propagation);
-  r.verdict = Verdict(r, options);
+  if (options.verdict) r.verdict = Verdict(r, options);
   return r;
 }
 

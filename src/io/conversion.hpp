@@ -22,6 +22,7 @@ struct ConversionOptions {
   std::vector<double> at_x;       // positions (m) at which to report the path
   PropagationOptions propagation;  // Monte Carlo trials and seed (model/propagation.hpp)
   std::string length_unit = "mm";  // for the verdict sentences only
+  bool verdict = true;             // write the verdict sentences (only the JSON output has them)
 };
 
 struct ConversionResult {

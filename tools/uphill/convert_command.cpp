@@ -3,11 +3,11 @@
 // flags, or a CSV batch (file or stdin) in which each row is one configuration and the flags
 // supply defaults for absent columns.
 #include <iostream>
+#include <memory>
 
 #include "commands.hpp"
+#include "app/convert_batch.hpp"
 #include "convert_output.hpp"
-#include "io/configuration_table.hpp"
-#include "io/csv_table.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "scene_flags.hpp"
@@ -53,49 +53,54 @@ io::ConversionOptions Options(const ConvertFlags& f) {
   return o;
 }
 
-std::vector<ConvertedRow> ConvertBatch(const ConvertFlags& f, const io::ConversionOptions& options) {
-  const io::CsvTable table = io::ReadCsvFile(f.batch);
-  const io::ConfigurationTable configurations(table);
+// The optional columns of a batch's table and CSV, from its header and the flags (the values
+// cannot be known before the rows are printed).
+OptionalColumns BatchColumns(const BatchHeader& input, const ConvertFlags& f, const io::ConversionOptions& options) {
+  OptionalColumns any;
   const io::FieldSource defaults = FlagSource(f.scene);
-  if (table.rows.empty()) throw InputError(table.source, "has a header but no data rows");
-  std::vector<ConvertedRow> rows;
-  for (const io::CsvRow& row : table.rows) {
-    ConvertedRow out;
-    out.row = row.row;
-    try {
-      if (!row.error.empty()) throw InputError(table.source + ", row " + std::to_string(row.row), row.error);
-      const io::Configuration c = io::ParseConfiguration(configurations.RowSource(row, &defaults));
-      try {
-        out.result = io::Convert(c, options);
-      } catch (const InputError& e) {
-        throw InputError(table.source + ", row " + std::to_string(row.row) + ": " + e.quantity(), e.rule());
-      }
-    } catch (const InputError& e) {
-      out.error = e.what();
-    }
-    rows.push_back(std::move(out));
-  }
-  return rows;
+  const auto has = [&](const std::string& field) {
+    for (const std::string& column : input.header)
+      if (io::SplitUnitSuffix(column).first == field) return true;
+    return defaults.lookup(field).has_value();
+  };
+  any.label = has("label");
+  for (const std::string& name : io::ConfigurationFieldNames())
+    if (name.rfind("u_", 0) == 0) any.uncertainty |= has(name);
+  any.rest = options.mu.has_value();
+  const auto body = defaults.lookup("body");
+  any.cone = (body && body->text == "double-cone");
+  for (const std::string& column : input.header) any.cone |= io::SplitUnitSuffix(column).first == "body";
+  return any;
 }
 
 void Run(const ConvertFlags& f) {
-  const io::ConversionOptions options = Options(f);
-  std::vector<ConvertedRow> rows;
-  const bool batch = !f.batch.empty();
-  if (batch) {
-    rows = ConvertBatch(f, options);
-  } else {
+  io::ConversionOptions options = Options(f);
+  const OutputFormat format = f.json ? OutputFormat::kJson : f.csv ? OutputFormat::kCsv : OutputFormat::kTable;
+  options.verdict = format == OutputFormat::kJson || f.batch.empty();  // only JSON and one setting's table show it
+  if (f.batch.empty()) {
     ConvertedRow row;
     row.result = io::Convert(io::ParseConfiguration(FlagSource(f.scene)), options);
-    rows.push_back(std::move(row));
+    ConversionPrinter printer(std::cout, format, false, f.length_unit, ColumnsOf(*row.result));
+    printer.Row(row);
+    printer.Finish();
+    return;
   }
-  const OutputFormat format = f.json ? OutputFormat::kJson : f.csv ? OutputFormat::kCsv : OutputFormat::kTable;
-  PrintConversion(std::cout, rows, format, batch, f.length_unit);
-  for (const auto& row : rows) {
-    if (row.error.empty()) continue;
-    std::cerr << "uphill: " << row.error << "\n";
-    ExitStatus() = 2;
-  }
+  // Rows are printed as they are converted; a bad row is named on stderr as it is met.
+  const io::FieldSource defaults = FlagSource(f.scene);
+  std::unique_ptr<ConversionPrinter> printer;
+  ConvertBatch(
+      f.batch, defaults, options,
+      [&](const BatchHeader& input) {
+        printer = std::make_unique<ConversionPrinter>(std::cout, format, true, f.length_unit,
+                                                      BatchColumns(input, f, options));
+      },
+      [&](const ConvertedRow& row) {
+        printer->Row(row);
+        if (row.error.empty()) return;
+        std::cerr << "uphill: " << row.error << "\n";
+        ExitStatus() = 2;
+      });
+  printer->Finish();
 }
 
 }  // namespace

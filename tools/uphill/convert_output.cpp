@@ -1,5 +1,7 @@
 #include "convert_output.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <functional>
 #include <numbers>
@@ -12,80 +14,36 @@ namespace {
 
 using io::ConversionResult;
 
-
-// A column of the table and CSV: header (with unit) and how to get its text from a result.
-struct Column {
-  std::string header;
-  std::function<std::string(const ConversionResult&)> text;
-};
-
-std::vector<Column> Columns(const std::vector<ConvertedRow>& rows, const std::string& unit) {
-  const auto deg = [](double rad) { return Printf("%.6f", rad * 180.0 / std::numbers::pi); };
-  const auto len = [unit](double m) { return Printf("%.6g", io::ToUnit(m, io::Dimension::kLength, unit)); };
-  bool any_rest = false, any_u = false, any_cone = false, any_label = false;
-  for (const auto& r : rows) {
-    if (!r.result) continue;
-    any_rest |= r.result->rest.has_value();
-    any_u |= r.result->propagation.has_value();
-    any_cone |= r.result->scene.cone() != nullptr;
-    any_label |= !r.result->configuration.label.empty();
-  }
-  std::vector<Column> cols;
-  if (any_label) cols.push_back({"label", [](const ConversionResult& r) { return r.configuration.label; }});
-  cols.push_back({"body", [](const ConversionResult& r) { return r.scene.body().Name(); }});
-  cols.push_back({"theta_deg", [deg](const ConversionResult& r) { return deg(r.scene.rails().theta); }});
-  cols.push_back({"alpha_deg", [deg](const ConversionResult& r) { return deg(r.scene.rails().alpha); }});
-  cols.push_back({"phi_deg", [deg](const ConversionResult& r) {
-                    return deg(r.scene.rails().HalfAngleBetweenRails());
-                  }});
-  cols.push_back({"X_" + unit, [len](const ConversionResult& r) {
-                    return r.scene.x_eq() ? len(*r.scene.x_eq()) : std::string("-");
-                  }});
-  if (any_u) {
-    cols.push_back({"u_X_" + unit, [len](const ConversionResult& r) {
-                      return r.propagation && r.propagation->x_eq ? len(r.propagation->x_eq->u_first_order)
-                                                                  : std::string("-");
-                    }});
-    cols.push_back({"u_X_mc_" + unit, [len](const ConversionResult& r) {
-                      return r.propagation && r.propagation->x_eq ? len(r.propagation->x_eq->u_monte_carlo)
-                                                                  : std::string("-");
-                    }});
-  }
-  cols.push_back({"x_max_" + unit, [len](const ConversionResult& r) { return len(r.scene.x_max()); }});
-  if (any_rest) {
-    cols.push_back({"x_rest_low_" + unit, [len](const ConversionResult& r) {
-                      return r.rest ? len(r.rest->low) : std::string("-");
-                    }});
-    cols.push_back({"x_rest_" + unit, [len](const ConversionResult& r) {
-                      return r.rest ? len(r.rest->high) : std::string("-");
-                    }});
-  }
-  if (any_cone)
-    cols.push_back({"theta0_deg", [deg](const ConversionResult& r) {
-                      return r.scene.theta0() ? deg(*r.scene.theta0()) : std::string("-");
-                    }});
-  cols.push_back({"rolls_up", [](const ConversionResult& r) { return r.scene.rolls_up() ? "yes" : "no"; }});
-  cols.push_back({"note", [](const ConversionResult& r) {
-                    std::string note;
-                    if (const auto crossbar = r.configuration.CrossbarDistance();
-                        crossbar && r.scene.x_eq() && *r.scene.x_eq() > *crossbar)
-                      note = "X beyond crossbar";
-                    if (r.propagation && r.propagation->disagrees)
-                      note += std::string(note.empty() ? "" : "; ") + "u: first order != MC";
-                    return note;
-                  }});
-  return cols;
+// printf's %.6f and %.6g (std::to_chars with a precision is specified as printf is, and is
+// several times faster: a large batch prints millions of these).
+std::string Fixed6(double v) {
+  char buf[64];
+  return std::string(buf, std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, 6).ptr);
 }
+std::string General6(double v) {
+  char buf[64];
+  return std::string(buf, std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 6).ptr);
+}
+
 
 std::string Pad(const std::string& s, size_t width) {
   return s.size() < width ? s + std::string(width - s.size(), ' ') : s + " ";
 }
 
-std::string CsvEscape(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
+// Appends a CSV cell, quoted when it holds a comma, a quote or a line break.
+void AppendCsv(std::string* line, const std::string& s) {
+  bool plain = true;
+  for (char c : s) plain &= c != ',' && c != '"' && c != '\n';
+  if (plain) {
+    *line += s;
+    return;
+  }
+  *line += '"';
+  for (char c : s) {
+    if (c == '"') *line += '"';
+    *line += c;
+  }
+  *line += '"';
 }
 
 void PrintSingle(std::ostream& out, const ConvertedRow& row, const std::string& unit) {
@@ -137,69 +95,154 @@ void PrintSingle(std::ostream& out, const ConvertedRow& row, const std::string& 
 
 }  // namespace
 
-void PrintConversion(std::ostream& out, const std::vector<ConvertedRow>& rows, OutputFormat format,
-                     bool batch, const std::string& unit) {
-  if (format == OutputFormat::kJson) {
-    nlohmann::ordered_json all = nlohmann::ordered_json::array();
-    for (const auto& row : rows) {
-      nlohmann::ordered_json j;
-      if (batch) j["row"] = row.row;
-      if (row.result) {
-        const nlohmann::ordered_json result = io::ToJson(*row.result);
-        for (const auto& [k, v] : result.items()) j[k] = v;
-      } else {
-        j["error"] = row.error;
-      }
-      all.push_back(j);
+OptionalColumns ColumnsOf(const ConversionResult& r) {
+  return {!r.configuration.label.empty(), r.propagation.has_value(), r.rest.has_value(), r.scene.cone() != nullptr};
+}
+
+ConversionPrinter::ConversionPrinter(std::ostream& out, OutputFormat format, bool batch, std::string unit,
+                                     OptionalColumns any)
+    : out_(out), format_(format), batch_(batch), unit_(std::move(unit)) {
+  const std::string unit_copy = unit_;
+  const auto deg = [](double rad) { return Fixed6(rad * 180.0 / std::numbers::pi); };
+  const auto len = [unit_copy](double m) { return General6(io::ToUnit(m, io::Dimension::kLength, unit_copy)); };
+  std::vector<Column>& cols = columns_;
+  if (any.label) cols.push_back({"label", [](const ConversionResult& r) { return r.configuration.label; }});
+  cols.push_back({"body", [](const ConversionResult& r) { return r.scene.body().Name(); }});
+  cols.push_back({"theta_deg", [deg](const ConversionResult& r) { return deg(r.scene.rails().theta); }});
+  cols.push_back({"alpha_deg", [deg](const ConversionResult& r) { return deg(r.scene.rails().alpha); }});
+  cols.push_back({"phi_deg", [deg](const ConversionResult& r) { return deg(r.scene.rails().HalfAngleBetweenRails()); }});
+  cols.push_back({"X_" + unit_, [len](const ConversionResult& r) {
+                    return r.scene.x_eq() ? len(*r.scene.x_eq()) : std::string("-");
+                  }});
+  if (any.uncertainty) {
+    cols.push_back({"u_X_" + unit_, [len](const ConversionResult& r) {
+                      return r.propagation && r.propagation->x_eq ? len(r.propagation->x_eq->u_first_order) : std::string("-");
+                    }});
+    cols.push_back({"u_X_mc_" + unit_, [len](const ConversionResult& r) {
+                      return r.propagation && r.propagation->x_eq ? len(r.propagation->x_eq->u_monte_carlo) : std::string("-");
+                    }});
+  }
+  cols.push_back({"x_max_" + unit_, [len](const ConversionResult& r) { return len(r.scene.x_max()); }});
+  if (any.rest) {
+    cols.push_back({"x_rest_low_" + unit_, [len](const ConversionResult& r) { return r.rest ? len(r.rest->low) : std::string("-"); }});
+    cols.push_back({"x_rest_" + unit_, [len](const ConversionResult& r) { return r.rest ? len(r.rest->high) : std::string("-"); }});
+  }
+  if (any.cone)
+    cols.push_back({"theta0_deg", [deg](const ConversionResult& r) {
+                      return r.scene.theta0() ? deg(*r.scene.theta0()) : std::string("-");
+                    }});
+  cols.push_back({"rolls_up", [](const ConversionResult& r) { return std::string(r.scene.rolls_up() ? "yes" : "no"); }});
+  cols.push_back({"note", [](const ConversionResult& r) {
+                    std::string note;
+                    if (const auto crossbar = r.configuration.CrossbarDistance();
+                        crossbar && r.scene.x_eq() && *r.scene.x_eq() > *crossbar)
+                      note = "X beyond crossbar";
+                    if (r.propagation && r.propagation->disagrees)
+                      note += std::string(note.empty() ? "" : "; ") + "u: first order != MC";
+                    return note;
+                  }});
+  if (format_ == OutputFormat::kCsv) {
+    out_ << "row";
+    for (const Column& c : columns_) out_ << "," << c.header;
+    out_ << ",error\n";
+  }
+}
+
+ConversionPrinter::~ConversionPrinter() = default;
+
+std::vector<std::string> ConversionPrinter::Cells(const ConvertedRow& row) const {
+  std::vector<std::string> line;
+  line.reserve(columns_.size() + 2);
+  line.push_back(std::to_string(row.row));
+  for (const Column& c : columns_) line.push_back(row.result ? c.text(*row.result) : "");
+  line.push_back(row.error);
+  return line;
+}
+
+void ConversionPrinter::Row(const ConvertedRow& row) {
+  const std::size_t index = rows_++;
+  if (format_ == OutputFormat::kJson) {
+    nlohmann::ordered_json j;
+    if (batch_) j["row"] = row.row;
+    if (row.result) {
+      const nlohmann::ordered_json result = io::ToJson(*row.result);
+      for (const auto& [k, v] : result.items()) j[k] = v;
+    } else {
+      j["error"] = row.error;
     }
-    out << (batch ? all.dump(2) : all.at(0).dump(2)) << "\n";
+    if (!batch_) {
+      out_ << j.dump(2) << "\n";
+      return;
+    }
+    // One element of the array as dump(2) of the whole array would indent it.
+    std::string text = j.dump(2);
+    std::string indented = index == 0 ? "[\n  " : ",\n  ";
+    indented.reserve(text.size() + 64);
+    for (char ch : text) {
+      indented += ch;
+      if (ch == '\n') indented += "  ";
+    }
+    out_ << indented;
     return;
   }
-  if (!batch && format == OutputFormat::kTable) {
-    if (rows.at(0).result) PrintSingle(out, rows.at(0), unit);
+  if (!batch_ && format_ == OutputFormat::kTable) {
+    if (row.result) PrintSingle(out_, row, unit_);
     return;
   }
-  const auto cols = Columns(rows, unit);
-  std::vector<std::vector<std::string>> cells;
+  std::vector<std::string> line = Cells(row);
+  if (format_ == OutputFormat::kCsv) {
+    csv_line_.clear();
+    for (std::size_t i = 0; i < line.size(); ++i) {
+      if (i) csv_line_ += ',';
+      AppendCsv(&csv_line_, line[i]);
+    }
+    csv_line_ += '\n';
+    out_.write(csv_line_.data(), static_cast<std::streamsize>(csv_line_.size()));
+    return;
+  }
+  if (!table_started_) {
+    held_.push_back(std::move(line));
+    if (held_.size() >= kTableSample) FlushTable();
+    return;
+  }
+  TableLine(line);
+}
+
+void ConversionPrinter::FlushTable() {
   std::vector<std::string> header{"row"};
-  for (const auto& c : cols) header.push_back(c.header);
+  for (const Column& c : columns_) header.push_back(c.header);
   header.push_back("error");
-  for (const auto& row : rows) {
-    std::vector<std::string> line{std::to_string(row.row)};
-    for (const auto& c : cols) line.push_back(row.result ? c.text(*row.result) : "");
-    line.push_back(row.error);
-    cells.push_back(line);
+  // Drop the error column when no row of the sample failed.
+  for (const auto& line : held_) error_column_ |= !line.back().empty();
+  width_.assign(header.size(), 0);
+  for (std::size_t i = 0; i < header.size(); ++i) width_[i] = header[i].size();
+  for (const auto& line : held_)
+    for (std::size_t i = 0; i < line.size(); ++i) width_[i] = std::max(width_[i], line[i].size());
+  table_started_ = true;
+  TableLine(header, true);
+  for (const auto& line : held_) TableLine(line);
+  held_.clear();
+}
+
+void ConversionPrinter::TableLine(const std::vector<std::string>& cells, bool header) {
+  const std::size_t shown = error_column_ ? cells.size() : cells.size() - 1;
+  std::string text;
+  for (std::size_t i = 0; i < shown; ++i) {
+    text += (i ? "  " : "") + cells[i];
+    if (i + 1 < shown) text += std::string(width_[i] > cells[i].size() ? width_[i] - cells[i].size() : 0, ' ');
   }
-  if (format == OutputFormat::kCsv) {
-    for (size_t i = 0; i < header.size(); ++i) out << (i ? "," : "") << header[i];
-    out << "\n";
-    for (const auto& line : cells) {
-      for (size_t i = 0; i < line.size(); ++i) out << (i ? "," : "") << CsvEscape(line[i]);
-      out << "\n";
-    }
-    return;
+  if (!error_column_ && !header && !cells.back().empty()) text += "  " + cells.back();
+  out_ << text << "\n";
+}
+
+void ConversionPrinter::Finish() {
+  if (finished_) return;
+  finished_ = true;
+  if (format_ == OutputFormat::kJson && batch_) out_ << (rows_ ? "\n]\n" : "[]\n");
+  if (format_ == OutputFormat::kTable && batch_) {
+    if (!table_started_) FlushTable();
+    out_ << "(lengths in " << unit_ << ", angles in degrees; X = unstable equilibrium, x_max = fall-off)\n";
   }
-  // Table: drop the error column when no row failed; align columns.
-  bool any_error = false;
-  for (const auto& row : rows) any_error |= !row.error.empty();
-  if (!any_error) {
-    header.pop_back();
-    for (auto& line : cells) line.pop_back();
-  }
-  std::vector<size_t> width(header.size());
-  for (size_t i = 0; i < header.size(); ++i) width[i] = header[i].size();
-  for (const auto& line : cells)
-    for (size_t i = 0; i < line.size(); ++i) width[i] = std::max(width[i], line[i].size());
-  const auto print = [&](const std::vector<std::string>& line) {
-    for (size_t i = 0; i < line.size(); ++i) {
-      out << (i ? "  " : "") << line[i];
-      if (i + 1 < line.size()) out << std::string(width[i] - line[i].size(), ' ');
-    }
-    out << "\n";
-  };
-  print(header);
-  for (const auto& line : cells) print(line);
-  out << "(lengths in " << unit << ", angles in degrees; X = unstable equilibrium, x_max = fall-off)\n";
 }
 
 }  // namespace uphill::cli

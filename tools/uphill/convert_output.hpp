@@ -1,27 +1,65 @@
 // Output of `uphill convert`: a readable table (lab units, each column naming its unit), CSV
 // (the same columns) or JSON (SI, io::ToJson). Failed rows of a batch appear in every format,
 // with their error, so the output lines up with the input rows.
+//
+// Rows are printed as they come (a batch of any size is never held): JSON as the elements of one
+// array, CSV line by line; the table holds its first kTableSample rows to size its columns, then
+// prints the rest with those widths (a wider cell shifts its line; an error after the sample, when
+// the sample had none, goes at the end of its line). The optional columns - label, the
+// uncertainties, the rest band, θ0 - are chosen before the first row: for a batch from its header
+// and the flags (ColumnsFor), for one configuration from its result.
 #pragma once
 
-#include <optional>
+#include <cstddef>
+#include <functional>
+#include <memory>
 #include <ostream>
 #include <string>
 #include <vector>
 
-#include "io/conversion.hpp"
+#include "app/convert_batch.hpp"
 
 namespace uphill::cli {
 
-// One input configuration's outcome: a result, or the one-line error it got.
-struct ConvertedRow {
-  int row = 0;  // spreadsheet row of a batch, 0 for a configuration from flags
-  std::optional<io::ConversionResult> result;
-  std::string error;
-};
-
 enum class OutputFormat { kTable, kCsv, kJson };
 
-void PrintConversion(std::ostream& out, const std::vector<ConvertedRow>& rows, OutputFormat format,
-                     bool batch, const std::string& length_unit);
+// The optional columns of the table and the CSV.
+struct OptionalColumns {
+  bool label = false, uncertainty = false, rest = false, cone = false;
+};
+// For one configuration: the columns its result has.
+OptionalColumns ColumnsOf(const io::ConversionResult& result);
+
+inline constexpr std::size_t kTableSample = 10000;
+
+class ConversionPrinter {
+ public:
+  ConversionPrinter(std::ostream& out, OutputFormat format, bool batch, std::string length_unit,
+                    OptionalColumns columns);
+  ~ConversionPrinter();
+  void Row(const ConvertedRow& row);
+  void Finish();  // closes the JSON array, prints a table held so far
+
+ private:
+  struct Column {
+    std::string header;
+    std::function<std::string(const io::ConversionResult&)> text;
+  };
+  std::vector<std::string> Cells(const ConvertedRow& row) const;
+  void FlushTable();
+  void TableLine(const std::vector<std::string>& cells, bool header = false);
+
+  std::ostream& out_;
+  OutputFormat format_;
+  bool batch_;
+  std::string unit_;
+  std::vector<Column> columns_;
+  std::size_t rows_ = 0;
+  // The table's sample, its widths once known, and whether it shows the error column.
+  std::vector<std::vector<std::string>> held_;
+  std::vector<std::size_t> width_;
+  bool error_column_ = false, table_started_ = false, finished_ = false;
+  std::string csv_line_;  // reused for every CSV line
+};
 
 }  // namespace uphill::cli
