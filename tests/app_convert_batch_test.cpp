@@ -1,6 +1,6 @@
 // app::ConvertBatch (src/app/convert_batch.hpp): rows that differ only in their numbers take a
 // short path (the first row's configuration with the numbers replaced); they must give exactly
-// what parsing every row in full gives. Truth: the full path (io::ParseConfiguration per row,
+// what parsing every row in full gives. Truth: the full path (ParseConfiguration per row,
 // forced here by a label column, which the short path does not take), on the same rows, valid
 // and invalid ones alike; and the row order and errors of the input.
 #include <gtest/gtest.h>
@@ -11,15 +11,15 @@
 #include "app/convert_batch.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
-io::FieldSource Flags() {
-  io::FieldSource s;
-  s.lookup = [](const std::string& name) -> std::optional<io::FieldSource::Field> {
-    if (name == "body") return io::FieldSource::Field{"spheroid", ""};
-    if (name == "a") return io::FieldSource::Field{"15.875mm", ""};
-    if (name == "b") return io::FieldSource::Field{"25.4mm", ""};
+FieldSource Flags() {
+  FieldSource s;
+  s.lookup = [](const std::string& name) -> std::optional<FieldSource::Field> {
+    if (name == "body") return FieldSource::Field{"spheroid", ""};
+    if (name == "a") return FieldSource::Field{"15.875mm", ""};
+    if (name == "b") return FieldSource::Field{"25.4mm", ""};
     return std::nullopt;
   };
   s.context = [](const std::string& name) { return "--" + name; };
@@ -29,13 +29,13 @@ io::FieldSource Flags() {
 std::vector<std::string> ConvertAll(const std::string& csv) {
   std::istringstream in(csv);
   std::vector<std::string> out;
-  io::ConversionOptions options;
+  ConversionOptions options;
   options.mu = 0.02;
   options.propagation.trials = 1000;  // seeded: the same draws on both paths
   ConvertBatch(in, "b.csv", Flags(), options, [](const BatchHeader&) {},
                [&](const ConvertedRow& row) {
                  out.push_back(std::to_string(row.row) + " " +
-                               (row.result ? io::ToJson(*row.result).dump() : "error: " + row.error));
+                               (row.result ? ToJson(*row.result).dump() : "error: " + row.error));
                });
   return out;
 }
@@ -73,4 +73,4 @@ TEST(ConvertBatch, RowsComeInInputOrderAndAHeaderOnlyFileIsRefused) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

@@ -16,7 +16,7 @@
 #include "model/spheroid_on_rods.hpp"
 #include "reference_cases.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 constexpr double kUlp = 1.1102230246251565e-16;  // 2^-53, half an ulp of 1
@@ -260,4 +260,4 @@ TEST(BatchKernelName, NamesTheChoice) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

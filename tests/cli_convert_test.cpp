@@ -9,7 +9,7 @@
 #include "model/scene.hpp"
 #include "reference_cases.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 using nlohmann::json;
@@ -156,4 +156,4 @@ TEST(ConvertCli, FlagsAreDefaultsForBatchColumnsAndCsvNamesItsUnits) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

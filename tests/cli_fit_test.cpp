@@ -10,7 +10,7 @@
 
 #include "cli_test_support.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 using nlohmann::json;
@@ -213,4 +213,4 @@ TEST(FitCli, ReportOfABadExperimentNamesTheProblem) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

@@ -8,7 +8,7 @@
 
 #include "cli_test_support.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 TEST(PaperFiguresCli, WritesEveryFigureAndASelfContainedGallery) {
@@ -34,4 +34,4 @@ TEST(PaperFiguresCli, WritesEveryFigureAndASelfContainedGallery) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

@@ -10,7 +10,7 @@
 #include "cli_test_support.hpp"
 #include "reference_cases.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 using nlohmann::json;
@@ -150,4 +150,4 @@ TEST(SimulateCli, BadInputExitsTwoNamingTheFlag) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

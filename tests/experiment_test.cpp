@@ -8,7 +8,7 @@
 #include "io/experiment.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::io {
+namespace uphill::testing {
 namespace {
 
 const std::string kSamples = std::string(UPHILL_SOURCE_DIR) + "/data";
@@ -141,4 +141,4 @@ TEST(FuzzRegression, DeeplyNestedJsonValuesAreRefusedWithoutRecursion) {
 }
 
 }  // namespace
-}  // namespace uphill::io
+}  // namespace uphill::testing

@@ -14,7 +14,7 @@
 #include "model/propagation.hpp"
 #include "oracle/friction_reference.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 // The paper's spheroid (2 × 1.25 × 1.25 inch, long axis across the rails) and crossbar height.
@@ -279,7 +279,7 @@ struct NoisyInputs {
 // One trial per setting (so the rows' model errors are independent): true L, D on the lab grid;
 // Y = x_rest(μ) of the true setting + N(0, u_y²); the scene and u_model from the recorded
 // L + N(0, u_L²), D + N(0, u_D²). u_model = u(X) = u(x_eq) from Propagate at the recorded values,
-// as report::AnalyseExperiment passes it.
+// as AnalyseExperiment passes it.
 NoisyInputs NoisyLab(double mu, double u_y, std::uint64_t seed, bool with_u_model = true) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal;
@@ -407,4 +407,4 @@ TEST(FrictionModelUncertainty, BadModelUncertaintiesAreRefused) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

@@ -28,7 +28,7 @@
 #define UPHILL_FIT_LARGE_N 1000000
 #endif
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 // ---------------------------------------------------------------------------------------------
@@ -753,4 +753,4 @@ TEST(Diagnostics, RowsCarryResidualsAndOutlierFlags) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

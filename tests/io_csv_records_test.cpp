@@ -17,7 +17,7 @@
 #include "io/xy_table.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::io {
+namespace uphill::testing {
 namespace {
 
 struct Read {
@@ -220,4 +220,4 @@ TEST(XyTable, RefusesAFileWithoutXOrWithUnknownColumns) {
 }
 
 }  // namespace
-}  // namespace uphill::io
+}  // namespace uphill::testing

@@ -12,7 +12,7 @@
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::io {
+namespace uphill::testing {
 namespace {
 
 TEST(Units, LengthsAnglesAndAccelerationToSI) {
@@ -233,4 +233,4 @@ TEST(FuzzRegression, CsvCellsThatAreNotUtf8AreRefusedPerRow) {
 }
 
 }  // namespace
-}  // namespace uphill::io
+}  // namespace uphill::testing

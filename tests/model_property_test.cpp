@@ -37,7 +37,7 @@
 #include "model/input_error.hpp"
 #include "model/scene.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 constexpr double kU = std::numeric_limits<double>::epsilon() / 2;  // unit roundoff, 2^-53
@@ -1273,4 +1273,4 @@ TEST(NoNaN, DenseGridOverRandomAndExtremeScenes) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

@@ -6,7 +6,7 @@
 #include "model/scene.hpp"
 #include "reference_cases.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 using nlohmann::json;
@@ -160,4 +160,4 @@ TEST(SweepTest, EquilibriumAgainstPhiAndTheta) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

@@ -11,7 +11,7 @@
 #include "model/scene.hpp"
 #include "motion/motion.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
@@ -478,4 +478,4 @@ TEST(MotionInput, RejectsOutOfDomain) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

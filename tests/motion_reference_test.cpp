@@ -10,7 +10,7 @@
 #include "motion/motion.hpp"
 #include "reference_cases.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 using nlohmann::json;
@@ -88,4 +88,4 @@ std::string Name(const ::testing::TestParamInfo<Param>& info) {
 INSTANTIATE_TEST_SUITE_P(Reference, ReleaseTest, ::testing::ValuesIn(Params()), Name);
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

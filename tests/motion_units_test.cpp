@@ -4,7 +4,7 @@
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::io {
+namespace uphill::testing {
 namespace {
 
 TEST(MotionUnits, TimeAndVelocityToSI) {
@@ -23,4 +23,4 @@ TEST(MotionUnits, TimeAndVelocityToSI) {
 }
 
 }  // namespace
-}  // namespace uphill::io
+}  // namespace uphill::testing

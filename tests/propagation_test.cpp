@@ -15,7 +15,7 @@
 #include "model/input_error.hpp"
 #include "model/scene.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 // The lab's spheroid (2 × 1.25 × 1.25 inch, long axis across the rails) and Experiment 2.
@@ -428,4 +428,4 @@ TEST(Errors, BadInputThrowsInputErrorNamingTheQuantity) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

@@ -1,6 +1,6 @@
-// The streamed JSON of `uphill fit --xy --json` (report::WriteFitJson, per-row entries computed on
+// The streamed JSON of `uphill fit --xy --json` (WriteFitJson, per-row entries computed on
 // demand, fit/line_rows.hpp) parses to exactly the JSON tree of the in-memory result
-// (report::FitToJson of the same fit with its rows kept): a round trip through nlohmann::json on
+// (FitToJson of the same fit with its rows kept): a round trip through nlohmann::json on
 // small N for every line method, rows and all, and with the rows left out (--no-rows).
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 #include "fit/york_line.hpp"
 #include "report/fit_json.hpp"
 
-namespace uphill {
+namespace uphill::testing {
 namespace {
 
 LineData Rows(std::size_t n, std::uint64_t seed) {
@@ -48,19 +48,19 @@ TEST(FitJsonStream, ParsesToTheInMemoryTree) {
       {FitRobust(d, robust_keep), FitRobust(d, robust_stream)}};
   for (const auto& [kept, streamed] : fits) {
     SCOPED_TRACE(MethodName(kept.method));
-    const nlohmann::json expected = nlohmann::json::parse(report::FitToJson(kept).dump(2));
+    const nlohmann::json expected = nlohmann::json::parse(FitToJson(kept).dump(2));
     ASSERT_EQ(expected.at("rows").size(), d.size());
     std::ostringstream out;
-    report::WriteFitJson(out, streamed, d);
+    WriteFitJson(out, streamed, d);
     const nlohmann::json got = nlohmann::json::parse(out.str());
     EXPECT_EQ(WithoutTimes(got), WithoutTimes(expected));
     // A report that kept its rows streams them too, the same.
     std::ostringstream from_kept;
-    report::WriteFitJson(from_kept, kept, d);
+    WriteFitJson(from_kept, kept, d);
     EXPECT_EQ(WithoutTimes(nlohmann::json::parse(from_kept.str())), WithoutTimes(expected));
     // --no-rows: everything but the per-row entries.
     std::ostringstream no_rows;
-    report::WriteFitJson(no_rows, streamed, d, false);
+    WriteFitJson(no_rows, streamed, d, false);
     nlohmann::json without = WithoutTimes(expected);
     without["rows"] = nlohmann::json::array();
     EXPECT_EQ(WithoutTimes(nlohmann::json::parse(no_rows.str())), without);
@@ -68,4 +68,4 @@ TEST(FitJsonStream, ParsesToTheInMemoryTree) {
 }
 
 }  // namespace
-}  // namespace uphill
+}  // namespace uphill::testing

@@ -23,7 +23,7 @@
 // Last: <httplib.h> includes <resolv.h>, whose `_res` macro breaks Eigen.
 #include <httplib.h>
 
-namespace uphill::server {
+namespace uphill::testing {
 namespace {
 
 namespace fs = std::filesystem;
@@ -38,7 +38,7 @@ fs::path TempDir(const std::string& name) {
   return dir;
 }
 
-json Experiment() {
+json ExperimentMetadata() {
   return {{"title", "Series 2 <script>alert(1)</script>"},
           {"operator", "A. Technician"},
           {"body", {{"type", "spheroid"}, {"a", "15.875 mm"}, {"b", "25.4 mm"}}},
@@ -100,7 +100,7 @@ class ServerTest : public ::testing::Test {
     return {r->status, parsed};
   }
   json Create() {
-    auto [status, body] = Send("PUT", "/api/experiment", {{"version", State()["version"]}, {"experiment", Experiment()}, {"unit", "mm"}});
+    auto [status, body] = Send("PUT", "/api/experiment", {{"version", State()["version"]}, {"experiment", ExperimentMetadata()}, {"unit", "mm"}});
     EXPECT_EQ(status, 200) << body.dump();
     return body;
   }
@@ -154,7 +154,7 @@ TEST_F(ServerTest, CreatesAnExperimentAndWritesFilesThatLoad) {
   Add(Row("t1", 150, 392));
   s = Add(Row("t2, with \"quotes\"", 200, 292));
   ASSERT_EQ(s["rows"].size(), 2u);
-  const io::Experiment e = io::LoadExperiment(dir_.string());
+  const Experiment e = LoadExperiment(dir_.string());
   ASSERT_EQ(e.rows.size(), 2u);
   EXPECT_TRUE(e.rows[0].error.empty()) << e.rows[0].error;
   EXPECT_EQ(e.rows[1].trial, "t2, with \"quotes\"");
@@ -235,7 +235,7 @@ TEST_F(ServerTest, EditsDeletesAndUndoes) {
   EXPECT_EQ(after["version"], undone2["version"]);
   EXPECT_EQ(after["rows"], undone2["rows"]);
   EXPECT_TRUE(after["can_undo"]);  // the add of t2 can still be undone
-  EXPECT_EQ(io::LoadExperiment(dir_.string()).rows.size(), 2u);
+  EXPECT_EQ(LoadExperiment(dir_.string()).rows.size(), 2u);
 }
 
 TEST_F(ServerTest, StaleVersionIsAConflictWithTheCurrentState) {
@@ -336,7 +336,7 @@ TEST(ExperimentStoreTest, RecoversFromACrashBetweenJournalAndFiles) {
   std::string csv_before;
   {
     ExperimentStore store(dir.string());
-    store.SetMetadata(0, Experiment(), "mm");
+    store.SetMetadata(0, ExperimentMetadata(), "mm");
     store.AddRow(1, Row("t1", 150, 392));
     std::stringstream s;
     s << std::ifstream(dir / "measurements.csv").rdbuf();
@@ -352,7 +352,7 @@ TEST(ExperimentStoreTest, RecoversFromACrashBetweenJournalAndFiles) {
     const StoreSnapshot s = store.Get();
     EXPECT_EQ(s.version, 3);
     ASSERT_EQ(s.state.rows.size(), 2u);
-    EXPECT_EQ(io::LoadExperiment(dir.string()).rows.size(), 2u);  // files rewritten
+    EXPECT_EQ(LoadExperiment(dir.string()).rows.size(), 2u);  // files rewritten
     store.AddRow(3, Row("t3", 250, 232));                          // the journal continues cleanly
   }
   {
@@ -381,7 +381,7 @@ TEST(ExperimentStoreTest, OpensAHandMadeExperimentWithoutWriting) {
   fs::copy(fs::path(UPHILL_SOURCE_DIR) / "data" / "series2-fixed-L", dir, fs::copy_options::recursive);
   {
     ExperimentStore store(dir.string());
-    EXPECT_EQ(store.Get().state.rows.size(), io::LoadExperiment(dir.string()).rows.size());
+    EXPECT_EQ(store.Get().state.rows.size(), LoadExperiment(dir.string()).rows.size());
     EXPECT_FALSE(fs::exists(dir / "journal.jsonl"));
     const json checks = CheckAll(store.Get().state);  // declared in row_check.hpp
     EXPECT_EQ(checks["fit"]["n"], store.Get().state.rows.size());
@@ -422,7 +422,7 @@ TEST_F(ServerTest, TwoWritersLoseNothing) {
   std::set<std::string> trials;
   for (const json& r : s["rows"]) trials.insert(r["trial"]);
   EXPECT_EQ(trials.size(), 2u * kPerWriter);
-  EXPECT_EQ(io::LoadExperiment(dir_.string()).rows.size(), 2u * kPerWriter);
+  EXPECT_EQ(LoadExperiment(dir_.string()).rows.size(), 2u * kPerWriter);
 }
 
 // The real program, killed with SIGKILL in the middle of a burst of writes, then restarted.
@@ -472,7 +472,7 @@ TEST(ServeProcessTest, KillNineLosesNoAcknowledgedRow) {
     ServeProcess serve(dir);
     httplib::Client c("127.0.0.1", serve.port());
     c.set_read_timeout(5);
-    auto r = c.Put("/api/experiment", json({{"version", 0}, {"experiment", Experiment()}, {"unit", "mm"}}).dump(), kJson);
+    auto r = c.Put("/api/experiment", json({{"version", 0}, {"experiment", ExperimentMetadata()}, {"unit", "mm"}}).dump(), kJson);
     ASSERT_TRUE(r);
     ASSERT_EQ(r->status, 200);
     std::int64_t version = json::parse(r->body)["version"];
@@ -506,11 +506,11 @@ TEST(ServeProcessTest, KillNineLosesNoAcknowledgedRow) {
   for (const json& row : s["rows"]) present.insert(row["trial"]);
   for (const std::string& t : acknowledged) EXPECT_TRUE(present.count(t)) << "lost acknowledged row " << t;
   EXPECT_LE(present.size(), acknowledged.size() + 1);  // at most the one in flight
-  const io::Experiment e = io::LoadExperiment(dir.string());
+  const Experiment e = LoadExperiment(dir.string());
   EXPECT_EQ(e.rows.size(), present.size());
   again.Kill(SIGTERM);
   fs::remove_all(dir);
 }
 
 }  // namespace
-}  // namespace uphill::server
+}  // namespace uphill::testing

@@ -20,7 +20,7 @@
 #include "vision/track_analysis_output.hpp"
 #include "vision/track_table.hpp"
 
-namespace uphill::vision {
+namespace uphill::testing {
 namespace {
 
 constexpr double kDeg = M_PI / 180;
@@ -424,4 +424,4 @@ TEST(AnalyseTrackCommand, PrintsTheFitAndWritesJsonAndFigures) {
 }
 
 }  // namespace
-}  // namespace uphill::vision
+}  // namespace uphill::testing

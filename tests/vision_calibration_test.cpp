@@ -19,7 +19,7 @@
 #include "vision/chessboard_render.hpp"
 #include "vision_test_support.hpp"
 
-namespace uphill::vision {
+namespace uphill::testing {
 namespace {
 
 namespace fs = std::filesystem;
@@ -385,4 +385,4 @@ TEST(CalibrateTargetCommand, WritesAnSvgOfExactSizeAndAPngThatIsDetected) {
 }
 
 }  // namespace
-}  // namespace uphill::vision
+}  // namespace uphill::testing

@@ -11,7 +11,7 @@
 #include "vision/camera.hpp"
 #include "vision_test_support.hpp"
 
-namespace uphill::vision {
+namespace uphill::testing {
 namespace {
 
 namespace fs = std::filesystem;
@@ -211,4 +211,4 @@ TEST(CameraFiles, BadFilesAreRefusedNamingFileKeyAndRule) {
 }
 
 }  // namespace
-}  // namespace uphill::vision
+}  // namespace uphill::testing

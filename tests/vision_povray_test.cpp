@@ -26,7 +26,7 @@
 #include "vision/povray_scene.hpp"
 #include "vision/sensor_model.hpp"
 
-namespace uphill::vision {
+namespace uphill::testing {
 namespace {
 
 namespace fs = std::filesystem;
@@ -269,7 +269,7 @@ TEST_F(PovrayTest, UserPathOnATinyClip) {
                          FootageSceneFlags(tiny.condition) + " -o '" + track + "'");
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   const std::vector<ClipTruth> truth = ReadFootageTruth(files.truth_csv);
-  const io::CsvTable table = io::ReadCsvFile(track);
+  const CsvTable table = ReadCsvFile(track);
   ASSERT_EQ(table.rows.size(), truth.size());
   double s_px = 0, s_mm = 0;
   int found = 0, compared = 0;
@@ -296,4 +296,4 @@ TEST_F(PovrayTest, UserPathOnATinyClip) {
 }
 
 }  // namespace
-}  // namespace uphill::vision
+}  // namespace uphill::testing

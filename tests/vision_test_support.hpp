@@ -5,7 +5,7 @@
 
 #include "model/input_error.hpp"
 
-namespace uphill::vision {
+namespace uphill::testing {
 
 // The message of the InputError thrown by f, or "" if none was thrown.
 template <class F>
@@ -18,4 +18,4 @@ std::string InputErrorOf(F f) {
   return "";
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill::testing

@@ -14,7 +14,7 @@
 #include "vision/synthetic_clip.hpp"
 #include "vision/video_tracking.hpp"
 
-namespace uphill::vision {
+namespace uphill::testing {
 namespace {
 
 namespace fs = std::filesystem;
@@ -250,4 +250,4 @@ TEST(VisionTrack, BadInputIsNamed) {
 }
 
 }  // namespace
-}  // namespace uphill::vision
+}  // namespace uphill::testing

@@ -16,15 +16,15 @@ namespace {
 
 // The flags' defaults looked up once for every field name (they are the same for every row; a
 // batch asks for them millions of times).
-io::FieldSource Cached(const io::FieldSource& defaults) {
-  auto fields = std::make_shared<std::unordered_map<std::string, std::optional<io::FieldSource::Field>>>();
+FieldSource Cached(const FieldSource& defaults) {
+  auto fields = std::make_shared<std::unordered_map<std::string, std::optional<FieldSource::Field>>>();
   auto contexts = std::make_shared<std::unordered_map<std::string, std::string>>();
-  for (const std::string& name : io::ConfigurationFieldNames()) {
+  for (const std::string& name : ConfigurationFieldNames()) {
     (*fields)[name] = defaults.lookup(name);
     (*contexts)[name] = defaults.context(name);
   }
-  io::FieldSource cached;
-  cached.lookup = [fields, defaults](const std::string& name) -> std::optional<io::FieldSource::Field> {
+  FieldSource cached;
+  cached.lookup = [fields, defaults](const std::string& name) -> std::optional<FieldSource::Field> {
     const auto it = fields->find(name);
     return it != fields->end() ? it->second : defaults.lookup(name);
   };
@@ -39,19 +39,19 @@ io::FieldSource Cached(const io::FieldSource& defaults) {
 // number with its unit in the header (L_mm, u_D_mm, ...) or `note`, a row whose cells are all plain
 // numbers needs no parsing of field names, units or defaults: it is the configuration of the
 // first such row (parsed in full, ParseConfiguration) with the numbers replaced
-// (io::SetNumericField). Any other row - an empty or non-numeric cell, a value the model refuses -
+// (SetNumericField). Any other row - an empty or non-numeric cell, a value the model refuses -
 // is parsed in full, so that its result or its error is exactly the general path's.
 class NumericRows {
  public:
   explicit NumericRows(const std::vector<std::string>& header) {
     for (const std::string& column : header) {
-      const auto [name, unit] = io::SplitUnitSuffix(column);
+      const auto [name, unit] = SplitUnitSuffix(column);
       if (name == "note") {
         columns_.push_back({"", 0.0});
         continue;
       }
-      const auto dimension = io::NumericFieldDimension(name);
-      const double factor = dimension && !unit.empty() ? io::UnitFactor(*dimension, unit) : 0.0;
+      const auto dimension = NumericFieldDimension(name);
+      const double factor = dimension && !unit.empty() ? UnitFactor(*dimension, unit) : 0.0;
       if (factor == 0.0) return;  // a text column, or units in the cells: every row in full
       columns_.push_back({name, factor});
     }
@@ -59,21 +59,21 @@ class NumericRows {
   }
 
   // The configuration of `cells` if this row can take the short path (and a template exists).
-  std::optional<io::Configuration> Of(const std::vector<std::string_view>& cells) const {
+  std::optional<Configuration> Of(const std::vector<std::string_view>& cells) const {
     if (!usable_ || !first_) return std::nullopt;
-    io::Configuration c = *first_;
+    Configuration c = *first_;
     for (std::size_t j = 0; j < cells.size(); ++j) {
       if (columns_[j].name.empty()) continue;
       double number = 0;
       if (!Plain(cells[j], &number)) return std::nullopt;
-      const double si = number * columns_[j].factor;  // as io::ParseQuantity
-      if (!std::isfinite(si) || !io::SetNumericField(c, columns_[j].name, si)) return std::nullopt;
+      const double si = number * columns_[j].factor;  // as ParseQuantity
+      if (!std::isfinite(si) || !SetNumericField(c, columns_[j].name, si)) return std::nullopt;
     }
     return c;
   }
 
   // Offers a row parsed in full as the template of the later ones.
-  void Offer(const std::vector<std::string_view>& cells, const io::Configuration& c) {
+  void Offer(const std::vector<std::string_view>& cells, const Configuration& c) {
     if (!usable_ || first_) return;
     double number = 0;
     for (std::size_t j = 0; j < cells.size(); ++j)
@@ -82,7 +82,7 @@ class NumericRows {
   }
 
  private:
-  // A cell that is only a number, as io::ParseQuantity reads it (an optional '+' before
+  // A cell that is only a number, as ParseQuantity reads it (an optional '+' before
   // std::from_chars' syntax; fast_float rounds as from_chars does). Zero, subnormal and out-of-range
   // values take the full path, where from_chars' range rules apply.
   static bool Plain(std::string_view cell, double* number) {
@@ -101,16 +101,16 @@ class NumericRows {
   };
   std::vector<Column> columns_;
   bool usable_ = false;
-  std::optional<io::Configuration> first_;
+  std::optional<Configuration> first_;
 };
 
-void Run(io::CsvRecords& records, const io::FieldSource& flag_defaults, const io::ConversionOptions& options,
+void Run(CsvRecords& records, const FieldSource& flag_defaults, const ConversionOptions& options,
          const std::function<void(const BatchHeader&)>& on_header,
          const std::function<void(const ConvertedRow&)>& on_row) {
-  const io::ConfigurationTable table(records.header(), records.source());
-  const io::FieldSource defaults = Cached(flag_defaults);
+  const ConfigurationTable table(records.header(), records.source());
+  const FieldSource defaults = Cached(flag_defaults);
   NumericRows numeric(records.header());
-  io::CsvRecords::Record record;
+  CsvRecords::Record record;
   bool any = false;
   ConvertedRow out;
   while (records.Next(&record)) {
@@ -120,9 +120,9 @@ void Run(io::CsvRecords& records, const io::FieldSource& flag_defaults, const io
     out.result.reset();
     out.error.clear();
     if (record.error.empty()) {
-      if (const std::optional<io::Configuration> c = numeric.Of(record.cells)) {
+      if (const std::optional<Configuration> c = numeric.Of(record.cells)) {
         try {
-          out.result = io::Convert(*c, options);
+          out.result = Convert(*c, options);
           on_row(out);
           continue;
         } catch (const InputError&) {
@@ -133,10 +133,10 @@ void Run(io::CsvRecords& records, const io::FieldSource& flag_defaults, const io
     try {
       if (!record.error.empty())
         throw InputError(records.source() + ", row " + std::to_string(record.row), record.error);
-      const io::Configuration c = io::ParseConfiguration(table.RowSource(record.row, record.cells, &defaults));
+      const Configuration c = ParseConfiguration(table.RowSource(record.row, record.cells, &defaults));
       numeric.Offer(record.cells, c);
       try {
-        out.result = io::Convert(c, options);
+        out.result = Convert(c, options);
       } catch (const InputError& e) {
         throw InputError(records.source() + ", row " + std::to_string(record.row) + ": " + e.quantity(), e.rule());
       }
@@ -150,17 +150,17 @@ void Run(io::CsvRecords& records, const io::FieldSource& flag_defaults, const io
 
 }  // namespace
 
-void ConvertBatch(const std::string& path, const io::FieldSource& defaults, const io::ConversionOptions& options,
+void ConvertBatch(const std::string& path, const FieldSource& defaults, const ConversionOptions& options,
                   const std::function<void(const BatchHeader&)>& on_header,
                   const std::function<void(const ConvertedRow&)>& on_row) {
-  io::CsvRecords records(path);
+  CsvRecords records(path);
   Run(records, defaults, options, on_header, on_row);
 }
 
-void ConvertBatch(std::istream& in, const std::string& source, const io::FieldSource& defaults,
-                  const io::ConversionOptions& options, const std::function<void(const BatchHeader&)>& on_header,
+void ConvertBatch(std::istream& in, const std::string& source, const FieldSource& defaults,
+                  const ConversionOptions& options, const std::function<void(const BatchHeader&)>& on_header,
                   const std::function<void(const ConvertedRow&)>& on_row) {
-  io::CsvRecords records(in, source);
+  CsvRecords records(in, source);
   Run(records, defaults, options, on_header, on_row);
 }
 

@@ -27,7 +27,7 @@ namespace uphill {
 // One input row's outcome: a result, or the one-line error it got.
 struct ConvertedRow {
   int row = 0;  // spreadsheet row (header = 1); 0 for a configuration from flags
-  std::optional<io::ConversionResult> result;
+  std::optional<ConversionResult> result;
   std::string error;
 };
 
@@ -38,11 +38,11 @@ struct BatchHeader {
 
 // Throws InputError for the input as a whole (cannot be read, empty, an unknown column, a
 // header-only file). on_header runs once, after the header is checked and before the first row.
-void ConvertBatch(const std::string& path, const io::FieldSource& defaults, const io::ConversionOptions& options,
+void ConvertBatch(const std::string& path, const FieldSource& defaults, const ConversionOptions& options,
                   const std::function<void(const BatchHeader&)>& on_header,
                   const std::function<void(const ConvertedRow&)>& on_row);
-void ConvertBatch(std::istream& in, const std::string& source, const io::FieldSource& defaults,
-                  const io::ConversionOptions& options, const std::function<void(const BatchHeader&)>& on_header,
+void ConvertBatch(std::istream& in, const std::string& source, const FieldSource& defaults,
+                  const ConversionOptions& options, const std::function<void(const BatchHeader&)>& on_header,
                   const std::function<void(const ConvertedRow&)>& on_row);
 
 }  // namespace uphill

@@ -228,7 +228,7 @@ void RunMotionBenchmark(const MotionBenchmarkOptions& f, std::ostream& out) {
   }
   plot += "\n";
   fs::create_directories(f.out);
-  report::RenderFigure({"work_precision_motion", "Work-precision of the motion methods",
+  RenderFigure({"work_precision_motion", "Work-precision of the motion methods",
                         "Time per 200-point trajectory against the largest relative error (spheroid 20x32 mm, "
                         "theta 1 deg, alpha 30 deg, release at 1.05 X).",
                         data, plot},

@@ -141,7 +141,7 @@ void WriteSection(const std::filesystem::path& path, const Section& section) {
       text += "\n" + fresh;
     }
   }
-  io::WriteFileAtomically(path.string(), text);
+  WriteFileAtomically(path.string(), text);
 }
 
 std::filesystem::path DocumentPath(const std::string& doc, bool disabled, std::string* why) {

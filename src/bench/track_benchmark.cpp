@@ -23,7 +23,6 @@ namespace uphill::bench {
 namespace {
 
 namespace fs = std::filesystem;
-using namespace uphill::vision;
 
 // Bump when the renderer or the clip settings change, so that cached clips are not reused.
 constexpr const char* kClipVersion = "v3";

@@ -11,11 +11,12 @@
 #include "model/input_error.hpp"
 #include "model/spheroid_on_line_rails.hpp"
 #include "model/spheroid_on_rods.hpp"
+#include "model/number_text.hpp"
 
 namespace uphill {
 namespace {
 
-using namespace fit_internal;
+using namespace internal;
 
 // The closed-form geometry of one row: a spheroid (a, b) on line rails - also a sphere on line
 // rails (a = b = R) and a sphere on rods (a = b = R + r on the rod axes), exactly as Scene builds
@@ -97,14 +98,14 @@ void Validate(const FrictionData& data, std::size_t parameters) {
   for (std::size_t i = 0; i < n; ++i) {
     if (!data.u_model.empty() && !(std::isfinite(data.u_model[i]) && data.u_model[i] >= 0.0))
       throw InputError("u_model[" + std::to_string(i) + "]",
-                       "must be finite and >= 0 (got " + Num(data.u_model[i]) + ")");
+                       "must be finite and >= 0 (got " + ExactText(data.u_model[i]) + ")");
     if (!std::isfinite(data.y[i]))
       throw InputError("Y[" + std::to_string(i) + "]",
-                       "must be finite (got " + Num(data.y[i]) + ")");
+                       "must be finite (got " + ExactText(data.y[i]) + ")");
     if (!data.u_y.empty() && !(std::isfinite(data.u_y[i]) && data.u_y[i] > 0.0))
       throw InputError(
           "u(Y)[" + std::to_string(i) + "]",
-          "must be finite and > 0 for the friction fit (got " + Num(data.u_y[i]) + ")");
+          "must be finite and > 0 for the friction fit (got " + ExactText(data.u_y[i]) + ")");
   }
 }
 
@@ -187,7 +188,7 @@ FitReport FitFrictionImpl(const FrictionData& data, const FrictionOptions& optio
   if (options.mu_start) {
     mu0 = *options.mu_start;
     if (!(std::isfinite(mu0) && mu0 >= 0.0))
-      throw InputError("mu start", "must be finite and >= 0 (got " + Num(mu0) + ")");
+      throw InputError("mu start", "must be finite and >= 0 (got " + ExactText(mu0) + ")");
   } else if (fit.seed_with_closed_form) {
     mu0 = MuFromInversion(rows);
   }
@@ -197,8 +198,8 @@ FitReport FitFrictionImpl(const FrictionData& data, const FrictionOptions& optio
   for (std::size_t i = 0; i < n; ++i) {
     const double reference = data.scenes[i].Rest(mu0)->high;
     if (!(std::abs(x0[i] - reference) <= 1e-13 * std::abs(reference)))
-      throw std::logic_error("friction fit: row " + std::to_string(i) + " x_rest = " + Num(x0[i]) +
-                             " differs from Scene::Rest " + Num(reference));
+      throw std::logic_error("friction fit: row " + std::to_string(i) + " x_rest = " + ExactText(x0[i]) +
+                             " differs from Scene::Rest " + ExactText(reference));
   }
   std::array<double, P> theta{};
   theta[0] = mu0;

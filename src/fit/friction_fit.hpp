@@ -28,7 +28,7 @@
 // the effective variance σ_i² = u(Y_i)² + u_model,i² (the friction analogue of York's
 // u(Y)² + k²u(X)² with k = 1: Y = x_rest(μ) has unit slope in x_rest). Without it, χ²/ν
 // of lab data is inflated by the model's scatter and σ_μ is too small.
-// u_model is supplied by the caller and held fixed (independent of μ). report::AnalyseExperiment
+// u_model is supplied by the caller and held fixed (independent of μ). AnalyseExperiment
 // passes u(X) = u(x_eq) from the first-order propagation of the inputs' uncertainties
 // (model/propagation.hpp): an approximation of u(x_rest(μ̂)), good because ∂x_rest/∂input ≈
 // ∂x_eq/∂input while μ is small against tanθ (x_rest depends on μ only through

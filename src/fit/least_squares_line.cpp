@@ -16,7 +16,7 @@
 namespace uphill {
 namespace {
 
-using namespace fit_internal;
+using namespace internal;
 
 constexpr std::size_t kRows = 1024;  // per chunk of the rows' pass
 
@@ -144,7 +144,7 @@ FitReport FitLeastSquares(const LineData& data, const FitOptions& options, bool 
     // Normalised residual r_i/s, s the residual standard deviation (none for an exact fit).
     model.sigma_common = n > 2 ? std::sqrt(static_cast<double>(chi2) / static_cast<double>(n - 2)) : 0.0;
     const auto flag = [&](std::size_t i) {
-      if (fit_internal::EvaluateRow(model, threshold, i, data.x[i], data.y[i], 0.0, 0.0).outlier)
+      if (internal::EvaluateRow(model, threshold, i, data.x[i], data.y[i], 0.0, 0.0).outlier)
         report.outliers.push_back(i);
     };
     if (model.sigma_common > 0.0) {
@@ -162,7 +162,7 @@ FitReport FitLeastSquares(const LineData& data, const FitOptions& options, bool 
     report.rows.reserve(n);
     for (std::size_t i = 0; i < n; ++i)
       report.rows.push_back(
-          fit_internal::EvaluateRow(model, threshold, i, data.x[i], data.y[i], 0.0, weighted ? data.u_y[i] : 0.0));
+          internal::EvaluateRow(model, threshold, i, data.x[i], data.y[i], 0.0, weighted ? data.u_y[i] : 0.0));
   }
   report.chi2 = static_cast<double>(chi2);
   // R² = 1 − χ²/Σ w (Y − Ȳ_w)², the total from the moments (standardised units).

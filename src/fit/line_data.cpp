@@ -4,11 +4,11 @@
 
 #include "fit/internal/line_problem.hpp"
 #include "model/input_error.hpp"
+#include "model/number_text.hpp"
 
 namespace uphill {
 namespace {
 
-using fit_internal::Num;
 
 std::string At(const std::string& column, std::size_t i) {
   return column + "[" + std::to_string(i) + "]";
@@ -38,9 +38,9 @@ void RequireFinite(const std::vector<double>& v, const std::string& column) {
   if (AllWithin(v, kLargest)) return;
   for (std::size_t i = 0; i < v.size(); ++i) {
     if (!std::isfinite(v[i]))
-      throw InputError(At(column, i), "must be finite (got " + Num(v[i]) + ")");
+      throw InputError(At(column, i), "must be finite (got " + ExactText(v[i]) + ")");
     if (std::abs(v[i]) > kLargest)
-      throw InputError(At(column, i), "must be at most 1e100 in magnitude (got " + Num(v[i]) +
+      throw InputError(At(column, i), "must be at most 1e100 in magnitude (got " + ExactText(v[i]) +
                                           "): its square would overflow a double");
   }
 }
@@ -59,9 +59,9 @@ void RequireUncertainties(const std::vector<double>& u, std::size_t n, const std
     if (!ok)
       throw InputError(At(column, i), std::string("must be finite and ") +
                                           (zero_allowed ? ">= 0" : "> 0") + " for " + method +
-                                          " (got " + Num(u[i]) + ")");
+                                          " (got " + ExactText(u[i]) + ")");
     if (u[i] > kLargest || (u[i] != 0.0 && u[i] < kSmallestUncertainty))
-      throw InputError(At(column, i), "must lie in [1e-100, 1e100] (got " + Num(u[i]) +
+      throw InputError(At(column, i), "must lie in [1e-100, 1e100] (got " + ExactText(u[i]) +
                                           "): its square or inverse square would overflow a double");
   }
 }
@@ -81,7 +81,7 @@ void ValidateLineData(const LineData& data, UncertaintyUse use, const std::strin
   bool all_equal = true;
   for (std::size_t i = 1; i < n && all_equal; ++i) all_equal = data.x[i] == data.x[0];
   if (all_equal)
-    throw InputError("X", "all " + std::to_string(n) + " values are equal (" + Num(data.x[0]) +
+    throw InputError("X", "all " + std::to_string(n) + " values are equal (" + ExactText(data.x[0]) +
                               "), so the slope is undefined: vary the apparatus setting");
   switch (use) {
     case UncertaintyUse::kNone:

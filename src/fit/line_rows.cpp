@@ -11,7 +11,7 @@ LineRowResults::LineRowResults(const FitReport& fit, const LineData& data) : fit
 
 RowResult LineRowResults::operator[](std::size_t i) const {
   const LineData& d = *data_;
-  return fit_internal::EvaluateRow(fit_->row_model, fit_->outlier_threshold, i, d.x[i], d.y[i],
+  return internal::EvaluateRow(fit_->row_model, fit_->outlier_threshold, i, d.x[i], d.y[i],
                                    d.u_x.empty() ? 0.0 : d.u_x[i], d.u_y.empty() ? 0.0 : d.u_y[i]);
 }
 

@@ -10,11 +10,12 @@
 #include "fit/internal/line_problem.hpp"
 #include "fit/internal/row_model.hpp"
 #include "model/input_error.hpp"
+#include "model/number_text.hpp"
 
 namespace uphill {
 namespace {
 
-using namespace fit_internal;
+using namespace internal;
 
 constexpr double kHuberDefault = 1.345;            // 95 % efficiency at the normal distribution
 constexpr double kCauchyDefault = 2.3849;          // likewise
@@ -127,7 +128,7 @@ FitReport FitRobust(const LineData& data, const RobustOptions& options) {
   const std::size_t n = data.size();
   const bool stated = !data.u_y.empty();
   if (options.loss_scale != 0.0 && !(options.loss_scale > 0.0 && std::isfinite(options.loss_scale)))
-    throw InputError("loss scale", "must be finite and > 0, or 0 for the default (got " + Num(options.loss_scale) + ")");
+    throw InputError("loss scale", "must be finite and > 0, or 0 for the default (got " + ExactText(options.loss_scale) + ")");
   const double delta = options.loss_scale > 0.0 ? options.loss_scale
                                                  : (options.loss == RobustLoss::kHuber ? kHuberDefault : kCauchyDefault);
   const FitOptions& fit = options.fit;
@@ -195,7 +196,7 @@ FitReport FitRobust(const LineData& data, const RobustOptions& options) {
     if (!settled) report.notes.push_back("the robust scale did not settle in 50 rounds (last sigma used)");
     if (scale_from_ssr)
       report.notes.push_back("more than half the rows lie on the line (MAD = 0): the robust scale is the residual SD");
-    report.notes.push_back("robust scale sigma = 1.4826 MAD of the robust residuals = " + Num(sigma * view.sy));
+    report.notes.push_back("robust scale sigma = 1.4826 MAD of the robust residuals = " + ExactText(sigma * view.sy));
   }
   // Cauchy's loss is not convex: it starts from Huber's solution, with Huber's scale.
   if (options.loss == RobustLoss::kCauchy || !stated) solve(options.loss, delta);
@@ -219,7 +220,7 @@ FitReport FitRobust(const LineData& data, const RobustOptions& options) {
   long double chi2 = 0;
   if (fit.keep_rows) report.rows.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const RowResult row = fit_internal::EvaluateRow(model, fit.outlier_threshold, i, data.x[i], data.y[i], 0.0,
+    const RowResult row = internal::EvaluateRow(model, fit.outlier_threshold, i, data.x[i], data.y[i], 0.0,
                                                     stated ? data.u_y[i] : 0.0);
     chi2 += static_cast<long double>(row.weight) * row.normalised * row.normalised;
     if (std::abs(row.normalised) > delta) report.downweighted.push_back({i, row.weight, row.normalised});
@@ -228,7 +229,7 @@ FitReport FitRobust(const LineData& data, const RobustOptions& options) {
   }
   report.chi2 = static_cast<double>(chi2);
   report.notes.push_back(std::string(options.loss == RobustLoss::kHuber ? "Huber" : "Cauchy") + " loss, scale " +
-                         Num(delta) + " sigma; " + std::to_string(report.downweighted.size()) + " of " +
+                         ExactText(delta) + " sigma; " + std::to_string(report.downweighted.size()) + " of " +
                          std::to_string(n) + " rows down-weighted (|r/sigma| > scale)");
   FinishReport(report, {"k", "c"}, Eigen::Vector2d(line.k, line.c), false, true);
   if (!report.solver.converged) report.notes.push_back("Ceres: " + report.solver.termination);

@@ -14,7 +14,7 @@
 namespace uphill {
 namespace {
 
-using namespace fit_internal;
+using namespace internal;
 
 // York's criterion in standardised coordinates (x, y, u(X)/sx, u(Y)/sy), θ = (k, c):
 // r_i = e_i·sqrt(W_i), e_i = y_i − c − k·x_i, W_i = 1/(uy_i² + k²·ux_i²), with the analytic

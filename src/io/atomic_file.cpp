@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace uphill::io {
+namespace uphill {
 namespace {
 
 [[noreturn]] void Fail(const std::string& what, const std::string& path) {
@@ -66,4 +66,4 @@ void WriteFileAtomically(const std::string& path, std::string_view content) {
   }
 }
 
-}  // namespace uphill::io
+}  // namespace uphill

@@ -6,9 +6,9 @@
 #include <string>
 #include <string_view>
 
-namespace uphill::io {
+namespace uphill {
 
 // Throws std::runtime_error naming the path and the failing system call.
 void WriteFileAtomically(const std::string& path, std::string_view content);
 
-}  // namespace uphill::io
+}  // namespace uphill

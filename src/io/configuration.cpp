@@ -5,7 +5,7 @@
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::io {
+namespace uphill {
 namespace {
 
 struct FieldSpec {
@@ -223,4 +223,4 @@ bool SetNumericField(Configuration& c, std::string_view name, double si) {
   return true;
 }
 
-}  // namespace uphill::io
+}  // namespace uphill

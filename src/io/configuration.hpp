@@ -28,7 +28,7 @@
 #include "model/rails.hpp"
 #include "model/scene.hpp"
 
-namespace uphill::io {
+namespace uphill {
 
 struct Configuration {
   std::string label;
@@ -83,4 +83,4 @@ std::optional<Dimension> NumericFieldDimension(std::string_view name);
 // geometry is not checked here (Configuration::MakeScene does it).
 bool SetNumericField(Configuration& configuration, std::string_view name, double si);
 
-}  // namespace uphill::io
+}  // namespace uphill

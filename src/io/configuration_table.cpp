@@ -5,7 +5,7 @@
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::io {
+namespace uphill {
 
 namespace {
 
@@ -58,4 +58,4 @@ FieldSource ConfigurationTable::RowSource(int row, const std::vector<std::string
   return Source(row, cells, defaults);
 }
 
-}  // namespace uphill::io
+}  // namespace uphill

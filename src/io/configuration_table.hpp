@@ -11,7 +11,7 @@
 #include "io/configuration.hpp"
 #include "io/csv_table.hpp"
 
-namespace uphill::io {
+namespace uphill {
 
 class ConfigurationTable {
  public:
@@ -37,4 +37,4 @@ class ConfigurationTable {
   std::unordered_map<std::string, int> field_column_;  // field name -> column index
 };
 
-}  // namespace uphill::io
+}  // namespace uphill

@@ -8,7 +8,7 @@
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
 
-namespace uphill::io {
+namespace uphill {
 namespace {
 
 
@@ -147,4 +147,4 @@ nlohmann::ordered_json ToJson(const ConversionResult& r) {
   return j;
 }
 
-}  // namespace uphill::io
+}  // namespace uphill

@@ -15,7 +15,7 @@
 #include "io/configuration.hpp"
 #include "model/propagation.hpp"
 
-namespace uphill::io {
+namespace uphill {
 
 struct ConversionOptions {
   std::optional<double> mu;       // rolling-resistance coefficient for the rest band
@@ -40,4 +40,4 @@ ConversionResult Convert(const Configuration& configuration, const ConversionOpt
 
 nlohmann::ordered_json ToJson(const ConversionResult& result);
 
-}  // namespace uphill::io
+}  // namespace uphill

@@ -12,7 +12,7 @@
 #include "io/internal/utf8.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::io {
+namespace uphill {
 
 void OnQuotedField(void* data, std::size_t size, void* self) {
   static_cast<CsvRecords*>(self)->quoted_cells_.emplace_back(static_cast<const char*>(data), size);
@@ -267,4 +267,4 @@ bool CsvRecords::Next(Record* record) {
   return true;
 }
 
-}  // namespace uphill::io
+}  // namespace uphill

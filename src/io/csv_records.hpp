@@ -40,7 +40,7 @@
 #include <string_view>
 #include <vector>
 
-namespace uphill::io {
+namespace uphill {
 
 class CsvRecords {
  public:
@@ -107,4 +107,4 @@ class CsvRecords {
   friend void OnQuotedRecord(int terminator, void* self);
 };
 
-}  // namespace uphill::io
+}  // namespace uphill

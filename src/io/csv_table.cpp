@@ -5,7 +5,7 @@
 #include "io/csv_records.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::io {
+namespace uphill {
 
 int CsvTable::Column(const std::string& name) const {
   for (size_t i = 0; i < header.size(); ++i)
@@ -48,4 +48,4 @@ std::string CellContext(const CsvTable& table, int row, const std::string& colum
   return table.source + ", row " + std::to_string(row) + ", column " + column;
 }
 
-}  // namespace uphill::io
+}  // namespace uphill

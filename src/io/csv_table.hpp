@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-namespace uphill::io {
+namespace uphill {
 
 struct CsvRow {
   int row = 0;                      // spreadsheet row number (header = 1)
@@ -40,4 +40,4 @@ CsvTable ReadCsvFile(const std::string& path);
 // "file, row 3, column L_mm: " — the prefix of every message about a cell.
 std::string CellContext(const CsvTable& table, int row, const std::string& column);
 
-}  // namespace uphill::io
+}  // namespace uphill

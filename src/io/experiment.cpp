@@ -9,7 +9,7 @@
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::io {
+namespace uphill {
 namespace {
 
 using nlohmann::json;
@@ -192,4 +192,4 @@ Experiment LoadExperiment(const std::string& directory) {
   return e;
 }
 
-}  // namespace uphill::io
+}  // namespace uphill

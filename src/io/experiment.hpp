@@ -22,7 +22,7 @@
 
 #include "io/configuration.hpp"
 
-namespace uphill::io {
+namespace uphill {
 
 inline constexpr const char* kExperimentFormat = "uphill-experiment/1";
 
@@ -48,4 +48,4 @@ struct Experiment {
 // unknown format version, unknown keys or columns, a quantity given twice, or a missing Y column.
 Experiment LoadExperiment(const std::string& directory);
 
-}  // namespace uphill::io
+}  // namespace uphill

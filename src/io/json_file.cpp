@@ -4,7 +4,7 @@
 
 #include "model/input_error.hpp"
 
-namespace uphill::io {
+namespace uphill {
 
 nlohmann::json ReadJsonFile(const std::string& path) {
   std::ifstream in(path);
@@ -16,4 +16,4 @@ nlohmann::json ReadJsonFile(const std::string& path) {
   }
 }
 
-}  // namespace uphill::io
+}  // namespace uphill

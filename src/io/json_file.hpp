@@ -5,10 +5,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-namespace uphill::io {
+namespace uphill {
 
 // Throws InputError naming the path when the file cannot be opened or is not valid JSON (the
 // parser's message says where).
 nlohmann::json ReadJsonFile(const std::string& path);
 
-}  // namespace uphill::io
+}  // namespace uphill

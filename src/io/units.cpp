@@ -6,7 +6,7 @@
 
 #include "model/input_error.hpp"
 
-namespace uphill::io {
+namespace uphill {
 namespace {
 
 struct UnitEntry {
@@ -126,4 +126,4 @@ std::pair<std::string, std::string> SplitUnitSuffix(const std::string& header) {
   return {header, ""};
 }
 
-}  // namespace uphill::io
+}  // namespace uphill

@@ -16,7 +16,7 @@
 #include <string>
 #include <string_view>
 
-namespace uphill::io {
+namespace uphill {
 
 enum class Dimension { kLength, kAngle, kAcceleration, kDimensionless, kTime, kVelocity };
 
@@ -40,4 +40,4 @@ double ToUnit(double value_si, Dimension dimension, std::string_view unit);
 // of any dimension; otherwise {header, ""}.
 std::pair<std::string, std::string> SplitUnitSuffix(const std::string& header);
 
-}  // namespace uphill::io
+}  // namespace uphill

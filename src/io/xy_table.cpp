@@ -8,7 +8,7 @@
 #include "io/csv_records.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::io {
+namespace uphill {
 namespace {
 
 // Reserve the columns after this many rows, from the bytes they took.
@@ -124,4 +124,4 @@ std::string XyTable::Locate(const std::string& quantity) const {
   return source + ", row " + std::to_string(RowOf(i)) + ", column " + column;
 }
 
-}  // namespace uphill::io
+}  // namespace uphill

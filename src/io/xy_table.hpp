@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-namespace uphill::io {
+namespace uphill {
 
 using RowErrorSink = std::function<void(const std::string& message)>;
 
@@ -42,4 +42,4 @@ XyTable ReadXy(std::istream& in, const std::string& source, const RowErrorSink& 
 // Opens `path` ("-" reads stdin).
 XyTable ReadXyFile(const std::string& path, const RowErrorSink& on_row_error = {});
 
-}  // namespace uphill::io
+}  // namespace uphill

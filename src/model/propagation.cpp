@@ -27,7 +27,6 @@ constexpr int kNumInputs = kInputQuantityCount;
 constexpr int Index(InputQuantity q) { return static_cast<int>(q); }
 
 // Numbers in messages exactly as stored (as the model's own messages print them).
-std::string Num(double v) { return ExactText(v); }
 
 // ---------------------------------------------------------------------------------------------
 // The scene in a form both propagation methods read: which inputs exist, their values and u.
@@ -45,7 +44,7 @@ struct Problem {
 void RequireUncertainty(InputQuantity q, BodyKind body, double u) {
   if (!std::isfinite(u) || u < 0.0)
     throw InputError(std::string("u(") + InputName(q, body) + ")",
-                     "must be a finite number >= 0 (got " + Num(u) + ")");
+                     "must be a finite number >= 0 (got " + ExactText(u) + ")");
 }
 
 Problem MakeProblem(const UncertainRails& rails, const UncertainBody& body, Uncertain rod) {
@@ -87,7 +86,7 @@ Problem MakeProblem(const UncertainRails& rails, const UncertainBody& body, Unce
     set(InputQuantity::kRodRadius, rod);
   } else if (rod.u != 0.0) {
     throw InputError("u(r)", "must be 0 for line rails (r = 0); give r > 0 for round rods (got " +
-                                 Num(rod.u) + ")");
+                                 ExactText(rod.u) + ")");
   }
   return p;
 }
@@ -97,10 +96,10 @@ void ValidateOptions(const PropagationOptions& o) {
     throw InputError("trials", "must be 0 (first order only) or >= 100 (got " +
                                    std::to_string(o.trials) + ")");
   if (!(o.coverage > 0.0 && o.coverage < 1.0))
-    throw InputError("coverage", "must lie in (0, 1) (got " + Num(o.coverage) + ")");
+    throw InputError("coverage", "must lie in (0, 1) (got " + ExactText(o.coverage) + ")");
   if (!(o.disagreement_tolerance > 0.0) || !std::isfinite(o.disagreement_tolerance))
     throw InputError("disagreement tolerance",
-                     "must be a finite number > 0 (got " + Num(o.disagreement_tolerance) + ")");
+                     "must be a finite number > 0 (got " + ExactText(o.disagreement_tolerance) + ")");
 }
 
 // Output slots, in Outputs() order; which exist depends on the body.

@@ -4,16 +4,10 @@
 
 #include "model/input_error.hpp"
 #include "motion/motion_engine.hpp"
+#include "model/number_text.hpp"
 
 namespace uphill {
-namespace motion_detail {
-
-std::string Num(double v) {
-  std::ostringstream out;
-  out.precision(17);
-  out << v;
-  return out.str();
-}
+namespace internal {
 
 bool IsEllipse(const Scene& scene) {
   const BodyKind k = scene.body().kind;
@@ -33,9 +27,7 @@ EllipseCoordinate MakeEllipse(const Scene& scene) {
   return EllipseCoordinate(body.across, body.along, rails.tan_theta, rails.tan_half_alpha, body.InertiaFactor());
 }
 
-}  // namespace motion_detail
-
-using motion_detail::Num;
+}  // namespace internal
 
 std::string EventName(MotionEventKind kind) {
   switch (kind) {
@@ -52,18 +44,18 @@ Motion::Motion(const Scene& scene, double x0, const MotionOptions& o) {
   const double lo = scene.x_low(), hi = scene.x_max();
   const bool cone = scene.cone() != nullptr;
   if (!std::isfinite(x0) || x0 < lo || x0 > hi || (cone && x0 >= hi))
-    throw InputError("x0", "must lie on the path, in [" + Num(lo) + ", " + Num(hi) + (cone ? ")" : "]") +
-                               " m (got " + Num(x0) + " m)");
+    throw InputError("x0", "must lie on the path, in [" + ExactText(lo) + ", " + ExactText(hi) + (cone ? ")" : "]") +
+                               " m (got " + ExactText(x0) + " m)");
   if (!std::isfinite(o.v0)) throw InputError("v0", "must be a finite speed");
-  if (!(o.g > 0.0) || !std::isfinite(o.g)) throw InputError("g", "must be a finite number > 0 (got " + Num(o.g) + ")");
+  if (!(o.g > 0.0) || !std::isfinite(o.g)) throw InputError("g", "must be a finite number > 0 (got " + ExactText(o.g) + ")");
   if (!(o.mu >= 0.0) || !std::isfinite(o.mu))
-    throw InputError("mu", "must be a finite number >= 0 (got " + Num(o.mu) + ")");
+    throw InputError("mu", "must be a finite number >= 0 (got " + ExactText(o.mu) + ")");
   if (!(o.tolerance >= 1e-15 && o.tolerance <= 1e-2))
-    throw InputError("tolerance", "must lie in [1e-15, 1e-2] (got " + Num(o.tolerance) + ")");
+    throw InputError("tolerance", "must lie in [1e-15, 1e-2] (got " + ExactText(o.tolerance) + ")");
   if (o.method == MotionMethod::kQuadrature && o.mu > 0.0)
     throw InputError("mu", "rolling resistance needs the ode method (energy is not conserved)");
-  engine_ = o.method == MotionMethod::kQuadrature ? motion_detail::MakeQuadratureEngine(scene, x0, o)
-                                                  : motion_detail::MakeOdeEngine(scene, x0, o);
+  engine_ = o.method == MotionMethod::kQuadrature ? internal::MakeQuadratureEngine(scene, x0, o)
+                                                  : internal::MakeOdeEngine(scene, x0, o);
 }
 
 Motion::~Motion() = default;
@@ -80,7 +72,7 @@ MotionEvent Motion::PositionEvent(double x) const { return {MotionEventKind::kPo
 MotionSample Motion::At(double t) const { return engine_->At(t); }
 MotionSample Motion::AtPosition(double x) const {
   const double t = engine_->TimeAt(x);
-  if (!std::isfinite(t)) throw InputError("x", "the centre never reaches x = " + Num(x) + " m");
+  if (!std::isfinite(t)) throw InputError("x", "the centre never reaches x = " + ExactText(x) + " m");
   return engine_->AtPosition(x);
 }
 

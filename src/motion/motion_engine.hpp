@@ -39,10 +39,9 @@ class Motion::Engine {
   std::vector<MotionEvent> events_;
 };
 
-namespace motion_detail {
+namespace internal {
 
 inline double Inf() { return std::numeric_limits<double>::infinity(); }
-std::string Num(double v);
 
 // Sphere/spheroid path in the ellipse form (nullptr-like empty optional for cone and rods).
 bool IsEllipse(const Scene& scene);
@@ -53,5 +52,5 @@ std::unique_ptr<Motion::Engine> MakeQuadratureEngine(const Scene& scene, double 
 std::unique_ptr<Motion::Engine> MakeOdeEngine(const Scene& scene, double x0,
                                               const MotionOptions& options);
 
-}  // namespace motion_detail
+}  // namespace internal
 }  // namespace uphill

@@ -19,8 +19,9 @@
 
 #include "model/input_error.hpp"
 #include "motion/motion_engine.hpp"
+#include "model/number_text.hpp"
 
-namespace uphill::motion_detail {
+namespace uphill::internal {
 namespace {
 
 namespace odeint = boost::numeric::odeint;
@@ -83,7 +84,7 @@ class OdeEngine : public Motion::Engine {
 
   MotionSample At(double t) const override {
     if (!(t >= 0.0) || !(t <= end_time()))
-      throw InputError("t", "must lie in [0, " + Num(end_time()) + "] s, the motion (got " + Num(t) + " s)");
+      throw InputError("t", "must lie in [0, " + ExactText(end_time()) + "] s, the motion (got " + ExactText(t) + " s)");
     const double tau = t / time_scale_;
     if (steps_.empty()) return Sample(t, y_start_);
     for (const Step& s : steps_)
@@ -91,7 +92,7 @@ class OdeEngine : public Motion::Engine {
     // After the last step: at rest (μ > 0 or stays), or beyond the cone's horizon.
     if (apex_horizon_ && !rest_)
       throw InputError("t", "is beyond the integrated range (the cone is within 1e-6 of its apex at t = " +
-                                Num(steps_.back().tau1 * time_scale_) + " s)");
+                                ExactText(steps_.back().tau1 * time_scale_) + " s)");
     return Sample(t, y_end_);
   }
 
@@ -287,4 +288,4 @@ std::unique_ptr<Motion::Engine> MakeOdeEngine(const Scene& scene, double x0, con
   return std::make_unique<OdeEngine>(scene, x0, options);
 }
 
-}  // namespace uphill::motion_detail
+}  // namespace uphill::internal

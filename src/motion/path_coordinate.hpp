@@ -18,7 +18,7 @@
 
 #include "model/scene.hpp"
 
-namespace uphill::motion_detail {
+namespace uphill::internal {
 
 struct Geometry {
   double x, z;       // centre
@@ -191,4 +191,4 @@ class RodsCoordinate {
   double beta_eq_, inertia_;
 };
 
-}  // namespace uphill::motion_detail
+}  // namespace uphill::internal

@@ -17,8 +17,9 @@
 
 #include "model/input_error.hpp"
 #include "motion/motion_engine.hpp"
+#include "model/number_text.hpp"
 
-namespace uphill::motion_detail {
+namespace uphill::internal {
 namespace {
 
 enum class Mode { kCosh, kDirect, kSquare, kRods };
@@ -53,13 +54,13 @@ class QuadratureEngine : public Motion::Engine {
 
   MotionSample AtPosition(double x) const override {
     const auto hit = Locate(x);
-    if (!hit) throw InputError("x", "the centre never reaches x = " + Num(x) + " m");
+    if (!hit) throw InputError("x", "the centre never reaches x = " + ExactText(x) + " m");
     return SampleAt(legs_[hit->first], SigmaOfQ(QOfX(x)), hit->second);
   }
 
   MotionSample At(double t) const override {
     if (!(t >= 0.0) || !(t <= end_time()))
-      throw InputError("t", "must lie in [0, " + Num(end_time()) + "] s, the motion (got " + Num(t) + " s)");
+      throw InputError("t", "must lie in [0, " + ExactText(end_time()) + "] s, the motion (got " + ExactText(t) + " s)");
     if (legs_.empty()) return Rest(t);
     for (const Leg& leg : legs_) {
       if (t > leg.t_b) continue;
@@ -409,4 +410,4 @@ std::unique_ptr<Motion::Engine> MakeQuadratureEngine(const Scene& scene, double 
   return std::make_unique<QuadratureEngine>(scene, x0, options);
 }
 
-}  // namespace uphill::motion_detail
+}  // namespace uphill::internal

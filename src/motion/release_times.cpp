@@ -35,13 +35,14 @@
 #include "model/input_error.hpp"
 #include "model/libmvec_avx2.hpp"
 #include "motion/motion_engine.hpp"
+#include "model/number_text.hpp"
 
 #define UPHILL_RELEASE_AVX2 UPHILL_LIBMVEC_AVX2
 
 namespace uphill {
 namespace {
 
-using motion_detail::EllipseCoordinate;
+using internal::EllipseCoordinate;
 
 constexpr int kMinNodes = 2, kMaxNodes = 12;
 constexpr std::size_t kBlock = 64;  // panels per block (arrays of 512 B: they stay in L1)
@@ -369,22 +370,22 @@ bool ReleaseKernelAvailable(ReleaseKernel kernel) { return kernel != ReleaseKern
 
 void ReleaseTimes(const Scene& scene, double x0, std::span<const double> xs, std::span<double> t,
                   const ReleaseTimesOptions& o) {
-  using namespace motion_detail;
+  using namespace internal;
   if (!IsEllipse(scene)) throw InputError("scene", "ReleaseTimes needs a sphere or spheroid on line rails");
   if (!(x0 > *scene.x_eq() && x0 < scene.x_max()))
-    throw InputError("x0", "must lie in (X, x_max) = (" + Num(*scene.x_eq()) + ", " + Num(scene.x_max()) +
-                               ") m (got " + Num(x0) + " m)");
-  if (!(o.g > 0.0) || !std::isfinite(o.g)) throw InputError("g", "must be a finite number > 0 (got " + Num(o.g) + ")");
+    throw InputError("x0", "must lie in (X, x_max) = (" + ExactText(*scene.x_eq()) + ", " + ExactText(scene.x_max()) +
+                               ") m (got " + ExactText(x0) + " m)");
+  if (!(o.g > 0.0) || !std::isfinite(o.g)) throw InputError("g", "must be a finite number > 0 (got " + ExactText(o.g) + ")");
   if (o.nodes != 0 && (o.nodes < kMinNodes || o.nodes > kMaxNodes))
     throw InputError("nodes", "must be 0 (chosen from the tolerance) or 2 ... 12 (got " + std::to_string(o.nodes) + ")");
   if (!(o.tolerance >= 1e-15 && o.tolerance <= 1e-2))
-    throw InputError("tolerance", "must lie in [1e-15, 1e-2] (got " + Num(o.tolerance) + ")");
+    throw InputError("tolerance", "must lie in [1e-15, 1e-2] (got " + ExactText(o.tolerance) + ")");
   if (t.size() != xs.size()) throw InputError("t", "must have as many elements as xs");
   const double x_max = scene.x_max();
   double prev = x0;
   for (double x : xs) {
     if (!(x > prev && x <= x_max))
-      throw InputError("xs", "must increase strictly within (x0, x_max] (got " + Num(x) + " m after " + Num(prev) + " m)");
+      throw InputError("xs", "must increase strictly within (x0, x_max] (got " + ExactText(x) + " m after " + ExactText(prev) + " m)");
     prev = x;
   }
   if (xs.empty()) return;

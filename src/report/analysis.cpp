@@ -9,7 +9,7 @@
 #include "model/input_error.hpp"
 #include "model/propagation.hpp"
 
-namespace uphill::report {
+namespace uphill {
 namespace {
 
 std::string Mm(double metres) {
@@ -29,8 +29,8 @@ FitOutcome TryFit(const std::string& method, const std::string& title, Fit fit) 
   return outcome;
 }
 
-AnalysedRow AnalyseRow(const io::ExperimentRow& row, const AnalysisOptions& options) {
-  const io::Configuration& c = *row.configuration;
+AnalysedRow AnalyseRow(const ExperimentRow& row, const AnalysisOptions& options) {
+  const Configuration& c = *row.configuration;
   const Scene scene = c.MakeScene();
   AnalysedRow r;
   r.source = &row;
@@ -66,11 +66,11 @@ const FitOutcome* ExperimentAnalysis::Fit(const std::string& method) const {
   return nullptr;
 }
 
-ExperimentAnalysis AnalyseExperiment(const io::Experiment& experiment, const AnalysisOptions& options) {
+ExperimentAnalysis AnalyseExperiment(const Experiment& experiment, const AnalysisOptions& options) {
   ExperimentAnalysis a;
   a.experiment = &experiment;
   a.row_errors = experiment.Errors();
-  for (const io::ExperimentRow* row : experiment.UsableRows()) {
+  for (const ExperimentRow* row : experiment.UsableRows()) {
     try {
       a.rows.push_back(AnalyseRow(*row, options));
     } catch (const InputError& e) {
@@ -127,4 +127,4 @@ ExperimentAnalysis AnalyseExperiment(const io::Experiment& experiment, const Ana
   return a;
 }
 
-}  // namespace uphill::report
+}  // namespace uphill

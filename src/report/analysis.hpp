@@ -17,7 +17,7 @@
 #include "fit/friction_fit.hpp"
 #include "io/experiment.hpp"
 
-namespace uphill::report {
+namespace uphill {
 
 struct AnalysisOptions {
   std::uint64_t mc_trials = 100000;  // per row, for u(X) by Monte Carlo
@@ -26,7 +26,7 @@ struct AnalysisOptions {
 };
 
 struct AnalysedRow {
-  const io::ExperimentRow* source = nullptr;
+  const ExperimentRow* source = nullptr;
   double theta = 0, alpha = 0;              // rad
   double x_eq = 0, u_x_eq = 0, u_x_eq_mc = 0;  // m; u first order and Monte Carlo
   bool u_disagrees = false;                  // first order and MC differ by > 5 %
@@ -44,7 +44,7 @@ struct FitOutcome {
 };
 
 struct ExperimentAnalysis {
-  const io::Experiment* experiment = nullptr;
+  const Experiment* experiment = nullptr;
   std::vector<AnalysedRow> rows;            // the usable rows, in file order
   std::vector<std::string> row_errors;      // rows left out, with file, row, column, rule
   std::vector<FitOutcome> fits;             // ols, wls, york, robust, friction, in this order
@@ -55,6 +55,6 @@ struct ExperimentAnalysis {
 };
 
 // Throws InputError when no row is usable (nothing to analyse).
-ExperimentAnalysis AnalyseExperiment(const io::Experiment& experiment, const AnalysisOptions& options = {});
+ExperimentAnalysis AnalyseExperiment(const Experiment& experiment, const AnalysisOptions& options = {});
 
-}  // namespace uphill::report
+}  // namespace uphill

@@ -9,7 +9,7 @@
 #include <sstream>
 #include <tuple>
 
-namespace uphill::report {
+namespace uphill {
 namespace {
 
 std::string Num(double v) { return Printf("%.10g", v); }
@@ -159,4 +159,4 @@ std::vector<GnuplotFigure> AnalysisFigures(const ExperimentAnalysis& analysis) {
   return {YAgainstX(analysis), OffsetAgainstX(analysis), Residuals(analysis)};
 }
 
-}  // namespace uphill::report
+}  // namespace uphill

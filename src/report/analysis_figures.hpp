@@ -13,8 +13,8 @@
 #include "report/analysis.hpp"
 #include "report/gnuplot_figure.hpp"
 
-namespace uphill::report {
+namespace uphill {
 
 std::vector<GnuplotFigure> AnalysisFigures(const ExperimentAnalysis& analysis);
 
-}  // namespace uphill::report
+}  // namespace uphill

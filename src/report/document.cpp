@@ -8,7 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace uphill::report {
+namespace uphill {
 namespace {
 
 const char* kCss = R"(body{font-family:'DejaVu Sans',Helvetica,Arial,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222;line-height:1.45}
@@ -151,4 +151,4 @@ std::string RenderMarkdown(const Document& d) {
   return o.str();
 }
 
-}  // namespace uphill::report
+}  // namespace uphill

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace uphill::report {
+namespace uphill {
 
 struct Table {
   std::vector<std::string> header;
@@ -43,4 +43,4 @@ std::string Base64(const std::string& bytes);
 std::string RenderHtml(const Document& document, const std::string& directory);
 std::string RenderMarkdown(const Document& document);
 
-}  // namespace uphill::report
+}  // namespace uphill

@@ -12,7 +12,7 @@
 #include "report/gnuplot_figure.hpp"
 #include "model/number_text.hpp"
 
-namespace uphill::report {
+namespace uphill {
 namespace {
 
 std::string Mm(double m, const char* format = "%.2f") { return Printf(format, m * 1e3); }
@@ -128,7 +128,7 @@ std::string Summary(const ExperimentAnalysis& a) {
 }  // namespace
 
 Document FitDocument(const ExperimentAnalysis& a, bool with_figures) {
-  const io::Experiment& e = *a.experiment;
+  const Experiment& e = *a.experiment;
   Document d;
   d.title = "Fit report: " + (e.title.empty() ? e.directory : e.title);
   d.Paragraph(Summary(a));
@@ -209,9 +209,9 @@ void WriteFitReport(const ExperimentAnalysis& a, const std::string& directory) {
   fs::create_directories(directory);
   for (const GnuplotFigure& f : AnalysisFigures(a)) RenderFigure(f, directory);
   const Document d = FitDocument(a, true);
-  io::WriteFileAtomically((fs::path(directory) / "fit.json").string(), AnalysisToJson(a).dump(2) + "\n");
-  io::WriteFileAtomically((fs::path(directory) / "report.md").string(), RenderMarkdown(d));
-  io::WriteFileAtomically((fs::path(directory) / "report.html").string(), RenderHtml(d, directory));
+  WriteFileAtomically((fs::path(directory) / "fit.json").string(), AnalysisToJson(a).dump(2) + "\n");
+  WriteFileAtomically((fs::path(directory) / "report.md").string(), RenderMarkdown(d));
+  WriteFileAtomically((fs::path(directory) / "report.html").string(), RenderHtml(d, directory));
 }
 
-}  // namespace uphill::report
+}  // namespace uphill

@@ -8,7 +8,7 @@
 #include "report/analysis.hpp"
 #include "report/document.hpp"
 
-namespace uphill::report {
+namespace uphill {
 
 Document FitDocument(const ExperimentAnalysis& analysis, bool with_figures);
 
@@ -19,4 +19,4 @@ std::string RenderText(const Document& document);
 // (figures: gnuplot missing or failing; files: the path and the failing call).
 void WriteFitReport(const ExperimentAnalysis& analysis, const std::string& directory);
 
-}  // namespace uphill::report
+}  // namespace uphill

@@ -7,7 +7,7 @@
 
 #include "fit/line_rows.hpp"
 
-namespace uphill::report {
+namespace uphill {
 namespace {
 
 using nlohmann::ordered_json;
@@ -160,7 +160,7 @@ void WriteFitJson(std::ostream& out, const FitReport& r, const LineData& data, b
 ordered_json AnalysisToJson(const ExperimentAnalysis& a) {
   ordered_json j;
   j["format"] = kFitJsonFormat;
-  const io::Experiment& e = *a.experiment;
+  const Experiment& e = *a.experiment;
   j["experiment"] = {{"directory", e.directory}, {"title", e.title}, {"operator", e.operator_name},
                      {"date", e.date}, {"notes", e.notes}, {"metadata", e.metadata}};
   ordered_json rows = ordered_json::array();
@@ -199,4 +199,4 @@ ordered_json AnalysisToJson(const ExperimentAnalysis& a) {
   return j;
 }
 
-}  // namespace uphill::report
+}  // namespace uphill

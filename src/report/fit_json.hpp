@@ -15,7 +15,7 @@
 #include "fit/line_data.hpp"
 #include "report/analysis.hpp"
 
-namespace uphill::report {
+namespace uphill {
 
 inline constexpr const char* kFitJsonFormat = "uphill-fit/1";
 
@@ -30,4 +30,4 @@ nlohmann::ordered_json FitToJson(const FitReport& report);
 void WriteFitJson(std::ostream& out, const FitReport& report, const LineData& data, bool with_rows = true);
 nlohmann::ordered_json AnalysisToJson(const ExperimentAnalysis& analysis);
 
-}  // namespace uphill::report
+}  // namespace uphill

@@ -3,13 +3,13 @@
 //
 // Files: NAME.dat (the numbers, whitespace-separated blocks, units in the comments), NAME.gp (the
 // script), NAME.svg and NAME.png. Every file is replaced atomically: the data and script by
-// io::WriteFileAtomically, the images by letting gnuplot write temporaries that are renamed only
+// WriteFileAtomically, the images by letting gnuplot write temporaries that are renamed only
 // when gnuplot succeeds, so a failed run never leaves a half-written figure.
 #pragma once
 
 #include <string>
 
-namespace uphill::report {
+namespace uphill {
 
 struct GnuplotFigure {
   std::string name;     // file stem
@@ -23,4 +23,4 @@ struct GnuplotFigure {
 // gnuplot's complaint when gnuplot is missing (install Debian's gnuplot-nox) or fails.
 void RenderFigure(const GnuplotFigure& figure, const std::string& directory);
 
-}  // namespace uphill::report
+}  // namespace uphill

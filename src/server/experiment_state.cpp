@@ -15,7 +15,7 @@
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::server {
+namespace uphill {
 namespace {
 
 using nlohmann::json;
@@ -83,9 +83,9 @@ std::string CheckNumber(const json& j, const std::string& field) {
   return s;
 }
 
-void CheckQuantity(const json& j, const std::string& field, io::Dimension dimension) {
+void CheckQuantity(const json& j, const std::string& field, Dimension dimension) {
   const std::string s = CheckText(j, field, 64);
-  io::ParseQuantity(s, dimension, field);  // throws InputError naming the field
+  ParseQuantity(s, dimension, field);  // throws InputError naming the field
 }
 
 // RFC 4180: quote a field that holds a separator, a quote or surrounding spaces.
@@ -248,9 +248,9 @@ ordered_json ValidateMetadata(const json& j) {
   for (const auto& [key, value] : j.items())
     if (!kTopKeys.count(key)) throw InputError("experiment." + key.substr(0, 32), "unknown key");
   ordered_json out;
-  out["format"] = io::kExperimentFormat;
-  if (j.contains("format") && j.at("format") != io::kExperimentFormat)
-    throw InputError("experiment.format", std::string("must be \"") + io::kExperimentFormat + "\"");
+  out["format"] = kExperimentFormat;
+  if (j.contains("format") && j.at("format") != kExperimentFormat)
+    throw InputError("experiment.format", std::string("must be \"") + kExperimentFormat + "\"");
   for (const char* key : {"title", "operator", "date"})
     if (j.contains(key)) {
       const std::string s = CheckText(j.at(key), std::string("experiment.") + key, kMaxNoteLength);
@@ -291,8 +291,8 @@ ordered_json ValidateMetadata(const json& j) {
   }
   for (const std::string& d : dims) {
     if (!body.contains(d)) throw InputError("experiment.body." + d, "is missing (a length with its unit, e.g. \"12.7 mm\")");
-    CheckQuantity(body.at(d), "experiment.body." + d, io::Dimension::kLength);
-    if (!(io::ParseQuantity(body.at(d).get<std::string>(), io::Dimension::kLength, d) > 0))
+    CheckQuantity(body.at(d), "experiment.body." + d, Dimension::kLength);
+    if (!(ParseQuantity(body.at(d).get<std::string>(), Dimension::kLength, d) > 0))
       throw InputError("experiment.body." + d, "must be > 0");
     out_body[d] = Trim(body.at(d).get<std::string>());
   }
@@ -312,9 +312,9 @@ ordered_json ValidateMetadata(const json& j) {
         if (c != "horizontal" && c != "along-rail") throw InputError(field, "must be horizontal or along-rail");
         o[key] = c;
       } else {
-        CheckQuantity(value, field, IsAngle(key) ? io::Dimension::kAngle : io::Dimension::kLength);
-        const double v = io::ParseQuantity(value.get<std::string>(), IsAngle(key) ? io::Dimension::kAngle
-                                                                                  : io::Dimension::kLength, field);
+        CheckQuantity(value, field, IsAngle(key) ? Dimension::kAngle : Dimension::kLength);
+        const double v = ParseQuantity(value.get<std::string>(), IsAngle(key) ? Dimension::kAngle
+                                                                                  : Dimension::kLength, field);
         if (v < 0) throw InputError(field, "must be >= 0");
         o[key] = Trim(value.get<std::string>());
       }
@@ -397,21 +397,21 @@ ExperimentState LoadStateFromFiles(const std::string& directory) {
   state.metadata = Canonical(meta);
   state.exists = true;
   if (!fs::exists(csv_path)) return state;
-  const io::CsvTable table = io::ReadCsvFile(csv_path);
+  const CsvTable table = ReadCsvFile(csv_path);
   const int y = [&] {
     for (std::size_t i = 0; i < table.header.size(); ++i)
-      if (io::SplitUnitSuffix(table.header[i]).first == "Y") return static_cast<int>(i);
+      if (SplitUnitSuffix(table.header[i]).first == "Y") return static_cast<int>(i);
     return -1;
   }();
   if (y >= 0) {
-    const std::string suffix = io::SplitUnitSuffix(table.header[y]).second;
+    const std::string suffix = SplitUnitSuffix(table.header[y]).second;
     if (suffix == "mm" || suffix == "cm" || suffix == "m" || suffix == "in") state.unit = suffix;
   }
-  for (const io::CsvRow& csv_row : table.rows) {
+  for (const CsvRow& csv_row : table.rows) {
     Row r;
     r.id = state.next_id++;
     for (std::size_t i = 0; i < table.header.size() && i < csv_row.cells.size(); ++i) {
-      const auto [base, suffix] = io::SplitUnitSuffix(table.header[i]);
+      const auto [base, suffix] = SplitUnitSuffix(table.header[i]);
       const std::string& cell = csv_row.cells[i];
       if (base == "trial") r.trial = cell;
       else if (base == "series") r.series = cell;
@@ -424,8 +424,8 @@ ExperimentState LoadStateFromFiles(const std::string& directory) {
           continue;
         }
         try {  // another unit (a suffix or a unit in the cell): re-express in the state's unit
-          const double si = io::ParseQuantity(text, io::Dimension::kLength, base, suffix);
-          r.values[base] = FormatNumber(io::ToUnit(si, io::Dimension::kLength, state.unit));
+          const double si = ParseQuantity(text, Dimension::kLength, base, suffix);
+          r.values[base] = FormatNumber(ToUnit(si, Dimension::kLength, state.unit));
         } catch (const InputError&) {
           r.values[base] = text;  // kept as it is: the row's check will say what is wrong
         }
@@ -436,4 +436,4 @@ ExperimentState LoadStateFromFiles(const std::string& directory) {
   return state;
 }
 
-}  // namespace uphill::server
+}  // namespace uphill

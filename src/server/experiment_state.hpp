@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-namespace uphill::server {
+namespace uphill {
 
 // Request limits (also the server's): a page that asks for more is not a lab notebook.
 inline constexpr std::size_t kMaxRows = 5000;
@@ -69,7 +69,7 @@ ExperimentState StateFromJson(const nlohmann::json& json);  // of a snapshot; th
 // read. Throws InputError("row.<field>", rule).
 Row ValidateRow(const nlohmann::json& json, const ExperimentState& state);
 
-// experiment.json from a request: known keys only (as io::LoadExperiment), strings with units
+// experiment.json from a request: known keys only (as LoadExperiment), strings with units
 // that parse, a body type, lengths and counts bounded. Sets "format". Throws InputError.
 nlohmann::ordered_json ValidateMetadata(const nlohmann::json& json);
 // "mm", "cm", "m" or "in". Throws InputError otherwise.
@@ -86,4 +86,4 @@ nlohmann::json ApplyOperation(ExperimentState& state, const nlohmann::json& op);
 // missing/unreadable measurements.csv header.
 ExperimentState LoadStateFromFiles(const std::string& directory);
 
-}  // namespace uphill::server
+}  // namespace uphill

@@ -15,7 +15,7 @@
 #include "io/atomic_file.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::server {
+namespace uphill {
 namespace {
 
 namespace fs = std::filesystem;
@@ -194,11 +194,11 @@ void ExperimentStore::WriteFiles() {
   const std::string csv_text = state_.MeasurementsCsv();
   // experiment.json first: recovery accepts a new experiment.json with the previous CSV.
   if (const std::string h = ContentHash(json_text); h != json_hash_) {
-    io::WriteFileAtomically((fs::path(directory_) / "experiment.json").string(), json_text);
+    WriteFileAtomically((fs::path(directory_) / "experiment.json").string(), json_text);
     json_hash_ = h;
   }
   if (const std::string h = ContentHash(csv_text); h != csv_hash_) {
-    io::WriteFileAtomically((fs::path(directory_) / "measurements.csv").string(), csv_text);
+    WriteFileAtomically((fs::path(directory_) / "measurements.csv").string(), csv_text);
     csv_hash_ = h;
   }
 }
@@ -275,4 +275,4 @@ StoreSnapshot ExperimentStore::Undo(std::int64_t version) {
   return Commit(undo_.back(), true);
 }
 
-}  // namespace uphill::server
+}  // namespace uphill

@@ -4,7 +4,7 @@
 //
 // Durability. A change is (1) appended to EXP/journal.jsonl and fsynced, then (2) applied in
 // memory, then (3) experiment.json and measurements.csv are replaced with
-// io::WriteFileAtomically (write, fsync, rename, fsync the folder). Only then does the caller
+// WriteFileAtomically (write, fsync, rename, fsync the folder). Only then does the caller
 // acknowledge it. A crash at any point leaves complete files of version N or N − 1 and a journal
 // that holds N: on start the journal is replayed and the files rewritten (data/README.md,
 // "Journal"). A torn last journal line is a change that was never acknowledged: it is cut off.
@@ -35,7 +35,7 @@
 
 #include "server/experiment_state.hpp"
 
-namespace uphill::server {
+namespace uphill {
 
 inline constexpr const char* kJournalFile = "journal.jsonl";
 inline constexpr std::size_t kMaxUndo = 500;
@@ -105,4 +105,4 @@ class ExperimentStore {
 // FNV-1a 64 of the bytes, 16 hex digits (stable across runs and platforms).
 std::string ContentHash(const std::string& bytes);
 
-}  // namespace uphill::server
+}  // namespace uphill

@@ -16,7 +16,7 @@
 // Last: it includes <resolv.h>, whose `_res` macro breaks Eigen (a parameter of that name).
 #include <httplib.h>
 
-namespace uphill::server {
+namespace uphill {
 namespace {
 
 namespace fs = std::filesystem;
@@ -263,11 +263,11 @@ struct Server::Impl {
     http.Post("/api/report", [this](const httplib::Request&, httplib::Response& res) {
       std::lock_guard lock(report_mutex);  // one report at a time; the store stays free meanwhile
       try {
-        const io::Experiment experiment = io::LoadExperiment(options.directory);
-        report::AnalysisOptions analysis_options;
+        const Experiment experiment = LoadExperiment(options.directory);
+        AnalysisOptions analysis_options;
         analysis_options.mc_trials = options.report_mc_trials;
-        const report::ExperimentAnalysis analysis = report::AnalyseExperiment(experiment, analysis_options);
-        report::WriteFitReport(analysis, ReportDirectory());
+        const ExperimentAnalysis analysis = AnalyseExperiment(experiment, analysis_options);
+        WriteFitReport(analysis, ReportDirectory());
         ordered_json files = ordered_json::array();
         std::vector<std::string> names;
         for (const auto& entry : fs::directory_iterator(ReportDirectory()))
@@ -328,4 +328,4 @@ void Server::Stop() {
 
 ExperimentStore& Server::store() { return impl_->store; }
 
-}  // namespace uphill::server
+}  // namespace uphill

@@ -31,7 +31,7 @@
 
 #include "server/experiment_store.hpp"
 
-namespace uphill::server {
+namespace uphill {
 
 struct ServerOptions {
   std::string directory;               // the experiment folder (created with the experiment)
@@ -62,4 +62,4 @@ class Server {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace uphill::server
+}  // namespace uphill

@@ -4,7 +4,7 @@
 // char arrays) and their sizes.
 #include "page_assets_data.inc"
 
-namespace uphill::server {
+namespace uphill {
 namespace {
 std::string_view View(const unsigned char* data, std::size_t size) {
   return {reinterpret_cast<const char*>(data), size};
@@ -20,4 +20,4 @@ const std::vector<PageAsset>& PageAssets() {
   return assets;
 }
 
-}  // namespace uphill::server
+}  // namespace uphill

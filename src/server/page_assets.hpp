@@ -6,7 +6,7 @@
 #include <string_view>
 #include <vector>
 
-namespace uphill::server {
+namespace uphill {
 
 struct PageAsset {
   const char* path;          // URL path, e.g. "/app.js"
@@ -16,4 +16,4 @@ struct PageAsset {
 
 const std::vector<PageAsset>& PageAssets();
 
-}  // namespace uphill::server
+}  // namespace uphill

@@ -12,7 +12,7 @@
 #include "model/input_error.hpp"
 #include "model/propagation.hpp"
 
-namespace uphill::server {
+namespace uphill {
 namespace {
 
 using nlohmann::json;
@@ -29,7 +29,7 @@ const std::map<std::string, Range> kPlausible = {
 
 std::string Format(double v, const std::string& unit) {
   char buf[64];
-  std::snprintf(buf, sizeof buf, "%.4g %s", io::ToUnit(v, io::Dimension::kLength, unit), unit.c_str());
+  std::snprintf(buf, sizeof buf, "%.4g %s", ToUnit(v, Dimension::kLength, unit), unit.c_str());
   return buf;
 }
 
@@ -45,7 +45,7 @@ std::optional<double> Si(const Row& row, const std::string& q, const std::string
   const std::string& text = row.Value(q);
   if (text.empty()) return std::nullopt;
   try {
-    return io::ParseQuantity(text, io::Dimension::kLength, q, unit);
+    return ParseQuantity(text, Dimension::kLength, q, unit);
   } catch (const InputError&) {
     return std::nullopt;
   }
@@ -97,7 +97,7 @@ std::optional<std::string> MixUp(double value, double reference, const std::stri
   if (!(reference > 0) || !(value > 0)) return std::nullopt;
   const double r = value / reference;
   const auto near = [&](double target, double factor) { return std::abs(std::log(r / target)) < std::log(factor); };
-  const double per_unit = io::UnitFactor(io::Dimension::kLength, unit);
+  const double per_unit = UnitFactor(Dimension::kLength, unit);
   if (unit != "in" && near(per_unit / kInch, 1.6))
     return "looks like inches typed in a " + unit + " field (as inches: " + Format(value / per_unit * kInch, unit) + ")";
   if (unit == "mm" && near(0.1, 1.45)) return std::string("looks like cm typed in a mm field (×10)");
@@ -105,26 +105,26 @@ std::optional<std::string> MixUp(double value, double reference, const std::stri
   return std::nullopt;
 }
 
-io::FieldSource MakeSource(const ExperimentState& state, const Row& row, const std::vector<std::string>& columns) {
+FieldSource MakeSource(const ExperimentState& state, const Row& row, const std::vector<std::string>& columns) {
   const json meta = state.metadata.is_object() ? json(state.metadata) : json::object();
   const json body = meta.value("body", json::object());
   const json apparatus = meta.value("apparatus", json::object());
   const json defaults = meta.value("uncertainties", json::object());
   const auto text = [](const json& j) { return j.is_string() ? j.get<std::string>() : j.dump(); };
-  io::FieldSource source;
-  source.lookup = [=, &row, &state](const std::string& name) -> std::optional<io::FieldSource::Field> {
-    if (name == "body") return io::FieldSource::Field{body.contains("type") ? text(body.at("type")) : "", ""};
+  FieldSource source;
+  source.lookup = [=, &row, &state](const std::string& name) -> std::optional<FieldSource::Field> {
+    if (name == "body") return FieldSource::Field{body.contains("type") ? text(body.at("type")) : "", ""};
     if (name == "L_convention")
-      return apparatus.contains(name) ? std::optional<io::FieldSource::Field>({text(apparatus.at(name)), ""})
+      return apparatus.contains(name) ? std::optional<FieldSource::Field>({text(apparatus.at(name)), ""})
                                       : std::nullopt;
     if (std::find(columns.begin(), columns.end(), name) != columns.end()) {
-      if (!row.Value(name).empty()) return io::FieldSource::Field{row.Value(name), state.unit};
-      if (name.rfind("u_", 0) != 0) return io::FieldSource::Field{"", ""};  // refused as empty
+      if (!row.Value(name).empty()) return FieldSource::Field{row.Value(name), state.unit};
+      if (name.rfind("u_", 0) != 0) return FieldSource::Field{"", ""};  // refused as empty
     }
-    if (body.contains(name)) return io::FieldSource::Field{text(body.at(name)), ""};
-    if (apparatus.contains(name)) return io::FieldSource::Field{text(apparatus.at(name)), ""};
+    if (body.contains(name)) return FieldSource::Field{text(body.at(name)), ""};
+    if (apparatus.contains(name)) return FieldSource::Field{text(apparatus.at(name)), ""};
     if (name.rfind("u_", 0) == 0 && defaults.contains(name.substr(2)))
-      return io::FieldSource::Field{text(defaults.at(name.substr(2))), ""};
+      return FieldSource::Field{text(defaults.at(name.substr(2))), ""};
     return std::nullopt;
   };
   source.context = [=](const std::string& name) -> std::string {
@@ -173,7 +173,7 @@ RowCheck Check(const Context& context, const Row& row) {
         if (const auto median = Median(it->second, stored ? v : std::nullopt)) mix = MixUp(*v, *median, state.unit);
     }
     if (!mix && !plausible && state.unit != "in" && std::string(q) != "H") {
-      const double as_inches = *v / io::UnitFactor(io::Dimension::kLength, state.unit) * kInch;
+      const double as_inches = *v / UnitFactor(Dimension::kLength, state.unit) * kInch;
       if (as_inches >= range.low && as_inches <= range.high)
         mix = "looks like inches typed in a " + state.unit + " field (as inches: " + Format(as_inches, state.unit) + ")";
     }
@@ -190,7 +190,7 @@ RowCheck Check(const Context& context, const Row& row) {
     Add(check, "implausible", "H", "H ≥ L: the rails would rise at 45° or more");
   // The model.
   try {
-    const io::Configuration c = io::ParseConfiguration(MakeSource(state, row, columns));
+    const Configuration c = ParseConfiguration(MakeSource(state, row, columns));
     PropagationOptions p;
     p.trials = 0;  // first order only: fast enough for every keystroke
     const PropagationResult r = Propagate(c.MakeUncertainRails(), c.MakeUncertainBody(), c.rod_radius, p);
@@ -206,12 +206,12 @@ RowCheck Check(const Context& context, const Row& row) {
     Add(check, "invalid", FieldOf(e), e.what(), true);
   }
   try {
-    const io::FieldSource source = MakeSource(state, row, columns);
+    const FieldSource source = MakeSource(state, row, columns);
     const auto y = source.lookup("Y");
-    check.y = io::ParseQuantity(y ? y->text : "", io::Dimension::kLength, "Y", y ? y->default_unit : "");
+    check.y = ParseQuantity(y ? y->text : "", Dimension::kLength, "Y", y ? y->default_unit : "");
     if (!(*check.y > 0)) throw InputError("Y", "must be > 0 (a position beyond O)");
     check.u_y = 0.0;
-    if (const auto uy = source.lookup("u_Y")) check.u_y = io::ParseQuantity(uy->text, io::Dimension::kLength, "u_Y", uy->default_unit);
+    if (const auto uy = source.lookup("u_Y")) check.u_y = ParseQuantity(uy->text, Dimension::kLength, "u_Y", uy->default_unit);
   } catch (const InputError& e) {
     check.y.reset();
     Add(check, "invalid", "Y", e.what(), true);
@@ -254,7 +254,7 @@ json Number(std::optional<double> v, double scale = 1.0) { return v ? json(*v * 
 RowCheck CheckRow(const ExperimentState& state, const Row& row) { return Check(MakeContext(state), row); }
 
 ordered_json ToJson(const RowCheck& check, const std::string& unit) {
-  const double to_unit = 1.0 / io::UnitFactor(io::Dimension::kLength, unit);
+  const double to_unit = 1.0 / UnitFactor(Dimension::kLength, unit);
   const double to_deg = 180.0 / M_PI;
   ordered_json j;
   j["theta_deg"] = Number(check.theta, to_deg);
@@ -274,7 +274,7 @@ ordered_json ToJson(const RowCheck& check, const std::string& unit) {
 
 ordered_json CheckAll(const ExperimentState& state) {
   const Context context = MakeContext(state);
-  const double to_unit = 1.0 / io::UnitFactor(io::Dimension::kLength, state.unit);
+  const double to_unit = 1.0 / UnitFactor(Dimension::kLength, state.unit);
   ordered_json out;
   out["checks"] = ordered_json::array();
   LineData data;
@@ -306,4 +306,4 @@ ordered_json CheckAll(const ExperimentState& state) {
   return out;
 }
 
-}  // namespace uphill::server
+}  // namespace uphill

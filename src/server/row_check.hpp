@@ -4,7 +4,7 @@
 // are only a convenience.
 //
 // Flags (code, field, message; severity "error" when the row cannot be analysed as typed):
-//   invalid            the configuration or Y cannot be made (io::ParseConfiguration's message)
+//   invalid            the configuration or Y cannot be made (ParseConfiguration's message)
 //   implausible        a value outside what the apparatus can be: L ∉ [50 mm, 5 m], H ∉ [0, 2 m]
 //                      or H ≥ L, D ∉ [3 mm, 1 m], Y ∉ (0, 5 m]
 //   unit_mixup         a value that looks typed in another unit: within a factor 1.6 of 1/25.4
@@ -29,7 +29,7 @@
 
 #include "server/experiment_state.hpp"
 
-namespace uphill::server {
+namespace uphill {
 
 struct RowFlag {
   std::string code, field, message;
@@ -56,4 +56,4 @@ nlohmann::ordered_json ToJson(const RowCheck& check, const std::string& unit);
 //    "r_squared","residual_sd"} or {"n","unavailable":reason}}; fit lengths in `unit`.
 nlohmann::ordered_json CheckAll(const ExperimentState& state);
 
-}  // namespace uphill::server
+}  // namespace uphill

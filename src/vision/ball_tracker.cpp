@@ -10,7 +10,7 @@
 
 #include "model/input_error.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 namespace {
 
 using Eigen::Vector2d;
@@ -449,4 +449,4 @@ BallObservation BallTracker::Track(const cv::Mat& frame) {
   return m.Observe(fit);
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -43,7 +43,7 @@
 #include "model/scene.hpp"
 #include "vision/camera.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 struct TrackerOptions {
   std::optional<Eigen::Vector2d> init_uv;  // raw pixel near the centre in the first frame
@@ -83,4 +83,4 @@ class BallTracker {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -11,7 +11,7 @@
 
 #include "model/input_error.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 namespace {
 
 constexpr double kDegree = std::numbers::pi / 180;
@@ -383,4 +383,4 @@ cv::Mat ChessboardTargetImage(const ChessboardTarget& target, int pixels_per_squ
   return image;
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -31,7 +31,7 @@
 #include "vision/camera.hpp"
 #include "vision/chessboard_render.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 // ---- camera ----
 
@@ -126,4 +126,4 @@ std::vector<Eigen::Vector2d> FindChessboardCorners(const cv::Mat& image, const C
 // square. Print at a scale where a square measures `target.square` (and measure it after printing).
 cv::Mat ChessboardTargetImage(const ChessboardTarget& target, int pixels_per_square);
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -11,7 +11,7 @@
 #include "io/json_file.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 namespace {
 
 using nlohmann::json;
@@ -160,7 +160,7 @@ void ValidateRotation(const Eigen::Matrix3d& r, const std::string& context) {
   if (r.determinant() < 0) throw InputError(context, "is a reflection (determinant −1), not a rotation");
 }
 
-void WriteJson(const std::string& path, const ordered_json& j) { io::WriteFileAtomically(path, j.dump(2) + "\n"); }
+void WriteJson(const std::string& path, const ordered_json& j) { WriteFileAtomically(path, j.dump(2) + "\n"); }
 
 }  // namespace
 
@@ -245,13 +245,13 @@ Eigen::Vector3d CameraCentre(const CameraPose& pose) {
 }
 
 CameraIntrinsics ReadCameraFile(const std::string& path) {
-  const json j = io::ReadJsonFile(path);
+  const json j = ReadJsonFile(path);
   CheckFormat(j, path, kCameraFormat);
   return IntrinsicsFromJson(j, path, {"format", "calibration"});
 }
 
 SceneCalibration ReadSceneFile(const std::string& path) {
-  const json j = io::ReadJsonFile(path);
+  const json j = ReadJsonFile(path);
   CheckFormat(j, path, kSceneFormat);
   CheckKeys(j, {"format", "camera", "pose", "camera_centre_m", "viewing_direction", "calibration"}, path);
   SceneCalibration scene;
@@ -314,4 +314,4 @@ void WriteSceneFile(const std::string& path, const SceneCalibration& scene,
   WriteJson(path, j);
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-namespace uphill::vision {
+namespace uphill {
 
 struct CameraIntrinsics {
   int width = 0, height = 0;              // image size, pixels
@@ -97,4 +97,4 @@ void WriteCameraFile(const std::string& path, const CameraIntrinsics& camera,
 void WriteSceneFile(const std::string& path, const SceneCalibration& scene,
                     const CalibrationSummary& summary);
 
-}  // namespace uphill::vision
+}  // namespace uphill

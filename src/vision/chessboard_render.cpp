@@ -10,7 +10,7 @@
 
 #include "model/input_error.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 namespace {
 
 constexpr double kDegree = std::numbers::pi / 180;
@@ -200,4 +200,4 @@ std::vector<CameraPose> RandomBoardPoses(const CameraIntrinsics& camera, const C
   return poses;
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -33,7 +33,7 @@
 
 #include "vision/camera.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 struct ChessboardTarget {
   int cols = 9, rows = 6;  // inner corners across, down
@@ -101,4 +101,4 @@ std::vector<CameraPose> RandomBoardPoses(const CameraIntrinsics& camera, const C
                                          int count, std::uint32_t seed,
                                          const RandomBoardPoseOptions& options = {});
 
-}  // namespace uphill::vision
+}  // namespace uphill

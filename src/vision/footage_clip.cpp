@@ -28,7 +28,7 @@
 #include "motion/motion.hpp"
 #include "vision/lens_remap.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 namespace {
 
 namespace fs = std::filesystem;
@@ -541,7 +541,7 @@ std::string FileName(const char* pattern, int k) {
 void WritePng(const fs::path& path, const cv::Mat& image) {
   std::vector<unsigned char> bytes;
   if (!cv::imencode(".png", image, bytes)) throw std::runtime_error(path.string() + ": cannot encode PNG");
-  io::WriteFileAtomically(path.string(), std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  WriteFileAtomically(path.string(), std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 double ProcessCpuSeconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
@@ -568,7 +568,7 @@ std::vector<std::string> EnsureBoards(const FootageCondition& c, const fs::path&
     cv::merge(channels, lit);
     WritePng(paths[k], c.sensor.ToFrame8(lit, 1000000 + k));
   }
-  io::WriteFileAtomically((folder / "complete").string(), DescribeBoards(c).dump(2) + "\n");
+  WriteFileAtomically((folder / "complete").string(), DescribeBoards(c).dump(2) + "\n");
   return paths;
 }
 
@@ -675,7 +675,7 @@ FootageFiles RenderFootage(const FootageCondition& condition, const std::string&
   files.scene_truth = (folder / "scene_truth.json").string();
   const fs::path boards_marker = root / ("boards-" + Hex(Fnv1a(DescribeBoards(condition).dump()))) / "complete";
   if (!fresh && fs::exists(folder / "condition.json") && (condition.boards == 0 || fs::exists(boards_marker))) {
-    const nlohmann::json saved = io::ReadJsonFile((folder / "condition.json").string());
+    const nlohmann::json saved = ReadJsonFile((folder / "condition.json").string());
     files.from_cache = true;
     files.render_wall_seconds = saved.value("render_wall_s", 0.0);
     files.render_cpu_seconds = saved.value("render_cpu_s", 0.0);
@@ -731,7 +731,7 @@ FootageFiles RenderFootage(const FootageCondition& condition, const std::string&
                   p.position.x() * 1e3, p.position.y() * 1e3, p.position.z() * 1e3);
     points << line;
   }
-  io::WriteFileAtomically((partial / "points.csv").string(), points.str());
+  WriteFileAtomically((partial / "points.csv").string(), points.str());
   CalibrationSummary summary;
   summary.method = "the true camera of the POV-Ray footage (src/vision/footage_clip.hpp)";
   summary.verdict = "exact";
@@ -749,7 +749,7 @@ FootageFiles RenderFootage(const FootageCondition& condition, const std::string&
   description["render_cpu_s"] = files.render_cpu_seconds;
   description["povray_runs"] = files.povray_runs;
   description["subframes"] = files.subframes;
-  io::WriteFileAtomically((partial / "condition.json").string(), description.dump(2) + "\n");
+  WriteFileAtomically((partial / "condition.json").string(), description.dump(2) + "\n");
   std::error_code ec;
   fs::remove_all(folder, ec);
   fs::rename(partial, folder);
@@ -757,7 +757,7 @@ FootageFiles RenderFootage(const FootageCondition& condition, const std::string&
 }
 
 std::vector<ClipTruth> ReadFootageTruth(const std::string& path) {
-  const io::CsvTable table = io::ReadCsvFile(path);
+  const CsvTable table = ReadCsvFile(path);
   const char* names[] = {"frame", "t", "x", "z", "u", "v", "visibility"};
   int col[7];
   for (int i = 0; i < 7; ++i) {
@@ -765,11 +765,11 @@ std::vector<ClipTruth> ReadFootageTruth(const std::string& path) {
     if (col[i] < 0) throw InputError(path, std::string("has no column ") + names[i]);
   }
   std::vector<ClipTruth> out;
-  for (const io::CsvRow& row : table.rows) {
+  for (const CsvRow& row : table.rows) {
     if (!row.error.empty()) throw InputError(path + ", row " + std::to_string(row.row), row.error);
     auto number = [&](int i) {
-      const std::string context = io::CellContext(table, row.row, names[i]);
-      return io::ParseQuantity(row.cells[col[i]], io::Dimension::kDimensionless, context);
+      const std::string context = CellContext(table, row.row, names[i]);
+      return ParseQuantity(row.cells[col[i]], Dimension::kDimensionless, context);
     };
     ClipTruth t;
     t.frame = static_cast<int>(number(0));
@@ -784,4 +784,4 @@ std::vector<ClipTruth> ReadFootageTruth(const std::string& path) {
   return out;
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

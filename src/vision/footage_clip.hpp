@@ -63,7 +63,7 @@
 #include "vision/synthetic_clip.hpp"
 #include "vision/video_encoder.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 // Things that go wrong in a lab clip (the tracker must notice them, not invent positions).
 struct FootageEvents {
@@ -140,4 +140,4 @@ struct ApparatusPoint {
 };
 std::vector<ApparatusPoint> FootageApparatusPoints(const FootageCondition& condition);
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -5,7 +5,7 @@
 
 #include "model/input_error.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 namespace {
 
 using Eigen::Vector3d;
@@ -196,4 +196,4 @@ std::string FootageSceneFlags(const FootageCondition& c) {
   return out + text;
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

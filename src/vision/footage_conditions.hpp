@@ -40,7 +40,7 @@
 
 #include "vision/footage_clip.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 // What the benchmark expects of a condition: a track to score, or bad input to be reported.
 enum class FootageExpectation { kTrack, kBadInput };
@@ -61,4 +61,4 @@ NamedFootage FootageByName(const std::string& name);
 // ("--body sphere --R 25.4mm --L 1000mm --H 100mm --D 150mm --rod-diameter 8mm").
 std::string FootageSceneFlags(const FootageCondition& condition);
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -6,7 +6,7 @@
 
 #include "model/input_error.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 LensRemap::LensRemap(const CameraIntrinsics& camera, int margin_px) : camera_(camera) {
   ValidateIntrinsics(camera, "camera");
@@ -73,4 +73,4 @@ cv::Mat LensRemap::Vignetting(double strength) const {
   return out;
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

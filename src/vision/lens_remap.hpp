@@ -21,7 +21,7 @@
 
 #include "vision/camera.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 class LensRemap {
  public:
@@ -54,4 +54,4 @@ class LensRemap {
   double max_ray_radius_ = 0;
 };
 
-}  // namespace uphill::vision
+}  // namespace uphill

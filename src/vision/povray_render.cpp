@@ -9,7 +9,7 @@
 
 #include "vision/internal/child_process.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 namespace fs = std::filesystem;
 
@@ -85,4 +85,4 @@ bool PovrayAvailable(const std::string& program) {
   return status.ok();
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-namespace uphill::vision {
+namespace uphill {
 
 struct PovrayOptions {
   // +A: supersample where neighbouring samples differ by more (linear light): the body's outline
@@ -40,4 +40,4 @@ PovrayRun RunPovray(const std::string& scene_text, cv::Size size, int frames, co
 // True when the povray program can be run (for tests and benchmarks that need it).
 bool PovrayAvailable(const std::string& program = "povray");
 
-}  // namespace uphill::vision
+}  // namespace uphill

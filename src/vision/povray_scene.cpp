@@ -7,7 +7,7 @@
 
 #include "model/input_error.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 namespace {
 
 using Eigen::Matrix3d;
@@ -242,4 +242,4 @@ std::string PovraySceneText(const Scene& scene, const FootageApparatus& apparatu
   return out.str();
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

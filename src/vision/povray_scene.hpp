@@ -45,7 +45,7 @@
 #include "vision/camera.hpp"
 #include "vision/chessboard_render.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 enum class TableCover { kWood, kCloth };
 
@@ -115,4 +115,4 @@ SoftBox FootageSoftBox(const FootageApparatus& apparatus);
 // the scene (the board's pose is relative to the camera anyway). Throws InputError as above.
 std::string PovrayBoardSceneText(const PovrayShot& shot);
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -8,7 +8,7 @@
 #include <numbers>
 #include <vector>
 
-namespace uphill::vision {
+namespace uphill {
 
 double LightModel::Gain(double t) const {
   constexpr double kTwoPi = 2 * std::numbers::pi;
@@ -78,4 +78,4 @@ cv::Mat SensorModel::ToFrame8(const cv::Mat& linear, std::uint64_t frame) const 
   return out;
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -27,7 +27,7 @@
 #include <cstdint>
 #include <opencv2/core.hpp>
 
-namespace uphill::vision {
+namespace uphill {
 
 struct ShutterTiming {
   double fps = 30;
@@ -68,4 +68,4 @@ struct SensorModel {
 double SrgbEncode(double linear);
 double SrgbDecode(double encoded);
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -12,7 +12,7 @@
 #include "io/atomic_file.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 namespace {
 
 using Eigen::Vector2d;
@@ -489,7 +489,7 @@ void WriteClipTruthCsv(const std::string& path, const std::vector<ClipTruth>& tr
       std::snprintf(line, sizeof line, "%d,%.9f,,,,,0\n", r.frame, r.t);
     out << line;
   }
-  io::WriteFileAtomically(path, out.str());
+  WriteFileAtomically(path, out.str());
 }
 
 SceneCalibration SideViewCamera(int width, int height, double target_x, double target_z) {
@@ -522,4 +522,4 @@ ClipSetup DefaultClipSetup(int width, int height) {
   return {scene, SideViewCamera(width, height, 0.5, 0.02), apparatus, x0};
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -40,7 +40,7 @@
 #include "motion/motion.hpp"
 #include "vision/camera.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 struct ClipApparatus {
   double crossbar_x = 1.0;         // horizontal distance O -> crossbar, m
@@ -124,4 +124,4 @@ cv::Mat ToFrame8(const cv::Mat& linear, double gain, double noise_sigma, cv::RNG
 // when the body is not present). Written atomically.
 void WriteClipTruthCsv(const std::string& path, const std::vector<ClipTruth>& truth);
 
-}  // namespace uphill::vision
+}  // namespace uphill

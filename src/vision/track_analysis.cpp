@@ -13,7 +13,7 @@
 #include "model/number_text.hpp"
 #include "motion/motion.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -665,4 +665,4 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
   return a;
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

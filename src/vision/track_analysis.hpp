@@ -80,7 +80,7 @@
 #include "model/scene.hpp"
 #include "vision/track_table.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 enum class TrackFitParameter { kEffectiveG, kMu };
 
@@ -149,4 +149,4 @@ struct TrackAnalysis {
 
 TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAnalysisOptions& options = {});
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -6,7 +6,7 @@
 #include "io/atomic_file.hpp"
 #include "model/number_text.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 namespace {
 
 nlohmann::json Optional(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
@@ -149,9 +149,9 @@ nlohmann::json TrackAnalysisJson(const TrackAnalysis& a) {
   return j;
 }
 
-std::vector<report::GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& a) {
-  std::vector<report::GnuplotFigure> figures;
-  report::GnuplotFigure x;
+std::vector<GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& a) {
+  std::vector<GnuplotFigure> figures;
+  GnuplotFigure x;
   x.name = "track_x_vs_t";
   x.title = "Measured x(t) against the fitted model";
   x.caption = "Each point is one video frame where the ball was found (x of its centre in the apparatus frame); "
@@ -171,7 +171,7 @@ std::vector<report::GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& a) 
   x.plot = plot.str();
   figures.push_back(x);
   if (a.fit.available) {
-    report::GnuplotFigure r;
+    GnuplotFigure r;
     r.name = "track_residuals";
     r.title = "Residuals of the model fit";
     r.caption = "Measured minus fitted x for every frame of the fit window, with the stated u_x as error bars. "
@@ -194,9 +194,9 @@ std::vector<report::GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& a) 
 
 void WriteTrackAnalysis(const TrackAnalysis& analysis, const std::string& directory) {
   std::filesystem::create_directories(directory);
-  io::WriteFileAtomically((std::filesystem::path(directory) / "track_analysis.json").string(),
+  WriteFileAtomically((std::filesystem::path(directory) / "track_analysis.json").string(),
                           TrackAnalysisJson(analysis).dump(2) + "\n");
-  for (const auto& figure : TrackAnalysisFigures(analysis)) report::RenderFigure(figure, directory);
+  for (const auto& figure : TrackAnalysisFigures(analysis)) RenderFigure(figure, directory);
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -15,13 +15,13 @@
 #include "report/gnuplot_figure.hpp"
 #include "vision/track_analysis.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 std::string TrackAnalysisTable(const TrackAnalysis& analysis);
 nlohmann::json TrackAnalysisJson(const TrackAnalysis& analysis);
-std::vector<report::GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& analysis);
+std::vector<GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& analysis);
 // Writes DIR/track_analysis.json and the figures (.dat, .gp, .svg, .png). Throws
 // std::runtime_error when a file cannot be written or gnuplot fails.
 void WriteTrackAnalysis(const TrackAnalysis& analysis, const std::string& directory);
 
-}  // namespace uphill::vision
+}  // namespace uphill

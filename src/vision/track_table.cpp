@@ -8,7 +8,7 @@
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 namespace {
 
 bool Blank(const std::string& cell) {
@@ -16,16 +16,16 @@ bool Blank(const std::string& cell) {
 }
 
 // A plain number (the format fixes the units), via the project's one number parser.
-double Number(const io::CsvTable& table, const io::CsvRow& row, int column) {
-  return io::ParseQuantity(row.cells[column], io::Dimension::kDimensionless,
-                           io::CellContext(table, row.row, table.header[column]));
+double Number(const CsvTable& table, const CsvRow& row, int column) {
+  return ParseQuantity(row.cells[column], Dimension::kDimensionless,
+                           CellContext(table, row.row, table.header[column]));
 }
 
-void Require(bool ok, const io::CsvTable& table, const io::CsvRow& row, int column, const std::string& rule) {
-  if (!ok) throw InputError(io::CellContext(table, row.row, table.header[column]), rule);
+void Require(bool ok, const CsvTable& table, const CsvRow& row, int column, const std::string& rule) {
+  if (!ok) throw InputError(CellContext(table, row.row, table.header[column]), rule);
 }
 
-Track FromTable(const io::CsvTable& table) {
+Track FromTable(const CsvTable& table) {
   const auto& columns = TrackColumns();
   bool header_ok = table.header.size() >= columns.size();
   for (std::size_t c = 0; header_ok && c < columns.size(); ++c) header_ok = table.header[c] == columns[c];
@@ -35,7 +35,7 @@ Track FromTable(const io::CsvTable& table) {
   enum { kFrame, kT, kU, kV, kRadius, kX, kZ, kQuality };
   Track track;
   track.source = table.source;
-  for (const io::CsvRow& row : table.rows) {
+  for (const CsvRow& row : table.rows) {
     if (!row.error.empty()) throw InputError(table.source + ", row " + std::to_string(row.row), row.error);
     TrackFrame f;
     f.row = row.row;
@@ -90,8 +90,8 @@ std::size_t Track::found_count() const {
   return static_cast<std::size_t>(std::count_if(frames.begin(), frames.end(), [](const TrackFrame& f) { return f.found; }));
 }
 
-Track ReadTrack(std::istream& in, const std::string& source) { return FromTable(io::ReadCsv(in, source)); }
+Track ReadTrack(std::istream& in, const std::string& source) { return FromTable(ReadCsv(in, source)); }
 
-Track ReadTrackFile(const std::string& path) { return FromTable(io::ReadCsvFile(path)); }
+Track ReadTrackFile(const std::string& path) { return FromTable(ReadCsvFile(path)); }
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-namespace uphill::vision {
+namespace uphill {
 
 struct TrackFrame {
   int row = 0;         // spreadsheet row of the CSV (header = 1), for messages
@@ -50,4 +50,4 @@ Track ReadTrack(std::istream& in, const std::string& source);
 // Opens `path` ("-" reads stdin); InputError naming the file when it cannot be read.
 Track ReadTrackFile(const std::string& path);
 
-}  // namespace uphill::vision
+}  // namespace uphill

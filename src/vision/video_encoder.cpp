@@ -6,7 +6,7 @@
 
 #include "vision/internal/child_process.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 namespace fs = std::filesystem;
 
@@ -102,4 +102,4 @@ void VideoEncoder::Finish() {
   fs::remove(m.log, ec);
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -18,7 +18,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 
-namespace uphill::vision {
+namespace uphill {
 
 enum class VideoCodec { kH264, kH265, kFfv1 };
 
@@ -56,4 +56,4 @@ class VideoEncoder {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace uphill::vision
+}  // namespace uphill

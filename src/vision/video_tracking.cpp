@@ -14,7 +14,7 @@
 #include "io/atomic_file.hpp"
 #include "model/input_error.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 namespace {
 
 double ThreadCpuSeconds() {
@@ -161,8 +161,8 @@ void WriteTrack(const std::string& csv_path, const TrackResult& result, const Tr
   std::error_code ec;
   if (!folder.empty()) std::filesystem::create_directories(folder, ec);
   if (ec) throw std::runtime_error(folder.string() + ": cannot create the folder: " + ec.message());
-  io::WriteFileAtomically(csv_path, csv.str());
-  io::WriteFileAtomically(csv_path + ".json", side.dump(2) + "\n");
+  WriteFileAtomically(csv_path, csv.str());
+  WriteFileAtomically(csv_path + ".json", side.dump(2) + "\n");
 }
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -20,7 +20,7 @@
 
 #include "vision/ball_tracker.hpp"
 
-namespace uphill::vision {
+namespace uphill {
 
 struct TrackRow {
   int frame = 0;
@@ -60,4 +60,4 @@ struct TrackSources {
 // atomically. Throws std::runtime_error when a file cannot be written.
 void WriteTrack(const std::string& csv_path, const TrackResult& result, const TrackSources& sources);
 
-}  // namespace uphill::vision
+}  // namespace uphill

@@ -1,6 +1,6 @@
-// Fuzz target: io::ReadCsv followed by what `uphill convert --batch` does with the table
+// Fuzz target: ReadCsv followed by what `uphill convert --batch` does with the table
 // (tools/uphill/convert_command.cpp, ConvertBatch, without command-line defaults): the column
-// check of io::ConfigurationTable, io::ParseConfiguration per row, io::Convert (first-order
+// check of ConfigurationTable, ParseConfiguration per row, Convert (first-order
 // uncertainties only: Monte Carlo trials = 0), a point on the path, and the JSON output.
 // Only uphill::InputError may escape a step; anything else (a crash, a sanitizer report, another
 // exception) is a bug.
@@ -20,26 +20,26 @@ namespace {
 
 using namespace uphill;
 
-void ConvertRow(const io::ConfigurationTable& configurations, const io::CsvRow& row) {
+void ConvertRow(const ConfigurationTable& configurations, const CsvRow& row) {
   if (!row.error.empty()) return;
-  const io::Configuration c = io::ParseConfiguration(configurations.RowSource(row));
-  io::ConversionOptions options;
+  const Configuration c = ParseConfiguration(configurations.RowSource(row));
+  ConversionOptions options;
   options.mu = 0.01;
   options.propagation.trials = 0;  // first order only: Monte Carlo is the model's, not the reader's
-  const io::ConversionResult r = io::Convert(c, options);
-  (void)io::ToJson(r).dump();
+  const ConversionResult r = Convert(c, options);
+  (void)ToJson(r).dump();
   // A point halfway along the path, as --at-x would ask for.
   options.mu.reset();
   options.at_x = {0.5 * (r.scene.x_low() + r.scene.x_max())};
-  (void)io::ToJson(io::Convert(c, options)).dump();
+  (void)ToJson(Convert(c, options)).dump();
 }
 
 void Run(const std::string& text) {
   std::istringstream in(text);
-  const io::CsvTable table = io::ReadCsv(in, "fuzz.csv");
-  const io::ConfigurationTable configurations(table);
+  const CsvTable table = ReadCsv(in, "fuzz.csv");
+  const ConfigurationTable configurations(table);
   size_t converted = 0;
-  for (const io::CsvRow& row : table.rows) {
+  for (const CsvRow& row : table.rows) {
     if (++converted > 32) break;  // enough rows to mix good and bad ones; keeps runs fast
     try {
       ConvertRow(configurations, row);

@@ -1,5 +1,5 @@
-// Fuzz target: io::LoadExperiment (experiment.json + measurements.csv, data/README.md) and, when
-// rows are usable, report::AnalyseExperiment without Monte Carlo (mc_trials = 0) and its JSON
+// Fuzz target: LoadExperiment (experiment.json + measurements.csv, data/README.md) and, when
+// rows are usable, AnalyseExperiment without Monte Carlo (mc_trials = 0) and its JSON
 // (what `uphill fit EXP --json` prints). Input: experiment.json, a NUL byte, measurements.csv
 // (no NUL: measurements.csv is absent). The files go to a per-process temporary folder.
 // Only uphill::InputError may escape; anything else (a crash, a sanitizer report, another
@@ -43,12 +43,12 @@ void Write(const fs::path& path, std::string_view text) {
 // Loads (and analyses) the folder. Runs on a thread with a small stack (see below).
 void* LoadAndAnalyse(void*) {
   try {
-    const io::Experiment experiment = io::LoadExperiment(Folder().string());
+    const Experiment experiment = LoadExperiment(Folder().string());
     if (experiment.UsableRows().empty() || experiment.UsableRows().size() > 12) return nullptr;  // keeps runs fast
-    report::AnalysisOptions options;
+    AnalysisOptions options;
     options.mc_trials = 0;  // first-order u(X) only: Monte Carlo is the model's, not the reader's
-    const report::ExperimentAnalysis analysis = report::AnalyseExperiment(experiment, options);
-    (void)report::AnalysisToJson(analysis).dump();
+    const ExperimentAnalysis analysis = AnalyseExperiment(experiment, options);
+    (void)AnalysisToJson(analysis).dump();
   } catch (const InputError&) {
     // The documented refusal.
   }

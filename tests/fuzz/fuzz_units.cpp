@@ -1,4 +1,4 @@
-// Fuzz target: io::ParseQuantity (units.hpp) for every dimension, with and without a default
+// Fuzz target: ParseQuantity (units.hpp) for every dimension, with and without a default
 // unit (a CSV header suffix). Input: byte 0 picks the dimension, byte 1 the default unit, the
 // rest is the text. Beyond "no crash, only InputError" it checks the documented contract: an
 // accepted value is finite, an accepted text has a plain number (one optional sign), and a bare
@@ -17,7 +17,7 @@
 
 namespace {
 
-using uphill::io::Dimension;
+using uphill::Dimension;
 
 constexpr Dimension kDimensions[] = {Dimension::kLength,        Dimension::kAngle, Dimension::kAcceleration,
                                      Dimension::kDimensionless, Dimension::kTime,  Dimension::kVelocity};
@@ -39,7 +39,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string default_unit = kDefaultUnits[data[1] % kDefaultUnitCount];
   const std::string_view text(reinterpret_cast<const char*>(data + 2), size - 2);
   try {
-    const double v = uphill::io::ParseQuantity(text, dimension, "q", default_unit);
+    const double v = uphill::ParseQuantity(text, dimension, "q", default_unit);
     if (!std::isfinite(v)) Fail("accepted a non-finite value", text);
     // No "+-5", "++5" or "-+5": at most one sign before the digits.
     const auto first = text.find_first_not_of(" \t\n\v\f\r");
@@ -51,17 +51,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       // subnormal range, where the SI value has lost digits).
       double number = 0.0;
       try {
-        number = uphill::io::ParseQuantity(text, Dimension::kDimensionless, "q");
+        number = uphill::ParseQuantity(text, Dimension::kDimensionless, "q");
       } catch (const uphill::InputError&) {
         return 0;  // the text carries its own unit
       }
-      const double back = uphill::io::ToUnit(v, dimension, default_unit);
+      const double back = uphill::ToUnit(v, dimension, default_unit);
       if (std::abs(v) > 1e-290 && !(std::abs(back - number) <= 1e-14 * std::abs(number)))
         Fail("ToUnit does not invert the default unit", text);
     }
   } catch (const uphill::InputError&) {
     // The documented refusal.
   }
-  (void)uphill::io::SplitUnitSuffix(std::string(text));
+  (void)uphill::SplitUnitSuffix(std::string(text));
   return 0;
 }

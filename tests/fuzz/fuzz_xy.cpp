@@ -1,4 +1,4 @@
-// Fuzz target: io::ReadXy (the `uphill fit --xy` reader, io/xy_table.hpp) and the four line fits
+// Fuzz target: ReadXy (the `uphill fit --xy` reader, io/xy_table.hpp) and the four line fits
 // that `uphill fit --xy --method ols|wls|york|robust` runs on what it read. Only uphill::InputError
 // may escape; anything else (a crash, a sanitizer report, another exception) is a bug.
 #include <cmath>
@@ -31,9 +31,9 @@ void TryFit(FitFunction fit) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::istringstream in(std::string(reinterpret_cast<const char*>(data), size));
-  io::XyTable table;
+  XyTable table;
   try {
-    table = io::ReadXy(in, "fuzz.csv");
+    table = ReadXy(in, "fuzz.csv");
   } catch (const InputError&) {
     return 0;
   }

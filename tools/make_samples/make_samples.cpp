@@ -65,7 +65,7 @@ void Write(const std::string& dir, const std::string& title, const std::string& 
     }
   }
   nlohmann::ordered_json meta;
-  meta["format"] = uphill::io::kExperimentFormat;
+  meta["format"] = uphill::kExperimentFormat;
   meta["title"] = title;
   meta["operator"] = "synthetic (tools/make_samples)";
   meta["date"] = "2026-11-21";
@@ -80,10 +80,10 @@ void Write(const std::string& dir, const std::string& title, const std::string& 
   meta["body"] = {{"type", "spheroid"}, {"a", "15.875 mm"}, {"b", "25.4 mm"}};
   meta["apparatus"] = {{"H", "300 mm"}, {"L_convention", "horizontal"}};
   meta["uncertainties"] = {{"L", "1 mm"}, {"H", "0.5 mm"}, {"D", "0.2 mm"}, {"Y", "0.5 mm"}};
-  uphill::io::WriteFileAtomically(dir + "/experiment.json", meta.dump(2) + "\n");
-  uphill::io::WriteFileAtomically(dir + "/measurements.csv", csv.str());
+  uphill::WriteFileAtomically(dir + "/experiment.json", meta.dump(2) + "\n");
+  uphill::WriteFileAtomically(dir + "/measurements.csv", csv.str());
   // Read back: the generator's output must load without a single row error.
-  const auto loaded = uphill::io::LoadExperiment(dir);
+  const auto loaded = uphill::LoadExperiment(dir);
   if (!loaded.Errors().empty()) throw std::runtime_error(loaded.Errors().front());
   std::cout << "wrote " << dir << " (" << loaded.rows.size() << " trials)\n";
 }

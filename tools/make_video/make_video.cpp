@@ -21,7 +21,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace uphill;
-using namespace uphill::vision;
 
 struct Flags {
   std::string out;

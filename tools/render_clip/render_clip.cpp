@@ -15,7 +15,7 @@
 
 namespace {
 
-using namespace uphill::vision;
+using namespace uphill;
 
 struct Flags {
   std::string condition, cache;

@@ -28,28 +28,28 @@ struct AnalyseTrackFlags {
 
 #if UPHILL_VISION_PROGRAM
 void Run(const AnalyseTrackFlags& f) {
-  const Scene scene = io::ParseConfiguration(FlagSource(f.scene)).MakeScene();
-  vision::TrackAnalysisOptions o;
-  o.g = io::ParseQuantity(f.g, io::Dimension::kAcceleration, "--g");
+  const Scene scene = ParseConfiguration(FlagSource(f.scene)).MakeScene();
+  TrackAnalysisOptions o;
+  o.g = ParseQuantity(f.g, Dimension::kAcceleration, "--g");
   if (!(o.g > 0.0)) throw InputError("--g", "must be > 0");
-  o.u_x = io::ParseQuantity(f.u_x, io::Dimension::kLength, "--u-x");
+  o.u_x = ParseQuantity(f.u_x, Dimension::kLength, "--u-x");
   if (!(o.u_x > 0.0)) throw InputError("--u-x", "must be > 0 (the standard uncertainty of a tracked position)");
   if (f.fit == "g") {
-    o.fit = vision::TrackFitParameter::kEffectiveG;
+    o.fit = TrackFitParameter::kEffectiveG;
   } else if (f.fit == "mu") {
-    o.fit = vision::TrackFitParameter::kMu;
+    o.fit = TrackFitParameter::kMu;
   } else {
     throw InputError("--fit", "must be g (an effective g) or mu (rolling resistance), got '" + f.fit + "'");
   }
-  const vision::Track track = vision::ReadTrackFile(f.track);
-  const vision::TrackAnalysis analysis = vision::AnalyseTrack(track, scene, o);
+  const Track track = ReadTrackFile(f.track);
+  const TrackAnalysis analysis = AnalyseTrack(track, scene, o);
   if (f.json) {
-    std::cout << vision::TrackAnalysisJson(analysis).dump(2) << "\n";
+    std::cout << TrackAnalysisJson(analysis).dump(2) << "\n";
   } else {
-    std::cout << vision::TrackAnalysisTable(analysis);
+    std::cout << TrackAnalysisTable(analysis);
   }
   if (!f.output.empty()) {
-    vision::WriteTrackAnalysis(analysis, f.output);
+    WriteTrackAnalysis(analysis, f.output);
     if (!f.json) std::cout << "wrote " << f.output << "/track_analysis.json and the figures track_x_vs_t"
                            << (analysis.fit.available ? ", track_residuals" : "") << " (.svg, .png, .gp, .dat)\n";
   }

@@ -55,7 +55,6 @@ void AddTargetFlags(CLI::App* cmd, TargetFlags* f, bool square_required) {
 
 #if UPHILL_VISION_PROGRAM
 
-using vision::ChessboardTarget;
 
 std::string Num(double v, int precision = 6) {
   std::ostringstream out;
@@ -76,8 +75,8 @@ void Row(const std::string& name, const std::string& value) {
 
 ChessboardTarget Target(const TargetFlags& f) {
   if (f.square.empty()) throw InputError("--square", "is required (the side of one square, with unit, e.g. 20mm)");
-  ChessboardTarget t{f.cols, f.rows, io::ParseQuantity(f.square, io::Dimension::kLength, "--square")};
-  vision::ValidateTarget(t);
+  ChessboardTarget t{f.cols, f.rows, ParseQuantity(f.square, Dimension::kLength, "--square")};
+  ValidateTarget(t);
   return t;
 }
 
@@ -91,10 +90,10 @@ void PrintVerdict(const std::string& verdict, const std::vector<std::string>& re
 void RunCamera(const CalibrateFlags& f) {
   const ChessboardTarget target = Target(f.target);
   if (f.images.empty()) throw InputError("IMAGES", "give the chessboard views (10 to 20 image files)");
-  vision::CameraCalibrationOptions options;
+  CameraCalibrationOptions options;
   options.fit_k3 = f.fit_k3;
-  const vision::CameraCalibration c = vision::CalibrateCameraFromFiles(f.images, target, options);
-  const vision::CameraIntrinsics& k = c.camera;
+  const CameraCalibration c = CalibrateCameraFromFiles(f.images, target, options);
+  const CameraIntrinsics& k = c.camera;
   std::cout << "camera calibration: " << c.views_used << " of " << c.views.size() << " views used, chessboard "
             << target.cols << "×" << target.rows << " inner corners, " << Num(target.square * 1000) << " mm squares\n";
   Row("image size", std::to_string(k.width) + " × " + std::to_string(k.height) + " px");
@@ -116,7 +115,7 @@ void RunCamera(const CalibrateFlags& f) {
       std::cout << "    " << v.name << ": rejected, " << v.rejected_because << "\n";
   }
   PrintVerdict(c.verdict, c.reasons);
-  vision::WriteCameraFile(f.output, k, c.Summary(target));
+  WriteCameraFile(f.output, k, c.Summary(target));
   std::cout << "wrote " << f.output << "\n";
 }
 
@@ -125,44 +124,44 @@ void RunCamera(const CalibrateFlags& f) {
 // POINTS.csv: u, v in pixels (columns `u`, `v` or `u_px`, `v_px`), x, y, z in the apparatus
 // frame with a length unit in the header (`x_mm`) or in every cell (`x` = "120mm"); optional
 // `name` (used in messages) and `note` (ignored).
-std::vector<vision::ScenePoint> ReadPoints(const std::string& path) {
-  const io::CsvTable table = io::ReadCsvFile(path);
+std::vector<ScenePoint> ReadPoints(const std::string& path) {
+  const CsvTable table = ReadCsvFile(path);
   int u = -1, v = -1, xyz[3] = {-1, -1, -1}, name = -1;
   std::string xyz_unit[3];
   for (size_t i = 0; i < table.header.size(); ++i) {
     const std::string& h = table.header[i];
     const int column = static_cast<int>(i);
-    const auto [stem, unit] = io::SplitUnitSuffix(h);
+    const auto [stem, unit] = SplitUnitSuffix(h);
     if (h == "u" || h == "u_px") {
       u = column;
     } else if (h == "v" || h == "v_px") {
       v = column;
     } else if ((stem == "x" || stem == "y" || stem == "z") &&
-               (unit.empty() || io::UnitFactor(io::Dimension::kLength, unit) > 0)) {
+               (unit.empty() || UnitFactor(Dimension::kLength, unit) > 0)) {
       xyz[stem[0] - 'x'] = column;
       xyz_unit[stem[0] - 'x'] = unit;
     } else if (h == "name") {
       name = column;
     } else if (h != "note") {
-      throw InputError(io::CellContext(table, 1, h),
+      throw InputError(CellContext(table, 1, h),
                        "unknown column (expected u, v in pixels, x, y, z with a length unit as in x_mm, "
                        "and optionally name, note)");
     }
   }
   if (u < 0 || v < 0 || xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0)
     throw InputError(table.source + ", row 1", "the header must have the columns u, v, x, y, z (e.g. u,v,x_mm,y_mm,z_mm)");
-  std::vector<vision::ScenePoint> points;
-  for (const io::CsvRow& row : table.rows) {
+  std::vector<ScenePoint> points;
+  for (const CsvRow& row : table.rows) {
     if (!row.error.empty()) throw InputError(table.source + ", row " + std::to_string(row.row), row.error);
-    vision::ScenePoint p;
+    ScenePoint p;
     const auto cell = [&](int column) -> const std::string& { return row.cells[column]; };
-    const auto where = [&](int column) { return io::CellContext(table, row.row, table.header[column]); };
+    const auto where = [&](int column) { return CellContext(table, row.row, table.header[column]); };
     p.label = table.source + ", row " + std::to_string(row.row);
     if (name >= 0 && !cell(name).empty()) p.label += " (" + cell(name) + ")";
-    p.pixel = {io::ParseQuantity(cell(u), io::Dimension::kDimensionless, where(u)),
-               io::ParseQuantity(cell(v), io::Dimension::kDimensionless, where(v))};
+    p.pixel = {ParseQuantity(cell(u), Dimension::kDimensionless, where(u)),
+               ParseQuantity(cell(v), Dimension::kDimensionless, where(v))};
     for (int k = 0; k < 3; ++k)
-      p.position[k] = io::ParseQuantity(cell(xyz[k]), io::Dimension::kLength, where(xyz[k]), xyz_unit[k]);
+      p.position[k] = ParseQuantity(cell(xyz[k]), Dimension::kLength, where(xyz[k]), xyz_unit[k]);
     points.push_back(p);
   }
   return points;
@@ -182,7 +181,7 @@ Eigen::Vector3d Point(const std::string& text, const std::string& flag) {
   std::vector<double> values;
   std::stringstream in(text);
   for (std::string item; std::getline(in, item, ',');)
-    values.push_back(io::ParseQuantity(item, io::Dimension::kLength, flag));
+    values.push_back(ParseQuantity(item, Dimension::kLength, flag));
   if (values.size() != 3) throw InputError(flag, "must be x,y,z with units, e.g. 350mm,50mm,0mm");
   return {values[0], values[1], values[2]};
 }
@@ -194,14 +193,14 @@ cv::Mat ReadImage(const std::string& path, const std::string& flag) {
 }
 
 void RunScene(const CalibrateFlags& f) {
-  const vision::CameraIntrinsics camera = vision::ReadCameraFile(f.camera);
-  vision::SceneCalibrationResult r;
+  const CameraIntrinsics camera = ReadCameraFile(f.camera);
+  SceneCalibrationResult r;
   if (!f.board_image.empty()) {
     if (!f.points.empty()) throw InputError("--points/--board-image", "give one of them, not both");
     if (f.board_origin.empty()) throw InputError("--board-origin", "is required with --board-image");
     const Eigen::Vector3d x = Axis(f.board_x_axis, "--board-x-axis"), y = Axis(f.board_y_axis, "--board-y-axis");
     if (x.dot(y) != 0) throw InputError("--board-x-axis/--board-y-axis", "must be perpendicular");
-    r = vision::CalibrateSceneFromChessboard(camera, {f.board_image, ReadImage(f.board_image, "--board-image")},
+    r = CalibrateSceneFromChessboard(camera, {f.board_image, ReadImage(f.board_image, "--board-image")},
                                              Target(f.target), Point(f.board_origin, "--board-origin"), x, y);
   } else {
     if (f.points.empty()) throw InputError("--points", "is required (or --board-image)");
@@ -212,7 +211,7 @@ void RunScene(const CalibrateFlags& f) {
       frame_height = frame.rows;
     }
     try {
-      r = vision::CalibrateScene(camera, ReadPoints(f.points), frame_width, frame_height);
+      r = CalibrateScene(camera, ReadPoints(f.points), frame_width, frame_height);
     } catch (const InputError& e) {
       // The library names rows (labels) or "points"/"frame"; say which file was meant.
       const std::string& q = e.quantity();
@@ -221,8 +220,8 @@ void RunScene(const CalibrateFlags& f) {
       throw;
     }
   }
-  const vision::CameraPose& pose = r.scene.pose;
-  const Eigen::Vector3d centre = vision::CameraCentre(pose);
+  const CameraPose& pose = r.scene.pose;
+  const Eigen::Vector3d centre = CameraCentre(pose);
   const Eigen::Vector3d axis = pose.rotation.row(2).transpose();
   const double degree = std::numbers::pi / 180;
   std::cout << "scene calibration: " << r.residuals.size() << " points, camera " << f.camera << "\n";
@@ -238,7 +237,7 @@ void RunScene(const CalibrateFlags& f) {
   std::cout << "  residuals:\n";
   for (const auto& p : r.residuals) std::cout << "    " << p.label << ": " << Fixed(p.error_px, 3) << " px\n";
   PrintVerdict(r.verdict, r.reasons);
-  vision::WriteSceneFile(f.output, r.scene, r.Summary());
+  WriteSceneFile(f.output, r.scene, r.Summary());
   std::cout << "wrote " << f.output << "\n";
 }
 
@@ -268,18 +267,18 @@ void RunTarget(const CalibrateFlags& f) {
   const ChessboardTarget t = Target(f.target);
   const std::string extension = std::filesystem::path(f.output).extension().string();
   if (extension == ".svg") {
-    io::WriteFileAtomically(f.output, TargetSvg(t));
+    WriteFileAtomically(f.output, TargetSvg(t));
     std::cout << "wrote " << f.output << ": print at 100 % (no \"fit to page\"), then measure a square: it must be "
               << Num(t.square * 1000) << " mm (give the measured value to --square)\n";
     return;
   }
   if (extension != ".png") throw InputError("-o", "must end in .svg or .png (got '" + f.output + "')");
-  const double dpi = io::ParseQuantity(f.dpi, io::Dimension::kDimensionless, "--dpi");
+  const double dpi = ParseQuantity(f.dpi, Dimension::kDimensionless, "--dpi");
   const int pixels = static_cast<int>(std::lround(t.square / 0.0254 * dpi));
-  const cv::Mat image = vision::ChessboardTargetImage(t, pixels);
+  const cv::Mat image = ChessboardTargetImage(t, pixels);
   std::vector<uchar> png;
   cv::imencode(".png", image, png);
-  io::WriteFileAtomically(f.output, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+  WriteFileAtomically(f.output, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
   std::cout << "wrote " << f.output << ": " << image.cols << " × " << image.rows << " px, " << pixels
             << " px per square; print at " << Num(dpi) << " dpi so that a square measures " << Num(t.square * 1000)
             << " mm (measure it and give the measured value to --square)\n";

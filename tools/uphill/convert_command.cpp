@@ -33,20 +33,20 @@ std::vector<double> ParseLengthList(const std::string& text, const std::string& 
   while (start <= text.size()) {
     const size_t comma = text.find(',', start);
     const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    out.push_back(io::ParseQuantity(item, io::Dimension::kLength, flag));
+    out.push_back(ParseQuantity(item, Dimension::kLength, flag));
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
   return out;
 }
 
-io::ConversionOptions Options(const ConvertFlags& f) {
-  io::ConversionOptions o;
-  if (io::UnitFactor(io::Dimension::kLength, f.length_unit) == 0.0)
-    throw InputError("--length-unit", "must be one of " + io::AcceptedUnits(io::Dimension::kLength));
+ConversionOptions Options(const ConvertFlags& f) {
+  ConversionOptions o;
+  if (UnitFactor(Dimension::kLength, f.length_unit) == 0.0)
+    throw InputError("--length-unit", "must be one of " + AcceptedUnits(Dimension::kLength));
   o.length_unit = f.length_unit;
   if (!f.at_x.empty()) o.at_x = ParseLengthList(f.at_x, "--at-x");
-  if (!f.mu.empty()) o.mu = io::ParseQuantity(f.mu, io::Dimension::kDimensionless, "--mu");
+  if (!f.mu.empty()) o.mu = ParseQuantity(f.mu, Dimension::kDimensionless, "--mu");
   if (f.mc_trials < 100) throw InputError("--mc-trials", "must be at least 100");
   o.propagation.trials = f.mc_trials;
   o.propagation.seed = f.seed;
@@ -55,38 +55,38 @@ io::ConversionOptions Options(const ConvertFlags& f) {
 
 // The optional columns of a batch's table and CSV, from its header and the flags (the values
 // cannot be known before the rows are printed).
-OptionalColumns BatchColumns(const BatchHeader& input, const ConvertFlags& f, const io::ConversionOptions& options) {
+OptionalColumns BatchColumns(const BatchHeader& input, const ConvertFlags& f, const ConversionOptions& options) {
   OptionalColumns any;
-  const io::FieldSource defaults = FlagSource(f.scene);
+  const FieldSource defaults = FlagSource(f.scene);
   const auto has = [&](const std::string& field) {
     for (const std::string& column : input.header)
-      if (io::SplitUnitSuffix(column).first == field) return true;
+      if (SplitUnitSuffix(column).first == field) return true;
     return defaults.lookup(field).has_value();
   };
   any.label = has("label");
-  for (const std::string& name : io::ConfigurationFieldNames())
+  for (const std::string& name : ConfigurationFieldNames())
     if (name.rfind("u_", 0) == 0) any.uncertainty |= has(name);
   any.rest = options.mu.has_value();
   const auto body = defaults.lookup("body");
   any.cone = (body && body->text == "double-cone");
-  for (const std::string& column : input.header) any.cone |= io::SplitUnitSuffix(column).first == "body";
+  for (const std::string& column : input.header) any.cone |= SplitUnitSuffix(column).first == "body";
   return any;
 }
 
 void Run(const ConvertFlags& f) {
-  io::ConversionOptions options = Options(f);
+  ConversionOptions options = Options(f);
   const OutputFormat format = f.json ? OutputFormat::kJson : f.csv ? OutputFormat::kCsv : OutputFormat::kTable;
   options.verdict = format == OutputFormat::kJson || f.batch.empty();  // only JSON and one setting's table show it
   if (f.batch.empty()) {
     ConvertedRow row;
-    row.result = io::Convert(io::ParseConfiguration(FlagSource(f.scene)), options);
+    row.result = Convert(ParseConfiguration(FlagSource(f.scene)), options);
     ConversionPrinter printer(std::cout, format, false, f.length_unit, ColumnsOf(*row.result));
     printer.Row(row);
     printer.Finish();
     return;
   }
   // Rows are printed as they are converted; a bad row is named on stderr as it is met.
-  const io::FieldSource defaults = FlagSource(f.scene);
+  const FieldSource defaults = FlagSource(f.scene);
   std::unique_ptr<ConversionPrinter> printer;
   ConvertBatch(
       f.batch, defaults, options,

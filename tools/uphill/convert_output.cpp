@@ -12,7 +12,6 @@
 namespace uphill::cli {
 namespace {
 
-using io::ConversionResult;
 
 // printf's %.6f and %.6g (std::to_chars with a precision is specified as printf is, and is
 // several times faster: a large batch prints millions of these).
@@ -50,7 +49,7 @@ void PrintSingle(std::ostream& out, const ConvertedRow& row, const std::string& 
   const ConversionResult& r = *row.result;
   const auto deg = [](double rad) { return Printf("%.6f", rad * 180.0 / std::numbers::pi) + " deg"; };
   const auto len = [unit](double m) {
-    return Printf("%.9g", io::ToUnit(m, io::Dimension::kLength, unit)) + " " + unit;
+    return Printf("%.9g", ToUnit(m, Dimension::kLength, unit)) + " " + unit;
   };
   const auto line = [&out](const std::string& key, const std::string& value) {
     out << "  " << key << std::string(key.size() < 30 ? 30 - key.size() : 1, ' ') << value << "\n";
@@ -81,7 +80,7 @@ void PrintSingle(std::ostream& out, const ConvertedRow& row, const std::string& 
       const std::string name = q->name;
       const auto show = [&](double v) {
         return is_angle ? Printf("%.3g", v * 180.0 / std::numbers::pi) + " deg"
-                        : Printf("%.3g", io::ToUnit(v, io::Dimension::kLength, unit)) + " " + unit;
+                        : Printf("%.3g", ToUnit(v, Dimension::kLength, unit)) + " " + unit;
       };
       line("u(" + name + ")", Pad(show(q->u_first_order), 16) + Pad(show(q->u_monte_carlo), 16) +
                                   (q->disagrees ? "first order and MC differ by > 5 %: use MC" : ""));
@@ -104,7 +103,7 @@ ConversionPrinter::ConversionPrinter(std::ostream& out, OutputFormat format, boo
     : out_(out), format_(format), batch_(batch), unit_(std::move(unit)) {
   const std::string unit_copy = unit_;
   const auto deg = [](double rad) { return Fixed6(rad * 180.0 / std::numbers::pi); };
-  const auto len = [unit_copy](double m) { return General6(io::ToUnit(m, io::Dimension::kLength, unit_copy)); };
+  const auto len = [unit_copy](double m) { return General6(ToUnit(m, Dimension::kLength, unit_copy)); };
   std::vector<Column>& cols = columns_;
   if (any.label) cols.push_back({"label", [](const ConversionResult& r) { return r.configuration.label; }});
   cols.push_back({"body", [](const ConversionResult& r) { return r.scene.body().Name(); }});
@@ -165,7 +164,7 @@ void ConversionPrinter::Row(const ConvertedRow& row) {
     nlohmann::ordered_json j;
     if (batch_) j["row"] = row.row;
     if (row.result) {
-      const nlohmann::ordered_json result = io::ToJson(*row.result);
+      const nlohmann::ordered_json result = ToJson(*row.result);
       for (const auto& [k, v] : result.items()) j[k] = v;
     } else {
       j["error"] = row.error;

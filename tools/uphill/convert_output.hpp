@@ -1,5 +1,5 @@
 // Output of `uphill convert`: a readable table (lab units, each column naming its unit), CSV
-// (the same columns) or JSON (SI, io::ToJson). Failed rows of a batch appear in every format,
+// (the same columns) or JSON (SI, ToJson). Failed rows of a batch appear in every format,
 // with their error, so the output lines up with the input rows.
 //
 // Rows are printed as they come (a batch of any size is never held): JSON as the elements of one
@@ -28,7 +28,7 @@ struct OptionalColumns {
   bool label = false, uncertainty = false, rest = false, cone = false;
 };
 // For one configuration: the columns its result has.
-OptionalColumns ColumnsOf(const io::ConversionResult& result);
+OptionalColumns ColumnsOf(const ConversionResult& result);
 
 inline constexpr std::size_t kTableSample = 10000;
 
@@ -43,7 +43,7 @@ class ConversionPrinter {
  private:
   struct Column {
     std::string header;
-    std::function<std::string(const io::ConversionResult&)> text;
+    std::function<std::string(const ConversionResult&)> text;
   };
   std::vector<std::string> Cells(const ConvertedRow& row) const;
   void FlushTable();

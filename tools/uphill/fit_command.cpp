@@ -68,7 +68,7 @@ void RunXy(const FitFlags& f) {
   RequireMethod(f.method);  // before the file is read
   // X,Y[,uX,uY] (io/xy_table.hpp): a row that cannot be read is named on stderr as it is met and
   // left out; the fit uses the others (exit status 2 tells).
-  io::XyTable table = io::ReadXyFile(f.xy, [](const std::string& error) {
+  XyTable table = ReadXyFile(f.xy, [](const std::string& error) {
     std::cerr << "uphill: " << error << " (row left out)\n";
     ExitStatus() = 2;
   });
@@ -80,17 +80,17 @@ void RunXy(const FitFlags& f) {
     throw InputError(table.Locate(e.quantity()), e.rule());  // name the file's row and column
   }
   if (f.json) {
-    report::WriteFitJson(std::cout, r, data, !f.no_rows);
+    WriteFitJson(std::cout, r, data, !f.no_rows);
   } else {
     PrintFitText(r);
   }
 }
 
-report::ExperimentAnalysis Analyse(const FitFlags& f, io::Experiment* keep) {
-  *keep = io::LoadExperiment(f.experiment);
-  report::AnalysisOptions options;
+ExperimentAnalysis Analyse(const FitFlags& f, Experiment* keep) {
+  *keep = LoadExperiment(f.experiment);
+  AnalysisOptions options;
   options.mc_trials = f.mc_trials;
-  report::ExperimentAnalysis a = report::AnalyseExperiment(*keep, options);
+  ExperimentAnalysis a = AnalyseExperiment(*keep, options);
   for (const auto& e : a.row_errors) {
     std::cerr << "uphill: " << e << " (row left out)\n";
     ExitStatus() = 2;
@@ -99,12 +99,12 @@ report::ExperimentAnalysis Analyse(const FitFlags& f, io::Experiment* keep) {
 }
 
 void RunExperiment(const FitFlags& f) {
-  io::Experiment experiment;
-  const report::ExperimentAnalysis a = Analyse(f, &experiment);
+  Experiment experiment;
+  const ExperimentAnalysis a = Analyse(f, &experiment);
   if (f.json) {
-    std::cout << report::AnalysisToJson(a).dump(2) << "\n";
+    std::cout << AnalysisToJson(a).dump(2) << "\n";
   } else {
-    std::cout << report::RenderText(report::FitDocument(a, false));
+    std::cout << RenderText(FitDocument(a, false));
   }
 }
 
@@ -131,9 +131,9 @@ void AddFitCommand(CLI::App& app) {
   report->add_option("-o,--output", flags->output, "output folder (created if needed)")->required();
   report->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials per row for u(X)")->capture_default_str();
   report->callback([flags] {
-    io::Experiment experiment;
-    const report::ExperimentAnalysis a = Analyse(*flags, &experiment);
-    report::WriteFitReport(a, flags->output);
+    Experiment experiment;
+    const ExperimentAnalysis a = Analyse(*flags, &experiment);
+    WriteFitReport(a, flags->output);
     std::cout << "wrote " << flags->output << "/report.html, report.md, fit.json, and the figures "
               << "fit_y_vs_x, fit_offset, fit_residuals (.svg, .png, .gp script, .dat data)\n";
   });

@@ -35,9 +35,9 @@ std::string Line(std::initializer_list<double> values) {
   return out + "\n";
 }
 
-report::GnuplotFigure PotentialFigure() {
+GnuplotFigure PotentialFigure() {
   // Paper FIG. 4: U(x) = m·g·z(x) for several b/a, α = 30°, θ = 10°, a = 20 mm.
-  report::GnuplotFigure f{"fig_potential", "U(x) for several b/a (alpha = 30 deg, theta = 10 deg)",
+  GnuplotFigure f{"fig_potential", "U(x) for several b/a (alpha = 30 deg, theta = 10 deg)",
                           "Potential energy U/(m g a) = z/a of the centre against x/a, spheroid a = 20 mm, "
                           "b/a = 0.5, 1, 1.6, 2, 3; each curve ends at its fall-off x_max; the maximum is X.",
                           "", "set xlabel 'x / a'\nset ylabel 'U / (m g a) = z / a'\nset key top right\nset grid\nplot "};
@@ -64,9 +64,9 @@ report::GnuplotFigure PotentialFigure() {
 }
 
 // X/a against an angle, for b/a = 1, 1.6, 2.
-report::GnuplotFigure XFigure(bool against_phi) {
+GnuplotFigure XFigure(bool against_phi) {
   const std::string name = against_phi ? "fig_x_vs_phi" : "fig_x_vs_theta";
-  report::GnuplotFigure f{name,
+  GnuplotFigure f{name,
                           against_phi ? "X against phi (theta = 1 deg)" : "X against theta (phi = 30 deg)",
                           against_phi ? "Unstable equilibrium X/a against the 3-D half angle phi between the rails "
                                         "(tan phi = tan(alpha/2) cos theta), theta = 1 deg."
@@ -121,7 +121,7 @@ double PaperSpeed(const SphereCase& c, double x) {
   return std::sqrt(2 * kG * (c.R - c.scene.At(x).z) / c.scene.KineticFactor(x));
 }
 
-std::vector<report::GnuplotFigure> SphereFigures() {
+std::vector<GnuplotFigure> SphereFigures() {
   SphereCase c;
   const Motion m(c.scene, c.s);
   const double t_end = m.end_time();
@@ -139,7 +139,7 @@ std::vector<report::GnuplotFigure> SphereFigures() {
       " Sphere R = 20 mm, theta = 0, phi = 60 deg, released at rest at s = 0.1 R; ends at the fall-off x_max = "
       "R/sin(alpha/2). Dashed: the paper's eq. 8 (and its speed), which is the separatrix (energy of a body at "
       "rest at x = 0, clock started at s), not the release from rest (PHYSICS.md).";
-  std::vector<report::GnuplotFigure> out;
+  std::vector<GnuplotFigure> out;
   out.push_back({"fig_sphere_xz_t", "Sphere: x(t) and z(t)", "Position x and height z of the centre." + caption_tail,
                  traj + paper,
                  "set xlabel 't [s]'\nset ylabel 'x, z [mm]'\nset key top left\nset grid\n"
@@ -165,22 +165,22 @@ std::vector<report::GnuplotFigure> SphereFigures() {
 
 // The paper's two experiment plots, from the sample experiments (data/README.md): Y against X
 // with the fits, drawn by the report layer into DIR/<series>/.
-void ExperimentFigures(const std::string& data_dir, const std::string& dir, report::Document* gallery) {
+void ExperimentFigures(const std::string& data_dir, const std::string& dir, Document* gallery) {
   const struct {
     const char* folder;
     const char* title;
   } series[] = {{"series1-fixed-D", "Experiment 1 (sample data): D fixed, L varied"},
                 {"series2-fixed-L", "Experiment 2 (sample data): L fixed, D varied"}};
   for (const auto& s : series) {
-    const io::Experiment experiment = io::LoadExperiment((fs::path(data_dir) / s.folder).string());
-    report::AnalysisOptions options;
+    const Experiment experiment = LoadExperiment((fs::path(data_dir) / s.folder).string());
+    AnalysisOptions options;
     options.mc_trials = 10000;
-    const report::ExperimentAnalysis analysis = report::AnalyseExperiment(experiment, options);
+    const ExperimentAnalysis analysis = AnalyseExperiment(experiment, options);
     const fs::path sub = fs::path(dir) / s.folder;
     fs::create_directories(sub);
-    for (const report::GnuplotFigure& f : report::AnalysisFigures(analysis)) {
+    for (const GnuplotFigure& f : AnalysisFigures(analysis)) {
       if (f.name == "fit_residuals") continue;
-      report::RenderFigure(f, sub.string());
+      RenderFigure(f, sub.string());
       gallery->Figure(std::string(s.folder) + "/" + f.name, std::string(s.title) + ": " + f.title, f.caption);
       std::cout << sub.string() << "/" << f.name << ".{svg,png}\n";
     }
@@ -189,15 +189,15 @@ void ExperimentFigures(const std::string& data_dir, const std::string& dir, repo
 
 void Run(const std::string& dir, const std::string& data_dir) {
   fs::create_directories(dir);
-  std::vector<report::GnuplotFigure> figures{PotentialFigure(), XFigure(true), XFigure(false)};
+  std::vector<GnuplotFigure> figures{PotentialFigure(), XFigure(true), XFigure(false)};
   for (auto& f : SphereFigures()) figures.push_back(std::move(f));
-  report::Document gallery;
+  Document gallery;
   gallery.title = "The seed paper's figures, redrawn by uphill";
   gallery.Paragraph("Each figure is drawn by gnuplot from the script (.gp) and data (.dat) kept beside its SVG "
                     "and PNG in this folder. Where PHYSICS.md shows the paper's formula to be wrong, the "
                     "corrected physics is drawn and the paper's curve is added, labelled as such.");
   for (const auto& f : figures) {
-    report::RenderFigure(f, dir);
+    RenderFigure(f, dir);
     gallery.Figure(f.name, f.title, f.caption);
     std::cout << dir << "/" << f.name << ".{svg,png}\n";
   }
@@ -207,7 +207,7 @@ void Run(const std::string& dir, const std::string& data_dir) {
   } else {
     ExperimentFigures(data_dir, dir, &gallery);
   }
-  io::WriteFileAtomically((fs::path(dir) / "index.html").string(), report::RenderHtml(gallery, dir));
+  WriteFileAtomically((fs::path(dir) / "index.html").string(), RenderHtml(gallery, dir));
   std::cout << dir << "/index.html\n";
 }
 

@@ -25,7 +25,7 @@ void AddSceneFlags(CLI::App* command, SceneFlags* flags) {
       {"alpha", "divergence angle, with unit (deg, rad), instead of L, H, D"},
       {"rod_diameter", "diameter of round rods, with unit (default: line rails)"},
   };
-  for (const std::string& field : io::ConfigurationFieldNames()) {
+  for (const std::string& field : ConfigurationFieldNames()) {
     if (field == "L_convention") continue;  // the --L-along-rail flag below
     std::string help;
     if (auto it = kHelp.find(field); it != kHelp.end()) {
@@ -40,16 +40,16 @@ void AddSceneFlags(CLI::App* command, SceneFlags* flags) {
                     "L is measured along a rail from O (default: horizontally)");
 }
 
-io::FieldSource FlagSource(const SceneFlags& flags) {
-  io::FieldSource source;
-  source.lookup = [&flags](const std::string& name) -> std::optional<io::FieldSource::Field> {
+FieldSource FlagSource(const SceneFlags& flags) {
+  FieldSource source;
+  source.lookup = [&flags](const std::string& name) -> std::optional<FieldSource::Field> {
     if (name == "L_convention") {
       if (!flags.along_rail) return std::nullopt;
-      return io::FieldSource::Field{"along-rail", ""};
+      return FieldSource::Field{"along-rail", ""};
     }
     const auto it = flags.values.find(name);
     if (it == flags.values.end()) return std::nullopt;
-    return io::FieldSource::Field{it->second, ""};
+    return FieldSource::Field{it->second, ""};
   };
   source.context = [](const std::string& name) {
     return name == "L_convention" ? std::string("--L-along-rail") : FlagName(name);

@@ -12,7 +12,7 @@
 namespace uphill::cli {
 
 struct SceneFlags {
-  std::map<std::string, std::string> values;  // field name (io::ConfigurationFieldNames) -> text
+  std::map<std::string, std::string> values;  // field name (ConfigurationFieldNames) -> text
   bool along_rail = false;
 };
 
@@ -23,6 +23,6 @@ void AddSceneFlags(CLI::App* command, SceneFlags* flags);
 std::string FlagName(const std::string& field);
 
 // The flags as a field source (each field named by its flag in messages).
-io::FieldSource FlagSource(const SceneFlags& flags);
+FieldSource FlagSource(const SceneFlags& flags);
 
 }  // namespace uphill::cli

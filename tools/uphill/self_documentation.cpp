@@ -166,10 +166,10 @@ std::string ProgramSections() {
   std::string s;
   s += ".SH UNITS\n";
   s += Roff("SI inside the library. On the command line every length and angle carries its unit: lengths " +
-            io::AcceptedUnits(io::Dimension::kLength) + "; angles " + io::AcceptedUnits(io::Dimension::kAngle) +
-            "; times " + io::AcceptedUnits(io::Dimension::kTime) + "; speeds " +
-            io::AcceptedUnits(io::Dimension::kVelocity) + "; accelerations " +
-            io::AcceptedUnits(io::Dimension::kAcceleration) +
+            AcceptedUnits(Dimension::kLength) + "; angles " + AcceptedUnits(Dimension::kAngle) +
+            "; times " + AcceptedUnits(Dimension::kTime) + "; speeds " +
+            AcceptedUnits(Dimension::kVelocity) + "; accelerations " +
+            AcceptedUnits(Dimension::kAcceleration) +
             ". A number without a unit is refused. Tables print lengths in mm and angles in degrees, and "
             "every column header names its unit; JSON output is always SI (metres, radians, seconds).") +
        "\n";
@@ -256,7 +256,7 @@ int WriteManPages(const CLI::App& root, const std::string& dir, const std::strin
   fs::create_directories(dir);
   int pages = 0;
   ForEachCommand(root, [&](const CLI::App& app) {
-    io::WriteFileAtomically((fs::path(dir) / (PageName(app) + ".1")).string(), ManPage(app, version));
+    WriteFileAtomically((fs::path(dir) / (PageName(app) + ".1")).string(), ManPage(app, version));
     ++pages;
   });
   return pages;
@@ -358,7 +358,7 @@ void AddSelfDocumentationFlags(CLI::App& app, const std::string& version) {
          [&app](const std::string& file) {
            const std::string script = BashCompletion(app);
            if (file == "-") std::cout << script;
-           else io::WriteFileAtomically(file, script);
+           else WriteFileAtomically(file, script);
            throw CLI::Success();
          },
          "write the bash completion script to FILE (- for stdout) and exit")

@@ -21,7 +21,7 @@ struct ServeFlags {
 };
 
 void Serve(const ServeFlags& flags) {
-  server::ServerOptions options;
+  ServerOptions options;
   options.directory = flags.directory;
   options.host = flags.host;
   options.port = flags.port;
@@ -35,7 +35,7 @@ void Serve(const ServeFlags& flags) {
   // A browser that closes a connection mid-answer must not kill the server.
   signal(SIGPIPE, SIG_IGN);
 
-  server::Server server(options);
+  Server server(options);
   const int port = server.Bind();
   const std::string shown_host = flags.host.find(':') != std::string::npos ? "[" + flags.host + "]" : flags.host;
   std::cout << "uphill serve: http://" << shown_host << ":" << port << "/  (experiment "

@@ -26,13 +26,13 @@ struct SimulateFlags {
   std::string length_unit = "mm";
 };
 
-std::vector<double> ParseList(const std::string& text, io::Dimension dimension, const std::string& flag) {
+std::vector<double> ParseList(const std::string& text, Dimension dimension, const std::string& flag) {
   std::vector<double> out;
   size_t start = 0;
   while (start <= text.size()) {
     const size_t comma = text.find(',', start);
     const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    out.push_back(io::ParseQuantity(item, dimension, flag));
+    out.push_back(ParseQuantity(item, dimension, flag));
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
@@ -60,13 +60,13 @@ Result Simulate(const SimulateFlags& f, const Scene& scene, const Motion& motion
   const std::string end_text =
       std::isfinite(end) ? " (the motion ends at t = " + Num(end) + " s: " + EventName(r.events.back().kind) + ")" : "";
   if (!f.at_times.empty()) {
-    for (double t : ParseList(f.at_times, io::Dimension::kTime, "--at-times")) {
+    for (double t : ParseList(f.at_times, Dimension::kTime, "--at-times")) {
       if (t < 0.0) throw InputError("--at-times", "must be >= 0 s (got " + Num(t) + " s)");
       if (t > end) throw InputError("--at-times", Num(t) + " s is after the end of the motion" + end_text);
       r.samples.push_back(motion.At(t));
     }
   } else if (!f.at_x.empty()) {
-    for (double x : ParseList(f.at_x, io::Dimension::kLength, "--at-x")) {
+    for (double x : ParseList(f.at_x, Dimension::kLength, "--at-x")) {
       const double t = motion.TimeAt(x);
       if (!std::isfinite(t))
         throw InputError("--at-x", Num(x * 1e3) + " mm is never reached (released at " + Num(motion.x0() * 1e3) +
@@ -75,11 +75,11 @@ Result Simulate(const SimulateFlags& f, const Scene& scene, const Motion& motion
       r.events.push_back(motion.PositionEvent(x));
     }
   } else {
-    const double dt = io::ParseQuantity(f.dt, io::Dimension::kTime, "--dt");
+    const double dt = ParseQuantity(f.dt, Dimension::kTime, "--dt");
     if (!(dt > 0.0)) throw InputError("--dt", "must be > 0 s");
     double t_stop = end;
     if (!f.t_end.empty()) {
-      t_stop = std::min(end, io::ParseQuantity(f.t_end, io::Dimension::kTime, "--t-end"));
+      t_stop = std::min(end, ParseQuantity(f.t_end, Dimension::kTime, "--t-end"));
       if (!(t_stop >= 0.0)) throw InputError("--t-end", "must be >= 0 s");
     } else if (!std::isfinite(t_stop)) {
       // Comes to rest: stop there. Otherwise (cone toward its apex, at rest at X): --t-end.
@@ -133,7 +133,7 @@ void Print(const SimulateFlags& f, const Scene& scene, const Motion& motion, con
     return;
   }
   const std::string& lu = f.length_unit;
-  const auto L = [&](double v) { return io::ToUnit(v, io::Dimension::kLength, lu); };
+  const auto L = [&](double v) { return ToUnit(v, Dimension::kLength, lu); };
   std::cout << "released at x0 = " << Num(L(motion.x0())) << " " << lu;
   if (scene.x_eq()) std::cout << "  (X = " << Num(L(*scene.x_eq())) << " " << lu << ")";
   std::cout << ", x_max = " << Num(L(scene.x_max())) << " " << lu << ", method "
@@ -154,16 +154,16 @@ void Print(const SimulateFlags& f, const Scene& scene, const Motion& motion, con
 }
 
 void Run(const SimulateFlags& f) {
-  if (io::UnitFactor(io::Dimension::kLength, f.length_unit) == 0.0)
-    throw InputError("--length-unit", "must be one of " + io::AcceptedUnits(io::Dimension::kLength));
+  if (UnitFactor(Dimension::kLength, f.length_unit) == 0.0)
+    throw InputError("--length-unit", "must be one of " + AcceptedUnits(Dimension::kLength));
   if (f.json && f.csv) throw InputError("--csv/--json", "give at most one of them");
-  const Scene scene = io::ParseConfiguration(FlagSource(f.scene)).MakeScene();
+  const Scene scene = ParseConfiguration(FlagSource(f.scene)).MakeScene();
   if (f.x0.empty()) throw InputError("--x0", "is required (release position, with unit, e.g. --x0 120mm)");
-  const double x0 = io::ParseQuantity(f.x0, io::Dimension::kLength, "--x0");
+  const double x0 = ParseQuantity(f.x0, Dimension::kLength, "--x0");
   MotionOptions o;
-  o.v0 = io::ParseQuantity(f.v0, io::Dimension::kVelocity, "--v0");
-  o.g = io::ParseQuantity(f.g, io::Dimension::kAcceleration, "--g");
-  o.mu = io::ParseQuantity(f.mu, io::Dimension::kDimensionless, "--mu");
+  o.v0 = ParseQuantity(f.v0, Dimension::kVelocity, "--v0");
+  o.g = ParseQuantity(f.g, Dimension::kAcceleration, "--g");
+  o.mu = ParseQuantity(f.mu, Dimension::kDimensionless, "--mu");
   if (!(o.g > 0.0)) throw InputError("--g", "must be > 0");
   if (!(o.mu >= 0.0)) throw InputError("--mu", "must be >= 0");
   if (f.method == "quadrature") {

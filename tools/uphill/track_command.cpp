@@ -54,7 +54,7 @@ Eigen::Vector2d ParsePixel(const std::string& text) {
 }
 
 // The scene file carries the intrinsics it was calibrated with; they must be the camera file's.
-void RequireSameCamera(const vision::CameraIntrinsics& cam, const vision::CameraIntrinsics& in_scene,
+void RequireSameCamera(const CameraIntrinsics& cam, const CameraIntrinsics& in_scene,
                        const TrackFlags& f) {
   auto differs = [](double a, double b) { return std::abs(a - b) > 1e-9 * std::max(1.0, std::abs(a)); };
   std::string what;
@@ -74,16 +74,16 @@ void Run(const TrackFlags& f) {
   if (f.camera.empty()) throw InputError("--camera", "is required (the camera file of `uphill calibrate camera`)");
   if (f.scene_file.empty()) throw InputError("--scene", "is required (the scene file of `uphill calibrate scene`)");
   if (f.out.empty()) throw InputError("-o", "is required (the track CSV to write)");
-  const io::Configuration configuration = io::ParseConfiguration(FlagSource(f.scene));
+  const Configuration configuration = ParseConfiguration(FlagSource(f.scene));
   const Scene scene = configuration.MakeScene();
   if (scene.body().kind == BodyKind::kDoubleCone)
     throw InputError("--body", "tracking supports a sphere or a spheroid, not a double cone");
-  const vision::CameraIntrinsics camera = vision::ReadCameraFile(f.camera);
-  vision::SceneCalibration calibration = vision::ReadSceneFile(f.scene_file);
+  const CameraIntrinsics camera = ReadCameraFile(f.camera);
+  SceneCalibration calibration = ReadSceneFile(f.scene_file);
   RequireSameCamera(camera, calibration.camera, f);
   calibration.camera = camera;
 
-  vision::TrackVideoOptions options;
+  TrackVideoOptions options;
   options.calibration_name = f.scene_file;
   options.overlay_path = f.overlay;
   if (!f.init.empty()) options.tracker.init_uv = ParsePixel(f.init);
@@ -102,9 +102,9 @@ void Run(const TrackFlags& f) {
       }
       std::fflush(stderr);
     };
-  const vision::TrackResult result = vision::TrackVideo(f.video, scene, calibration, options);
+  const TrackResult result = TrackVideo(f.video, scene, calibration, options);
   if (bar) std::fprintf(stderr, "\n");
-  vision::WriteTrack(f.out, result, {f.video, f.camera, f.scene_file, scene.body().Name()});
+  WriteTrack(f.out, result, {f.video, f.camera, f.scene_file, scene.body().Name()});
 
   int found = 0;
   double quality = 0;
@@ -122,10 +122,10 @@ void Run(const TrackFlags& f) {
   }
   if (f.analyse) {
     // The same analysis as `uphill analyse-track OUT [scene flags] -o <OUT's folder>`, default options.
-    const vision::TrackAnalysis analysis = vision::AnalyseTrack(vision::ReadTrackFile(f.out), scene);
-    std::cout << "\n" << vision::TrackAnalysisTable(analysis);
+    const TrackAnalysis analysis = AnalyseTrack(ReadTrackFile(f.out), scene);
+    std::cout << "\n" << TrackAnalysisTable(analysis);
     const std::string folder = std::filesystem::path(f.out).parent_path().string();
-    vision::WriteTrackAnalysis(analysis, folder.empty() ? "." : folder);
+    WriteTrackAnalysis(analysis, folder.empty() ? "." : folder);
     std::cout << "wrote " << (folder.empty() ? "." : folder) << "/track_analysis.json and its figures\n";
   }
 }

@@ -7,7 +7,7 @@
 #include <cstring>
 #include <limits>
 
-namespace uphill::fit_internal {
+namespace uphill::internal {
 
 CompressedLineCost::CompressedLineCost() {
   set_num_residuals(3);
@@ -78,9 +78,9 @@ bool CompressedLineCost::Evaluate(double const* const* parameters, double* resid
   return true;
 }
 
-}  // namespace uphill::fit_internal
+}  // namespace uphill::internal
 
-namespace uphill::fit_internal {
+namespace uphill::internal {
 
 int RefineNewton(const CompressedLineCost& cost, double* theta, double unverified_below) {
   Eigen::Map<Eigen::Vector2d> t(theta);
@@ -112,4 +112,4 @@ int RefineNewton(const CompressedLineCost& cost, double* theta, double unverifie
   return steps;
 }
 
-}  // namespace uphill::fit_internal
+}  // namespace uphill::internal

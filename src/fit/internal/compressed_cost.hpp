@@ -28,7 +28,7 @@
 #include <array>
 #include <limits>
 
-namespace uphill::fit_internal {
+namespace uphill::internal {
 
 struct LineSums {
   double rr = 0.0;                                // Σ r_i²
@@ -84,4 +84,4 @@ class CompressedLineCost : public ceres::CostFunction {
   mutable int passes_ = 0;
 };
 
-}  // namespace uphill::fit_internal
+}  // namespace uphill::internal

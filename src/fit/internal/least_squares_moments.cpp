@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-namespace uphill::fit_internal {
+namespace uphill::internal {
 namespace {
 
 constexpr std::size_t kRows = 1024;  // per chunk (8 KB of each column)
@@ -58,4 +58,4 @@ bool LeastSquaresCost::RowSums(const double* theta, bool /*with_hessian*/, LineS
   return true;
 }
 
-}  // namespace uphill::fit_internal
+}  // namespace uphill::internal

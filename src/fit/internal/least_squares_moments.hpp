@@ -12,7 +12,7 @@
 #include "fit/internal/compressed_cost.hpp"
 #include "fit/internal/line_problem.hpp"
 
-namespace uphill::fit_internal {
+namespace uphill::internal {
 
 struct LineMoments {
   double w = 0, x = 0, y = 0, xx = 0, xy = 0, yy = 0;
@@ -33,4 +33,4 @@ class LeastSquaresCost final : public CompressedLineCost {
   LineMoments m_;
 };
 
-}  // namespace uphill::fit_internal
+}  // namespace uphill::internal

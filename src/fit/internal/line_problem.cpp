@@ -9,15 +9,9 @@
 #include <stdexcept>
 
 #include "model/input_error.hpp"
+#include "model/number_text.hpp"
 
-namespace uphill::fit_internal {
-
-std::string Num(double v) {
-  std::ostringstream out;
-  out.precision(17);
-  out << v;
-  return out.str();
-}
+namespace uphill::internal {
 
 double PowerOfTwoBelow(double v) {
   int e = 0;
@@ -182,7 +176,7 @@ ceres::Solver::Options SolverOptions(const FitOptions& options) {
 void ValidateFitOptions(const FitOptions& options) {
   if (!(options.outlier_threshold > 0.0))
     throw InputError("outlier threshold",
-                     "must be > 0 (got " + Num(options.outlier_threshold) + ")");
+                     "must be > 0 (got " + ExactText(options.outlier_threshold) + ")");
   if (std::string error; !SolverOptions(options).IsValid(&error)) throw InputError("fit options", error);
 }
 
@@ -362,7 +356,7 @@ void RequireRepresentable(const std::vector<double>& standardised_u, const std::
       throw InputError(quantity + "[" + std::to_string(i) + "]",
                        "is out of binary64 range relative to the spread of the data "
                        "(u/spread = " +
-                           Num(u) + "); rescale the data");
+                           ExactText(u) + "); rescale the data");
   }
 }
 
@@ -417,4 +411,4 @@ void FinishReport(FitReport& report, const std::vector<std::string>& names,
   }
 }
 
-}  // namespace uphill::fit_internal
+}  // namespace uphill::internal

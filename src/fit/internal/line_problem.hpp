@@ -15,7 +15,7 @@
 #include "fit/fit_report.hpp"
 #include "fit/line_data.hpp"
 
-namespace uphill::fit_internal {
+namespace uphill::internal {
 
 // 2^e with 2^e ≤ v < 2^(e+1), v > 0 finite: scaling by it is exact in binary.
 double PowerOfTwoBelow(double v);
@@ -100,7 +100,5 @@ double UpperTailChiSquared(double chi2, int dof);
 void FinishReport(FitReport& report, const std::vector<std::string>& names,
                   const Eigen::VectorXd& values, bool p_value_applies, bool rows_flagged = false);
 
-// "1.2345678901234567" (17 significant digits) for messages.
-std::string Num(double v);
 
-}  // namespace uphill::fit_internal
+}  // namespace uphill::internal

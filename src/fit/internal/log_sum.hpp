@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <numbers>
 
-namespace uphill::fit_internal {
+namespace uphill::internal {
 
 class LogSum {
  public:
@@ -45,4 +45,4 @@ class LogSum {
   long double sum_ = 0;
 };
 
-}  // namespace uphill::fit_internal
+}  // namespace uphill::internal

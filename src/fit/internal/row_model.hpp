@@ -8,7 +8,7 @@
 
 #include "fit/fit_report.hpp"
 
-namespace uphill::fit_internal {
+namespace uphill::internal {
 
 // The robust weight ρ'(s), s = z², of the model's loss at normalised residual z.
 inline double RobustWeight(const LineRowModel& m, double z) {
@@ -57,4 +57,4 @@ inline RowResult EvaluateRow(const LineRowModel& m, double outlier_threshold, st
   return row;
 }
 
-}  // namespace uphill::fit_internal
+}  // namespace uphill::internal

@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <string_view>
 
-namespace uphill::io::internal {
+namespace uphill::internal {
 
 // Index of the first byte that is not part of well-formed UTF-8 (RFC 3629: no overlong forms,
 // no surrogates, nothing above U+10FFFF), or npos.
@@ -42,4 +42,4 @@ inline std::size_t InvalidUtf8At(std::string_view s) {
   return std::string_view::npos;
 }
 
-}  // namespace uphill::io::internal
+}  // namespace uphill::internal

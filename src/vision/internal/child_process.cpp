@@ -14,7 +14,7 @@
 
 extern char** environ;
 
-namespace uphill::vision::internal {
+namespace uphill::internal {
 namespace {
 
 std::vector<char*> Argv(const std::vector<std::string>& argv) {
@@ -124,4 +124,4 @@ std::string TailOfFile(const std::string& path, int lines) {
   return out;
 }
 
-}  // namespace uphill::vision::internal
+}  // namespace uphill::internal

@@ -8,7 +8,7 @@
 #include <sys/types.h>
 #include <vector>
 
-namespace uphill::vision::internal {
+namespace uphill::internal {
 
 struct ChildStatus {
   bool started = false;     // false: the program could not be started (not installed?)
@@ -46,4 +46,4 @@ class ChildInput {
 // The last `lines` lines of a text file ("" if it cannot be read), for error messages.
 std::string TailOfFile(const std::string& path, int lines = 6);
 
-}  // namespace uphill::vision::internal
+}  // namespace uphill::internal
