@@ -21,18 +21,18 @@ namespace {
 
 constexpr double kUlp = 1.1102230246251565e-16;  // 2^-53, half an ulp of 1
 
-std::vector<BatchKernel> Kernels() {
-  std::vector<BatchKernel> k = {BatchKernel::kScalar};
-  if (BatchKernelAvailable(BatchKernel::kAvx2)) k.push_back(BatchKernel::kAvx2);
+std::vector<VectorKernel> Kernels() {
+  std::vector<VectorKernel> k = {VectorKernel::kScalar};
+  if (VectorKernelAvailable(VectorKernel::kAvx2)) k.push_back(VectorKernel::kAvx2);
   return k;
 }
 
 bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 // Relative agreement: exact for kScalar, within `ulps` (of 2^-53) for kAvx2.
-void ExpectClose(BatchKernel kernel, double actual, double model, double ulps, const char* what,
+void ExpectClose(VectorKernel kernel, double actual, double model, double ulps, const char* what,
                  std::size_t i) {
-  if (kernel == BatchKernel::kScalar) {
+  if (kernel == VectorKernel::kScalar) {
     EXPECT_TRUE(SameBits(actual, model)) << what << "[" << i << "] " << actual << " vs " << model;
   } else {
     EXPECT_NEAR(actual, model, ulps * kUlp * std::abs(model)) << what << "[" << i << "]";
@@ -70,8 +70,8 @@ TEST(BatchConvert, RailsFromApparatusMatchModel) {
     std::vector<double> L = c.L;
     if (convention == LConvention::kAlongRail)  // along a rail L must exceed hypot(H, D/2)
       for (std::size_t i = 0; i < n; ++i) L[i] = std::hypot(c.H[i], c.D[i] / 2) * (1.0 + c.L[i]);
-    for (BatchKernel kernel : Kernels()) {
-      SCOPED_TRACE(BatchKernelName(kernel));
+    for (VectorKernel kernel : Kernels()) {
+      SCOPED_TRACE(VectorKernelName(kernel));
       std::vector<double> theta(n), alpha(n), phi(n), B(n), T(n);
       RailsFromApparatusBatch(n, L.data(), c.H.data(), c.D.data(), convention,
                               {theta.data(), alpha.data(), phi.data(), B.data(), T.data()}, kernel);
@@ -93,8 +93,8 @@ TEST(BatchConvert, RailsFromApparatusMatchModel) {
 TEST(BatchConvert, RailsFromAnglesMatchModel) {
   const std::size_t n = 1001;
   const Configurations c = Random(n, 2);
-  for (BatchKernel kernel : Kernels()) {
-    SCOPED_TRACE(BatchKernelName(kernel));
+  for (VectorKernel kernel : Kernels()) {
+    SCOPED_TRACE(VectorKernelName(kernel));
     std::vector<double> theta(n), alpha(n), phi(n), B(n), T(n);
     RailsFromAnglesBatch(n, c.theta.data(), c.alpha.data(),
                          {theta.data(), alpha.data(), phi.data(), B.data(), T.data()}, kernel);
@@ -117,8 +117,8 @@ TEST(BatchConvert, BodiesMatchModel) {
     B[i] = std::tan(c.theta[i]);
     T[i] = std::tan(c.alpha[i] / 2);
   }
-  for (BatchKernel kernel : Kernels()) {
-    SCOPED_TRACE(BatchKernelName(kernel));
+  for (VectorKernel kernel : Kernels()) {
+    SCOPED_TRACE(VectorKernelName(kernel));
     std::vector<double> x_eq(n), x_max(n), x_eq_r(n), x_max_r(n), x_fall(n), theta0(n), q(n);
     SpheroidBatch(n, c.a.data(), c.b.data(), nullptr, B.data(), T.data(), x_eq.data(),
                   x_max.data(), kernel);
@@ -138,7 +138,7 @@ TEST(BatchConvert, BodiesMatchModel) {
       ExpectClose(kernel, theta0[i], cone.theta0(), 8, "theta0", i);
       // Q = (1 + B²) − (kT)²: kAvx2 rounds once less; compare absolutely (Q is O(1) or a
       // cancellation, which the sign test Q > 0 tolerates).
-      if (kernel == BatchKernel::kScalar) {
+      if (kernel == VectorKernel::kScalar) {
         EXPECT_TRUE(SameBits(q[i], cone.Q()));
       } else {
         EXPECT_NEAR(q[i], cone.Q(), 8 * kUlp * (1 + B[i] * B[i] + cone.s()));
@@ -149,7 +149,7 @@ TEST(BatchConvert, BodiesMatchModel) {
 
 TEST(BatchConvert, ResultDoesNotDependOnPositionOrBatchSize) {
   const Configurations c = Random(64, 4);
-  for (BatchKernel kernel : Kernels()) {
+  for (VectorKernel kernel : Kernels()) {
     std::vector<double> full(64);
     ConvertApparatusBatch(64, c.L.data(), c.H.data(), c.D.data(), 0.015875, 0.0254, nullptr,
                           nullptr, full.data(), kernel);
@@ -168,7 +168,7 @@ TEST(BatchConvert, ResultDoesNotDependOnPositionOrBatchSize) {
 TEST(BatchConvert, FusedConversionAgreesWithTheStages) {
   const std::size_t n = 1503;  // several blocks of the scalar path, an odd tail
   const Configurations c = Random(n, 5);
-  for (BatchKernel kernel : Kernels()) {
+  for (VectorKernel kernel : Kernels()) {
     std::vector<double> theta(n), alpha(n), x_eq(n), t2(n), a2(n), B(n), T(n), x2(n);
     ConvertApparatusBatch(n, c.L.data(), c.H.data(), c.D.data(), 0.015875, 0.0254, theta.data(),
                           alpha.data(), x_eq.data(), kernel);
@@ -189,8 +189,8 @@ TEST(BatchConvert, FusedConversionAgreesWithTheStages) {
 // kernel (the path `uphill bench convert` times), within the reference file's tolerance.
 TEST(BatchConvert, ReferenceCases) {
   using nlohmann::json;
-  for (BatchKernel kernel : Kernels()) {
-    SCOPED_TRACE(BatchKernelName(kernel));
+  for (VectorKernel kernel : Kernels()) {
+    SCOPED_TRACE(VectorKernelName(kernel));
     int checked = 0;
     for (const json& c : testing::ReferenceFile().at("cases")) {
       const bool rods = c.contains("rod_radius") && c.at("rod_radius").is_number() &&
@@ -232,8 +232,8 @@ TEST(GaussianStream, IsBoostsNormalDistributionBitForBit) {
     boost::random::normal_distribution<double> unit;
     std::vector<double> expected(n);
     for (double& z : expected) z = unit(engine);
-    for (BatchKernel kernel : Kernels()) {
-      SCOPED_TRACE(BatchKernelName(kernel));
+    for (VectorKernel kernel : Kernels()) {
+      SCOPED_TRACE(VectorKernelName(kernel));
       GaussianStream stream(seed);
       std::vector<double> z(n);
       // Odd chunk sizes: the stream's state carries over between calls.
@@ -251,12 +251,12 @@ TEST(GaussianStream, IsBoostsNormalDistributionBitForBit) {
   }
 }
 
-TEST(BatchKernelName, NamesTheChoice) {
-  EXPECT_STREQ(BatchKernelName(BatchKernel::kScalar), "scalar (libm)");
-  EXPECT_STREQ(BatchKernelName(BatchKernel::kAvx2), "avx2+fma (libmvec)");
-  EXPECT_STREQ(BatchKernelName(BatchKernel::kAuto),
-               BatchKernelName(BatchKernelAvailable(BatchKernel::kAvx2) ? BatchKernel::kAvx2
-                                                                        : BatchKernel::kScalar));
+TEST(VectorKernelName, NamesTheChoice) {
+  EXPECT_STREQ(VectorKernelName(VectorKernel::kScalar), "scalar (libm)");
+  EXPECT_STREQ(VectorKernelName(VectorKernel::kAvx2), "avx2+fma (libmvec)");
+  EXPECT_STREQ(VectorKernelName(VectorKernel::kAuto),
+               VectorKernelName(VectorKernelAvailable(VectorKernel::kAvx2) ? VectorKernel::kAvx2
+                                                                        : VectorKernel::kScalar));
 }
 
 }  // namespace

@@ -415,15 +415,15 @@ TEST(MotionReleaseTimes, APrioriNodeCountMeetsTheTolerance) {
     MotionOptions mo;
     mo.tolerance = 1e-15;
     const Motion m(c.scene, x0, mo);
-    for (ReleaseKernel kernel : {ReleaseKernel::kScalar, ReleaseKernel::kAvx2}) {
-      if (!ReleaseKernelAvailable(kernel)) continue;
+    for (VectorKernel kernel : {VectorKernel::kScalar, VectorKernel::kAvx2}) {
+      if (!VectorKernelAvailable(kernel)) continue;
       for (double tol : {1e-4, 1e-8, 1e-11, 1e-13}) {
         ReleaseTimesOptions o;
         o.tolerance = tol;
         o.kernel = kernel;
         const double err = MaxRelativeDifference(ReleaseTimes(c.scene, x0, xs, o), m, xs);
         EXPECT_LT(err, tol <= 1e-13 ? 3 * tol : tol)
-            << ReleaseKernelName(kernel) << " tol " << tol << " release " << c.release << " n " << c.n;
+            << VectorKernelName(kernel) << " tol " << tol << " release " << c.release << " n " << c.n;
       }
     }
   }
@@ -434,10 +434,10 @@ TEST(MotionReleaseTimes, KernelsAgreeAndInputIsChecked) {
   const double x0 = 1.05 * *s.x_eq();
   const std::vector<double> xs = Positions(x0, s.x_max(), 37);  // a tail of 1 after 4·9
   ReleaseTimesOptions o;
-  o.kernel = ReleaseKernel::kScalar;
+  o.kernel = VectorKernel::kScalar;
   const std::vector<double> scalar = ReleaseTimes(s, x0, xs, o);
-  if (ReleaseKernelAvailable(ReleaseKernel::kAvx2)) {
-    o.kernel = ReleaseKernel::kAvx2;
+  if (VectorKernelAvailable(VectorKernel::kAvx2)) {
+    o.kernel = VectorKernel::kAvx2;
     const std::vector<double> avx2 = ReleaseTimes(s, x0, xs, o);
     for (size_t i = 0; i < xs.size(); ++i) EXPECT_NEAR(avx2[i], scalar[i], 1e-14 * scalar[i]) << i;
   }

@@ -51,7 +51,7 @@ struct Accuracy {
 
 // θ, α, x_eq of the spheroid apparatus cases and the FIG. 5/6 sweeps on line rails, through the
 // timed code path (ConvertApparatusBatch). Sweeps give angles: L = 1, H = tanθ, D = 2·tan(α/2).
-Accuracy AgainstReferences(const std::string& path, BatchKernel kernel) {
+Accuracy AgainstReferences(const std::string& path, VectorKernel kernel) {
   std::ifstream in(path);
   const nlohmann::json file = nlohmann::json::parse(in);
   auto ref = [](const nlohmann::json& v) {
@@ -126,11 +126,11 @@ void RunConvertBenchmark(const ConvertBenchmarkOptions& f, std::ostream& out) {
   if (f.repeats < 1) throw InputError("--repeats", "must be at least 1");
   Section section = StartSection("convert", f.common.command, kMethod);
   const std::string reference = f.reference.empty() ? FindUpward("tests/data/physics_reference.json") : f.reference;
-  const BatchKernel kernel = BatchKernel::kAuto;
+  const VectorKernel kernel = VectorKernel::kAuto;
   std::string lab = "Monte Carlo case (the lab spheroid, metres):";
   for (const LabInput& x : kLab) lab += std::string(" ") + x.name + " = " + Printf("%g", x.value) + " ± " + Printf("%g", x.u);
   out << "uphill bench convert: one core, thread CPU time, best of " << f.repeats << "; batch kernel "
-      << BatchKernelName(kernel) << "\n" << lab << "\n\n";
+      << VectorKernelName(kernel) << "\n" << lab << "\n\n";
   section.method += " " + lab + ".";
   Table table = ResultTable();
   table.Start(out);
@@ -148,22 +148,22 @@ void RunConvertBenchmark(const ConvertBenchmarkOptions& f, std::ostream& out) {
     }
   }
   std::vector<double> theta(n), alpha(n), x_eq(n);
-  auto convert = [&](BatchKernel k) {
+  auto convert = [&](VectorKernel k) {
     ConvertApparatusBatch(n, L.data(), H.data(), D.data(), kA, kB, theta.data(), alpha.data(), x_eq.data(), k);
   };
-  auto accuracy = [&](BatchKernel k) {
+  auto accuracy = [&](VectorKernel k) {
     if (reference.empty()) return std::string("(tests/data/physics_reference.json not found)");
     const Accuracy acc = AgainstReferences(reference, k);
     return Printf("max rel err %.2g", acc.max_rel) + " vs 60-digit refs (theta, alpha, X: " +
            std::to_string(acc.values) + " values)";
   };
   convert(kernel);  // first touch of the output pages outside the timing
-  const Measurement scalar_model = Measure(1, [&] { convert(BatchKernel::kScalar); });
+  const Measurement scalar_model = Measure(1, [&] { convert(VectorKernel::kScalar); });
   const Measurement batch = Measure(f.repeats, [&] { convert(kernel); });
   Row(table, std::string("convert L,H,D -> theta,alpha,X (") +
-                 (BatchKernelAvailable(BatchKernel::kAvx2) ? "avx2" : "scalar") + ")",
+                 (VectorKernelAvailable(VectorKernel::kAvx2) ? "avx2" : "scalar") + ")",
       n, batch, accuracy(kernel));
-  Row(table, "convert, scalar = the model (libm atan2)", n, scalar_model, accuracy(BatchKernel::kScalar));
+  Row(table, "convert, scalar = the model (libm atan2)", n, scalar_model, accuracy(VectorKernel::kScalar));
 
   // Monte Carlo: the lab case, all five inputs uncertain.
   const auto rails = UncertainRails::Apparatus({kLab[0].value, kLab[0].u}, {kLab[1].value, kLab[1].u},

@@ -114,10 +114,10 @@ void RunMotionBenchmark(const MotionBenchmarkOptions& f, std::ostream& out) {
     }
   }
   // The fast path: node count from the a-priori estimate (per tolerance), and fixed counts.
-  std::vector<ReleaseKernel> kernels = {ReleaseKernel::kScalar};
-  if (ReleaseKernelAvailable(ReleaseKernel::kAvx2)) kernels.insert(kernels.begin(), ReleaseKernel::kAvx2);
-  for (ReleaseKernel kernel : kernels) {
-    const std::string name = "uphill ReleaseTimes, " + ReleaseKernelName(kernel);
+  std::vector<VectorKernel> kernels = {VectorKernel::kScalar};
+  if (VectorKernelAvailable(VectorKernel::kAvx2)) kernels.insert(kernels.begin(), VectorKernel::kAvx2);
+  for (VectorKernel kernel : kernels) {
+    const std::string name = std::string("uphill ReleaseTimes, ") + VectorKernelName(kernel);
     // Fixed node counts are a separate curve (same method, no a-priori choice).
     auto add = [&](const ReleaseTimesOptions& o, const std::string& setting) {
       auto work = [&] { ReleaseTimes(scene, x0, xs, got, o); };

@@ -236,37 +236,7 @@ void Avx2ConvertApparatus(std::size_t n, const double* L, const double* H, const
 #pragma GCC pop_options
 #endif  // UPHILL_BATCH_AVX2
 
-bool CpuHasAvx2() {
-#if UPHILL_BATCH_AVX2
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return has;
-#else
-  return false;
-#endif
-}
-
-bool UseAvx2(BatchKernel kernel) {
-  switch (kernel) {
-    case BatchKernel::kAuto: return CpuHasAvx2();
-    case BatchKernel::kScalar: return false;
-    case BatchKernel::kAvx2:
-      if (!CpuHasAvx2())
-        throw std::runtime_error("batch kernel avx2+fma requested but not available here");
-      return true;
-  }
-  return false;
-}
-
 }  // namespace
-
-bool BatchKernelAvailable(BatchKernel kernel) {
-  return kernel != BatchKernel::kAvx2 || CpuHasAvx2();
-}
-
-const char* BatchKernelName(BatchKernel kernel) {
-  if (kernel == BatchKernel::kAuto) kernel = CpuHasAvx2() ? BatchKernel::kAvx2 : BatchKernel::kScalar;
-  return kernel == BatchKernel::kAvx2 ? "avx2+fma (libmvec)" : "scalar (libm)";
-}
 
 // The stage kernels write B and T only where the caller asked for them; a caller that wants
 // neither still needs them internally for φ, so they go through a small stack block then.
@@ -293,7 +263,7 @@ void WithSlopes(std::size_t n, const RailsArrays& out, Run run) {
 }  // namespace
 
 void RailsFromApparatusBatch(std::size_t n, const double* L, const double* H, const double* D,
-                             LConvention convention, const RailsArrays& out, BatchKernel kernel) {
+                             LConvention convention, const RailsArrays& out, VectorKernel kernel) {
   const bool avx2 = UseAvx2(kernel);
   WithSlopes(n, out, [&](std::size_t i, std::size_t m, const RailsArrays& o, double* B, double* T) {
 #if UPHILL_BATCH_AVX2
@@ -305,7 +275,7 @@ void RailsFromApparatusBatch(std::size_t n, const double* L, const double* H, co
 }
 
 void RailsFromAnglesBatch(std::size_t n, const double* theta, const double* alpha,
-                          const RailsArrays& out, BatchKernel kernel) {
+                          const RailsArrays& out, VectorKernel kernel) {
   const bool avx2 = UseAvx2(kernel);
   WithSlopes(n, out, [&](std::size_t i, std::size_t m, const RailsArrays& o, double* B, double* T) {
 #if UPHILL_BATCH_AVX2
@@ -318,7 +288,7 @@ void RailsFromAnglesBatch(std::size_t n, const double* theta, const double* alph
 
 void SpheroidBatch(std::size_t n, const double* a, const double* b, const double* rod_radius,
                    const double* tan_theta, const double* tan_half_alpha, double* x_eq,
-                   double* x_max, BatchKernel kernel) {
+                   double* x_max, VectorKernel kernel) {
 #if UPHILL_BATCH_AVX2
   if (UseAvx2(kernel))
     return Avx2Spheroid(n, a, b, rod_radius, tan_theta, tan_half_alpha, x_eq, x_max);
@@ -330,7 +300,7 @@ void SpheroidBatch(std::size_t n, const double* a, const double* b, const double
 
 void DoubleConeBatch(std::size_t n, const double* R, const double* h, const double* tan_theta,
                      const double* tan_half_alpha, double* x_fall, double* theta0, double* q,
-                     BatchKernel kernel) {
+                     VectorKernel kernel) {
 #if UPHILL_BATCH_AVX2
   if (UseAvx2(kernel))
     return Avx2DoubleCone(n, R, h, tan_theta, tan_half_alpha, x_fall, theta0, q);
@@ -342,7 +312,7 @@ void DoubleConeBatch(std::size_t n, const double* R, const double* h, const doub
 
 void ConvertApparatusBatch(std::size_t n, const double* L, const double* H, const double* D,
                            double a, double b, double* theta, double* alpha, double* x_eq,
-                           BatchKernel kernel) {
+                           VectorKernel kernel) {
 #if UPHILL_BATCH_AVX2
   if (UseAvx2(kernel)) return Avx2ConvertApparatus(n, L, H, D, a, b, theta, alpha, x_eq);
 #endif
@@ -470,7 +440,7 @@ void Avx2Normals(GaussianStream* stream, std::size_t n, double* z) {
 
 }  // namespace
 
-void GaussianStream::Fill(std::size_t n, double* z, BatchKernel kernel) {
+void GaussianStream::Fill(std::size_t n, double* z, VectorKernel kernel) {
 #if UPHILL_BATCH_AVX2
   if (UseAvx2(kernel)) return Avx2Normals(this, n, z);
 #else

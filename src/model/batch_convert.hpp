@@ -41,16 +41,9 @@
 #include <cstdint>
 
 #include "model/rails.hpp"
+#include "model/vector_kernel.hpp"
 
 namespace uphill {
-
-// Which implementation runs. kAuto picks kAvx2 when the CPU has AVX2 and FMA and the build found
-// libmvec, else kScalar. Asking for kAvx2 where it is not available throws std::runtime_error.
-enum class BatchKernel { kAuto, kScalar, kAvx2 };
-
-bool BatchKernelAvailable(BatchKernel kernel);
-// "avx2+fma (libmvec)" or "scalar (libm)": what `kernel` (kAuto: what it resolves to) runs.
-const char* BatchKernelName(BatchKernel kernel = BatchKernel::kAuto);
 
 // Outputs of the rails stage, n values each. A null pointer means "not wanted".
 struct RailsArrays {
@@ -64,24 +57,24 @@ struct RailsArrays {
 // Rails from crossbar measurements L, H, D (metres) with the given L convention.
 void RailsFromApparatusBatch(std::size_t n, const double* L, const double* H, const double* D,
                              LConvention convention, const RailsArrays& out,
-                             BatchKernel kernel = BatchKernel::kAuto);
+                             VectorKernel kernel = VectorKernel::kAuto);
 
 // Rails from angles θ, α (radians). out.theta/out.alpha, if given, receive copies.
 void RailsFromAnglesBatch(std::size_t n, const double* theta, const double* alpha,
-                          const RailsArrays& out, BatchKernel kernel = BatchKernel::kAuto);
+                          const RailsArrays& out, VectorKernel kernel = VectorKernel::kAuto);
 
 // Sphere (a = b = R) or spheroid: x_eq and x_max (metres; either may be null). rod_radius null:
 // line rails; otherwise the rods' radii (> 0), closed forms of spheroid_on_rods_closed_forms.hpp.
 void SpheroidBatch(std::size_t n, const double* a, const double* b, const double* rod_radius,
                    const double* tan_theta, const double* tan_half_alpha, double* x_eq,
-                   double* x_max, BatchKernel kernel = BatchKernel::kAuto);
+                   double* x_max, VectorKernel kernel = VectorKernel::kAuto);
 
 // Double cone (base radius R, half-length h) on line rails: x_fall = h·cot(α/2) (m), θ0 (rad),
 // and Q = 1 + tan²θ − (R/h)²tan²(α/2) (the closed form and the scene need Q > 0). Any output may
 // be null.
 void DoubleConeBatch(std::size_t n, const double* R, const double* h, const double* tan_theta,
                      const double* tan_half_alpha, double* x_fall, double* theta0, double* q,
-                     BatchKernel kernel = BatchKernel::kAuto);
+                     VectorKernel kernel = VectorKernel::kAuto);
 
 // The converter's common case in one pass: crossbar L, H, D (metres, horizontal convention) to
 // θ, α (rad) and X = x_eq (m) of one spheroid (semi-axes a, b, m) on line rails. Outputs may be
@@ -90,7 +83,7 @@ void DoubleConeBatch(std::size_t n, const double* R, const double* h, const doub
 // a few ulp of the model. This is the path `uphill bench convert` times.
 void ConvertApparatusBatch(std::size_t n, const double* L, const double* H, const double* D,
                            double a, double b, double* theta, double* alpha, double* x_eq,
-                           BatchKernel kernel = BatchKernel::kAuto);
+                           VectorKernel kernel = VectorKernel::kAuto);
 
 // GaussianStream: the Monte Carlo's source of standard normal deviates, reproducible and fast.
 //
@@ -112,7 +105,7 @@ void ConvertApparatusBatch(std::size_t n, const double* L, const double* H, cons
 class GaussianStream {
  public:
   explicit GaussianStream(std::uint64_t seed) : engine_(seed) {}
-  void Fill(std::size_t n, double* z, BatchKernel kernel = BatchKernel::kAuto);
+  void Fill(std::size_t n, double* z, VectorKernel kernel = VectorKernel::kAuto);
 
  private:
   friend struct GaussianStreamAccess;

@@ -3,7 +3,7 @@
 // Declared by hand rather than reached through <math.h>'s `#pragma omp declare simd` so that the
 // choice does not depend on -ffast-math or -fopenmp-simd, which the project does not use.
 // UPHILL_LIBMVEC_AVX2 is 1 where they exist (the target links libmvec and defines
-// UPHILL_HAVE_LIBMVEC); callers still check the CPU at run time (__builtin_cpu_supports).
+// UPHILL_HAVE_LIBMVEC); callers choose at run time through vector_kernel.hpp.
 // Accuracy: libmvec's documented bound, within 4 ulp of the correctly rounded result.
 #pragma once
 

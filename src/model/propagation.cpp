@@ -406,10 +406,9 @@ void CountWindowsAvx2(Window (&w)[2], const double* y, std::size_t n) {
 #define UPHILL_WINDOWS_AVX2 0
 #endif
 
-void CountWindows(Window (&w)[2], const double* y, std::size_t n, BatchKernel kernel) {
+void CountWindows(Window (&w)[2], const double* y, std::size_t n, VectorKernel kernel) {
 #if UPHILL_WINDOWS_AVX2
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (avx2 && kernel != BatchKernel::kScalar) return CountWindowsAvx2(w, y, n);
+  if (kernel != VectorKernel::kScalar && CpuHasAvx2Fma()) return CountWindowsAvx2(w, y, n);
 #endif
   (void)kernel;
   CountWindowsScalar(w, y, n);

@@ -134,7 +134,7 @@ struct PropagationOptions {
   // histograms or tests. Off by default: the statistics never need them.
   bool keep_samples = false;
   // The per-trial model; kAuto is the fastest available (see batch_convert.hpp).
-  BatchKernel kernel = BatchKernel::kAuto;
+  VectorKernel kernel = VectorKernel::kAuto;
 };
 
 // One output: the model's value at the input values and its uncertainty both ways.

@@ -57,6 +57,7 @@
 #include <vector>
 
 #include "model/scene.hpp"
+#include "model/vector_kernel.hpp"
 
 namespace uphill {
 
@@ -146,20 +147,16 @@ class Motion {
 // `uphill bench motion` prints the error reached against a 50-digit reference). Throws
 // InputError (naming x0, xs, g, nodes, tolerance, kernel or scene) for other scenes, x0 ≤ X,
 // positions not increasing in (x0, x_max].
-enum class ReleaseKernel { kAuto, kScalar, kAvx2 };
 struct ReleaseTimesOptions {
   double g = 9.80665;        // m/s², > 0
   double tolerance = 1e-13;  // relative, in [1e-15, 1e-2]; used when nodes = 0
   int nodes = 0;             // 0: from the tolerance; 2 … 12: fixed
-  ReleaseKernel kernel = ReleaseKernel::kAuto;  // kAvx2 throws where the CPU lacks AVX2 + FMA
+  VectorKernel kernel = VectorKernel::kAuto;  // vector_kernel.hpp
 };
 // Writes t[i] for xs[i]; t.size() == xs.size().
 void ReleaseTimes(const Scene& scene, double x0, std::span<const double> xs, std::span<double> t,
                   const ReleaseTimesOptions& options = {});
 std::vector<double> ReleaseTimes(const Scene& scene, double x0, const std::vector<double>& xs,
                                  const ReleaseTimesOptions& options = {});
-bool ReleaseKernelAvailable(ReleaseKernel kernel);
-// "avx2+fma (libmvec)" or "scalar (libm)": what kAuto (or the given kernel) runs.
-std::string ReleaseKernelName(ReleaseKernel kernel);
 
 }  // namespace uphill

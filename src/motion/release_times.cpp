@@ -168,15 +168,6 @@ void PositionsAvx2(const Release& r, const double* x, double* v, std::size_t n) 
 #pragma GCC pop_options
 #endif  // UPHILL_RELEASE_AVX2
 
-bool CpuHasAvx2() {
-#if UPHILL_RELEASE_AVX2
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return has;
-#else
-  return false;
-#endif
-}
-
 // ---- Gauss–Legendre rules (Boost.Math), expanded to all N nodes ------------------------------
 
 struct Rule {
@@ -361,13 +352,6 @@ void EvaluatePanels(const Release& r, bool avx2, const double* c, const double* 
 
 }  // namespace
 
-std::string ReleaseKernelName(ReleaseKernel kernel) {
-  if (kernel == ReleaseKernel::kAuto) kernel = CpuHasAvx2() ? ReleaseKernel::kAvx2 : ReleaseKernel::kScalar;
-  return kernel == ReleaseKernel::kAvx2 ? "avx2+fma (libmvec)" : "scalar (libm)";
-}
-
-bool ReleaseKernelAvailable(ReleaseKernel kernel) { return kernel != ReleaseKernel::kAvx2 || CpuHasAvx2(); }
-
 void ReleaseTimes(const Scene& scene, double x0, std::span<const double> xs, std::span<double> t,
                   const ReleaseTimesOptions& o) {
   using namespace internal;
@@ -389,9 +373,7 @@ void ReleaseTimes(const Scene& scene, double x0, std::span<const double> xs, std
     prev = x;
   }
   if (xs.empty()) return;
-  bool avx2 = o.kernel == ReleaseKernel::kAvx2 || (o.kernel == ReleaseKernel::kAuto && CpuHasAvx2());
-  if (o.kernel == ReleaseKernel::kAvx2 && !CpuHasAvx2())
-    throw InputError("kernel", "avx2+fma requested but not available on this CPU");
+  bool avx2 = UseAvx2(o.kernel);
 
   const EllipseCoordinate e = MakeEllipse(scene);
   const Release r = MakeRelease(e, x0, o.g);
