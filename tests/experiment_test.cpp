@@ -123,7 +123,8 @@ TEST(FuzzRegression, BodyWithoutTypeIsAnInputError) {
 }
 
 TEST(FuzzRegression, DeeplyNestedJsonValuesAreRefusedWithoutRecursion) {
-  // A value nested 10^5 deep was dumped into the error message, once per level: stack overflow.
+  // A value nested 10^5 deep must not be dumped into the error message once per level (that
+  // recursion overflows the stack).
   // Values of body, apparatus and uncertainties must be strings even when no row uses them, as
   // the metadata is copied (recursively) into fit.json.
   const std::string deep = std::string(100000, '[') + std::string(100000, ']');

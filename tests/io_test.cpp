@@ -190,7 +190,8 @@ TEST(AtomicFile, ReplacesContentAndLeavesNoTemporary) {
 // Regression tests for what fuzzing the readers found (tests/fuzz, scripts/fuzz.sh).
 
 TEST(FuzzRegression, QuantityThatOverflowsInSIIsRefused) {
-  // fuzz_units: "1e307 km" is a finite number but 1e310 m, which was returned as +inf.
+  // Found by fuzz_units: "1e307 km" is a finite number but 1e310 m, which must be refused, not
+  // returned as +inf.
   const auto error = [](const std::string& text, Dimension dimension) {
     try {
       ParseQuantity(text, dimension, "--L");
@@ -203,7 +204,7 @@ TEST(FuzzRegression, QuantityThatOverflowsInSIIsRefused) {
   EXPECT_EQ(error("-1e306km", Dimension::kLength), "--L: '-1e306km' is out of the range of a double");
   EXPECT_DOUBLE_EQ(ParseQuantity("-1e308in", Dimension::kLength, "--L"), -1e308 * 0.0254);  // shrinks
   EXPECT_DOUBLE_EQ(ParseQuantity("1e300 km", Dimension::kLength, "--L"), 1e303);
-  // One sign only: "+-5 mm" was read as -5 mm.
+  // One sign only: "+-5 mm" is not -5 mm.
   EXPECT_EQ(error("+-5 mm", Dimension::kLength), "--L: '+-5 mm' is not a number");
   EXPECT_EQ(error("++5", Dimension::kDimensionless), "--L: '++5' is not a number");
   EXPECT_DOUBLE_EQ(ParseQuantity("+5 mm", Dimension::kLength, "--L"), 0.005);

@@ -1,4 +1,4 @@
-// Property and numerical-stability tests of the model layer (PHYSICS.md), over random valid
+// Property and numerical-stability tests of the model layer (docs/physics.md), over random valid
 // configurations drawn from a fixed-seed std::mt19937_64, plus named hard cases.
 //
 // Tolerances. u = 2^-53 is the unit roundoff. A binary64 value f that the model computes from
@@ -14,7 +14,8 @@
 // x_max's own rounding (an ulp of x_max) moves the distance x_max − x by as much; near the
 // fall-off this term is the dominant, and genuine, ill-conditioning. A test that uses another
 // bound says why next to it.
-// High-precision references are the naive formulas of PHYSICS.md evaluated in 113-bit binary
+// High-precision references are the naive formulas of docs/physics.md
+// ("Spheroid on line rails") evaluated in 113-bit binary
 // floating point (boost::multiprecision::cpp_bin_float_quad), which absorbs their cancellation.
 #include <gtest/gtest.h>
 
@@ -175,7 +176,7 @@ Sensitive RestSens(const SpheroidCase& c, double mu) {
   return FromJet(x, {c.a, c.b, c.B(), c.T()}, std::abs(mu));
 }
 
-// PHYSICS.md eq4 and the contact, naive forms, in 113-bit arithmetic:
+// docs/physics.md "Spheroid on line rails": z(x) and the contact, naive forms, in 113-bit arithmetic:
 //   z = (B·x + sqrt(Δ))/(1 + A²), Δ = P·(a²(1 + A²) − A²x²), x_M = (x + B·z)/P,
 //   R* = distance from C to the line through both contacts = hypot(x − x_M, z − B·x_M).
 struct QuadPoint {

@@ -26,8 +26,8 @@ struct FitOptions {
   // "beyond 3 sigma": about 0.27 % of rows for Gaussian errors, so a few flags among 10^3 rows
   // are expected, not alarming.
   double outlier_threshold = 3.0;
-  // Start Ceres at the closed-form solution (Eigen QR of the centred design; York: a few
-  // effective-variance iterations). false starts at slope 0, intercept = weighted mean of Y
+  // Start Ceres at the closed-form solution (Eigen QR of the centred design; York: the WLS line
+  // in u(Y), which is York's criterion at slope 0). false starts at slope 0, intercept = weighted mean of Y
   // (friction: mu = 0), to show that Ceres on its own reaches the same values.
   bool seed_with_closed_form = true;
   // Ceres termination (Solver::Options of the same names). gradient_tolerance is absolute in

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "fit/internal/line_problem.hpp"
+#include "internal/line_problem.hpp"
 #include "fit/least_squares_line.hpp"
 #include "fit/york_line.hpp"
 #include "model/input_error.hpp"

@@ -1,6 +1,6 @@
 // The rolling-resistance model fitted to the measured farthest rest positions.
 //
-// Model (PHYSICS.md, "Rolling resistance as a slope threshold"): the body stays at rest where
+// Model (docs/physics.md "Rolling resistance"): the body stays at rest where
 // |z'(x)| ≤ μ, so the farthest rest position of row i is x_rest,i(μ) = Scene_i.Rest(μ)->high; for
 // line rails x_rest(μ) = x_max·K/sqrt(P·A² + K²), K = B + μ(1 + A²). The fit is
 //     Y_i = s·x_rest,i(μ),   μ ≥ 0,   s = 1 unless fit_scale (then s is a free scale factor that

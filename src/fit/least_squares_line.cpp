@@ -5,11 +5,11 @@
 #include <cmath>
 #include <limits>
 
-#include "fit/internal/compressed_cost.hpp"
-#include "fit/internal/least_squares_moments.hpp"
-#include "fit/internal/line_problem.hpp"
-#include "fit/internal/log_sum.hpp"
-#include "fit/internal/row_model.hpp"
+#include "internal/compressed_cost.hpp"
+#include "internal/least_squares_moments.hpp"
+#include "internal/line_problem.hpp"
+#include "internal/log_sum.hpp"
+#include "internal/row_model.hpp"
 #include "fit/model_comparison.hpp"
 #include "model/input_error.hpp"
 

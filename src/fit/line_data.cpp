@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "fit/internal/line_problem.hpp"
+#include "internal/line_problem.hpp"
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
 

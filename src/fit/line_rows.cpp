@@ -1,6 +1,6 @@
 #include "fit/line_rows.hpp"
 
-#include "fit/internal/row_model.hpp"
+#include "internal/row_model.hpp"
 
 namespace uphill {
 

@@ -5,10 +5,10 @@
 #include <limits>
 #include <memory>
 
-#include "fit/internal/compressed_cost.hpp"
-#include "fit/internal/least_squares_moments.hpp"
-#include "fit/internal/line_problem.hpp"
-#include "fit/internal/row_model.hpp"
+#include "internal/compressed_cost.hpp"
+#include "internal/least_squares_moments.hpp"
+#include "internal/line_problem.hpp"
+#include "internal/row_model.hpp"
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
 

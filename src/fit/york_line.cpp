@@ -5,9 +5,9 @@
 #include <cmath>
 #include <limits>
 
-#include "fit/internal/compressed_cost.hpp"
-#include "fit/internal/line_problem.hpp"
-#include "fit/internal/log_sum.hpp"
+#include "internal/compressed_cost.hpp"
+#include "internal/line_problem.hpp"
+#include "internal/log_sum.hpp"
 #include "fit/model_comparison.hpp"
 #include "model/input_error.hpp"
 

@@ -9,7 +9,7 @@
 #include <set>
 #include <stdexcept>
 
-#include "io/internal/utf8.hpp"
+#include "internal/utf8.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill {

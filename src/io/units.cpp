@@ -74,7 +74,7 @@ double ParseQuantity(std::string_view text, Dimension dimension, const std::stri
   const char* begin = trimmed.data();
   const char* end = begin + trimmed.size();
   // A leading '+' is allowed (spreadsheets write it); from_chars does not accept it. Only one
-  // sign, though: without this check "+-5 mm" was read as -5 mm (checked by tests/fuzz).
+  // sign, though: without this check "+-5 mm" would be read as -5 mm (found by tests/fuzz).
   if (*begin == '+') {
     ++begin;
     if (begin < end && (*begin == '-' || *begin == '+'))

@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "model/libmvec_avx2.hpp"
-#include "model/spheroid_on_rods_closed_forms.hpp"
+#include "internal/spheroid_on_rods_closed_forms.hpp"
 
 #define UPHILL_BATCH_AVX2 UPHILL_LIBMVEC_AVX2
 
@@ -213,8 +213,8 @@ void Avx2DoubleCone(std::size_t n, const double* R, const double* h, const doubl
 // Two divisions and one square root per configuration instead of four and one; each value is
 // within a few ulp of the model's expression (tests/batch_convert_test.cpp). What remains is
 // bound by the two atan calls (~4 cycles per value each); memory traffic at 10^7 configurations
-// hides behind them. (Non-temporal stores for large outputs were tried and measured 4× slower on
-// the development machine, an AMD EPYC under KVM.)
+// hides behind them. Ordinary stores, not non-temporal ones: the outputs are read again soon
+// (the Monte Carlo's next stage, the caller's table).
 void Avx2ConvertApparatus(std::size_t n, const double* L, const double* H, const double* D,
                           double a, double b, double* theta, double* alpha, double* x_eq) {
   const __m256d one = _mm256_set1_pd(1.0), half = _mm256_set1_pd(0.5), two = _mm256_set1_pd(2.0);

@@ -2,13 +2,14 @@
 // once, arrays in, arrays out (structure of arrays, one array per quantity).
 //
 // Why a separate path: the Monte Carlo propagation (propagation.hpp) and `uphill bench convert`
-// evaluate the closed forms 10^6–10^7 times. Through Rails/Scene each evaluation costs ~100 ns,
-// mostly scalar libm atan2; here the same formulas run 4 lanes at a time using glibc's libmvec
+// evaluate the closed forms 10^6–10^7 times. Through Rails/Scene each evaluation is dominated by
+// scalar libm atan2 and the objects' set-up; here the same formulas run 4 lanes at a time using glibc's libmvec
 // AVX2 variants (_ZGVdN4v_atan, _ZGVdN4v_tan, ≤ 4 ulp) when the CPU has AVX2 + FMA, chosen at run
 // time, with a scalar fallback that evaluates the model's own expressions (bit for bit those of
 // Rails, SpheroidOnLineRails, spheroid_on_rods_closed_forms.hpp and DoubleConeOnLineRails).
 //
-// Formulas, per element (PHYSICS.md; SI units: metres, radians):
+// Formulas, per element (docs/physics.md "Frame and apparatus", "Spheroid on line rails",
+// "Round rods", "Double cone"; SI units: metres, radians):
 //   rails from L, H, D    Lh = L (LConvention::kHorizontal) or sqrt((L − s)(L + s)), s = hypot(H, D/2)
 //                         B = tanθ = H/Lh,  T = tan(α/2) = D/(2·Lh)
 //                         θ = atan(B), α = 2·atan(T), φ = atan(T/sqrt(1 + B²))   [= atan2 forms]
@@ -94,8 +95,7 @@ void ConvertApparatusBatch(std::size_t n, const double* L, const double* H, cons
 // the seed and the Boost version, not on the CPU or the C++ library (std::normal_distribution's
 // algorithm is implementation-defined, which is why Boost's is used at all).
 //
-// Why not just call unit(engine): Boost's ziggurat costs ~6 ns per value here, the largest part
-// of a Monte Carlo trial. Its fast path (≈ 98.8 % of values: one 64-bit engine output gives a
+// Why not just call unit(engine): Boost's ziggurat is the largest part of a Monte Carlo trial. Its fast path (≈ 98.8 % of values: one 64-bit engine output gives a
 // layer index, a sign and a 53-bit fraction r; x = r·x[i] is accepted if x < x[i+1]) is plain
 // integer and IEEE arithmetic with correctly rounded conversions, so the AVX2 kernel evaluates it
 // for four consecutive engine outputs at once, with the same operations and Boost's own tables.

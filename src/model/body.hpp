@@ -1,4 +1,4 @@
-// Body: the rolling body, uniform density (PHYSICS.md "Bodies").
+// Body: the rolling body, uniform density (docs/physics.md "Bodies").
 //
 //   sphere       radius R                        I_y = 2/5·m·R²
 //   spheroid     semi-axes a (in x and z), b      I_y = 2/5·m·a²   (b along y, the rolling axis)

@@ -18,7 +18,7 @@
 #include "model/number_text.hpp"
 #include "model/scene.hpp"
 #include "model/spheroid_on_line_rails.hpp"
-#include "model/spheroid_on_rods_closed_forms.hpp"
+#include "internal/spheroid_on_rods_closed_forms.hpp"
 
 namespace uphill {
 namespace {

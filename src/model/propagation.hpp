@@ -46,9 +46,8 @@
 // interval is found without sorting the M values: a pilot of 2^14 trials places a narrow window
 // around each quantile, later trials are only counted (below) or kept (inside) — exact, with an
 // exact rerun in the (≈ 1e-4 probable) case that a window misses. Memory: ≈ 2 % of M per output.
-// Measured (`uphill bench convert`, AMD EPYC 2.45 GHz, one core): ≈ 45 ns per trial for 5 uncertain
-// inputs and 5 outputs, about half of it the 5 Gaussian draws (the mt19937_64 engine ≈ 2 ns per
-// draw, Boost's ziggurat ≈ 1.5 ns more).
+// About half of a trial's time is its Gaussian draws (`uphill bench convert` measures it:
+// docs/benchmarks.md).
 
 // Errors: InputError (model/input_error.hpp) naming the quantity and the rule, for a bad value
 // (the model's own checks: e.g. "D: must be > 0 (got -0.003)"), a bad uncertainty

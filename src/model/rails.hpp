@@ -1,6 +1,6 @@
 // Rails: the two straight rail lines r±(t) = (t, ±t·tan(α/2), t·tanθ), t ≥ 0, that meet at O.
 //
-// Frame (PHYSICS.md): O is the meeting point, x horizontal along the centre line toward the rising,
+// Frame (docs/physics.md "Frame and apparatus"): O is the meeting point, x horizontal along the centre line toward the rising,
 // diverging end, y horizontal across, z up. θ is the inclination, α the divergence angle in the
 // horizontal projection, φ the 3-D half angle between the rails: tanφ = tan(α/2)·cosθ.
 //
@@ -34,8 +34,8 @@ T HorizontalDistance(const T& L, const T& H, const T& D, LConvention convention)
 struct Rails {
   double theta = 0.0;           // inclination, rad, in [0, π/2)
   double alpha = 0.0;           // divergence angle, rad, in (0, π)
-  double tan_theta = 0.0;       // B in PHYSICS.md
-  double tan_half_alpha = 0.0;  // T in PHYSICS.md
+  double tan_theta = 0.0;       // B in docs/physics.md
+  double tan_half_alpha = 0.0;  // T in docs/physics.md
 
   // From angles. Throws InputError unless 0 ≤ θ < π/2 and 0 < α < π.
   static Rails FromAngles(double theta, double alpha);

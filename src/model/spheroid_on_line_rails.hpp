@@ -1,6 +1,6 @@
 // SpheroidOnLineRails: closed forms for a spheroid (and a sphere, a = b = R) on line rails.
 //
-// Notation of PHYSICS.md: A = (a/b)·tan(α/2), B = tanθ, P = 1 + A² + B². The centre path is an
+// Notation of docs/physics.md "Spheroid on line rails": A = (a/b)·tan(α/2), B = tanθ, P = 1 + A² + B². The centre path is an
 // arc of an ellipse; with the ellipse parameter ψ, x = x_max·sinψ, every quantity is a short
 // expression in ψ with no cancellation:
 //   z(x)   = z_eq·cos(ψ − ψ0)                      z_eq = a·sqrt(A² + B²)/A
@@ -15,11 +15,11 @@
 //   cos(ψ − ψ0) = cosψ·cosψ0 + sinψ·sinψ0,   sin(ψ − ψ0) = sinψ·cosψ0 − cosψ·sinψ0,
 //   cos(ψ + γ)  = cosψ·cosγ − sinψ·sinγ,     sin(ψ + γ)  = sinψ·cosγ + cosψ·sinγ,
 // and cosψ = sqrt(((x_max − x)/x_max)·(1 + x/x_max)), x_max − x exact (Sterbenz) near x_max.
-// (An earlier version formed ψ = atan2(sinψ, cosψ) and took sin(ψ − ψ0), cos(ψ + γ) of angle
-// differences, and 1 − x/x_max after rounding x/x_max. Near the fall-off, where ψ and, for small
-// α, ψ0 both approach π/2, those lose the digits of π/2 − ψ: z' at x_max·(1 − 1e-12) was wrong
-// by ~1e-4 relative, z' at x_max·(1 − 1e-6) with θ ≈ 90° and α = 1e-8 by ~4e-14, and z at the
-// last double below x_max by ~3e-9, none of it due to the conditioning of the value.)
+// (Why not ψ = atan2(sinψ, cosψ) and sin(ψ − ψ0), cos(ψ + γ) of angle differences, with
+// 1 − x/x_max after rounding x/x_max: near the fall-off, where ψ and, for small α, ψ0 both
+// approach π/2, those lose the digits of π/2 − ψ: z' at x_max·(1 − 1e-12) would be wrong by
+// ~1e-4 relative, z' at x_max·(1 − 1e-6) with θ ≈ 90° and α = 1e-8 by ~4e-14, and z at the last
+// double below x_max by ~3e-9, none of it due to the conditioning of the value.)
 //
 // Accuracy (binary64, tests/model_reference_test.cpp against 60-digit references and
 // tests/model_property_test.cpp against 113-bit evaluations at random points): x_eq, x_max,

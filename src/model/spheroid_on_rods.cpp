@@ -8,7 +8,7 @@
 #include <numbers>
 
 #include "model/input_error.hpp"
-#include "model/spheroid_on_rods_closed_forms.hpp"
+#include "internal/spheroid_on_rods_closed_forms.hpp"
 
 namespace uphill {
 namespace {
@@ -50,7 +50,7 @@ SpheroidOnRods::SpheroidOnRods(double a, double b, double tan_theta, double tan_
                                double rod_radius)
     : a_(a), b_(b), B_(tan_theta), T_(tan_half_alpha), r_(rod_radius) {
   RequirePositiveFinite("rod radius", rod_radius);
-  // Closed forms (PHYSICS.md), shared with first-order propagation: spheroid_on_rods_closed_forms.hpp.
+  // Closed forms (docs/physics.md "Round rods"), shared with first-order propagation: spheroid_on_rods_closed_forms.hpp.
   x_max_ = SpheroidOnRodsXMax(a, b, T_, r_);
   x_eq_ = SpheroidOnRodsXEq(a, b, B_, T_, r_);
   double x_unused;
@@ -89,8 +89,8 @@ SpheroidOnRods::SpheroidOnRods(double a, double b, double tan_theta, double tan_
   double z_unused;
   if (beta_low_ == beta_n) {
     // The contact at t = 0: the normal with n_y = 0, n·d = 0 is ∝ (tanθ, 0, −1), taken exactly
-    // rather than through the rounded angle β_n (whose n_y ≈ 1e-17 put x_low above x_eq = 0 at
-    // θ = 0, so that At(x_eq) was refused).
+    // rather than through the rounded angle β_n (whose n_y ≈ 1e-17 would put x_low above
+    // x_eq = 0 at θ = 0, so that At(x_eq) would be refused).
     CentreForNormal(B_, 0.0, -1.0, &x_low_, &z_unused);
   } else {
     CentreAtNormalAngle(beta_low_, &x_low_, &z_unused);

@@ -1,6 +1,6 @@
 // SpheroidOnRods: a spheroid on round rods of radius r > 0 (the rail lines are the rods' axes).
 //
-// No closed form exists for z(x) (PHYSICS.md "Round rods"), so this is the one numeric contact
+// No closed form exists for z(x) (docs/physics.md "Round rods"), so this is the one numeric contact
 // solve of the model, used only when the scene needs it (a non-spherical body on rods; a sphere
 // on rods is the closed form of a sphere of radius R + r).
 //

@@ -3,7 +3,7 @@
 #include <sstream>
 
 #include "model/input_error.hpp"
-#include "motion/motion_engine.hpp"
+#include "internal/motion_engine.hpp"
 #include "model/number_text.hpp"
 
 namespace uphill {

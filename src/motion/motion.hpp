@@ -1,8 +1,8 @@
-// Motion: the rolling motion of the body of a Scene released at x0 (PHYSICS.md "Energy").
+// Motion: the rolling motion of the body of a Scene released at x0 (docs/physics.md "Energy").
 //
 // Model: pure rolling at both contacts, one degree of freedom (the centre's x), energy
 //   ½·v²·K(x) + g·z(x) = const,   K = 1 + I/(m·R*²),
-// optionally with rolling resistance μ as a slope threshold (PHYSICS.md "Rolling resistance"):
+// optionally with rolling resistance μ as a slope threshold (docs/physics.md "Rolling resistance"):
 // a resisting force that does work g·μ per metre of horizontal travel, so the body stays at rest
 // where |z'(x)| ≤ μ. Direction from the physics: released at rest beyond X the body rolls away
 // from O (up the rails, its centre going down), below X it rolls back toward O; exactly at X it

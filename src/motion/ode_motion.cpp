@@ -18,7 +18,7 @@
 #include <optional>
 
 #include "model/input_error.hpp"
-#include "motion/motion_engine.hpp"
+#include "internal/motion_engine.hpp"
 #include "model/number_text.hpp"
 
 namespace uphill::internal {

@@ -1,7 +1,7 @@
 // ReleaseTimes (motion.hpp): a whole release trajectory t(x_1 … x_n) of a sphere or spheroid on
 // line rails by fixed Gauss–Legendre rules on arrays of nodes.
 //
-// Integrand (PHYSICS.md "Energy"; the substitution of the quadrature method written in
+// Integrand (docs/physics.md "Energy"; the substitution of the quadrature method written in
 // v = sinh(w/2)): with u = ψ − ψ0 the ellipse parameter measured from X, u0 its release value,
 //   u = u0·(1 + 2v²),  a2 = (u − u0)/2 = u0·v²,  a1 = (u + u0)/2 = u0 + a2,
 //   dt/dv = 2·sqrt(K·M·a1·a2 / (g·z_eq·sin a1·sin a2·(1 + v²))),
@@ -34,7 +34,7 @@
 
 #include "model/input_error.hpp"
 #include "model/libmvec_avx2.hpp"
-#include "motion/motion_engine.hpp"
+#include "internal/motion_engine.hpp"
 #include "model/number_text.hpp"
 
 #define UPHILL_RELEASE_AVX2 UPHILL_LIBMVEC_AVX2

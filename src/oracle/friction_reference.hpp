@@ -1,6 +1,7 @@
 // Reference for the rolling-resistance fit (fit/friction_fit.hpp): the Gauss-Newton normal
 // equations of Σ (Y_i − s·x_rest,i(μ))²/u(Y_i)² for a spheroid (or sphere, a = b) on line rails,
-// in long double, with x_rest and its derivative from the closed form (PHYSICS.md):
+// in long double, with x_rest and its derivative from the closed form (docs/physics.md
+// "Rolling resistance"):
 //     x_rest(μ) = x_max·K/sqrt(P·A² + K²),   K = tanθ + μ(1 + A²),
 //     dx_rest/dμ = x_max·P·A²(1 + A²)/(P·A² + K²)^(3/2),
 // evaluated by the model's SpheroidOnLineRails<long double> (the model's closed form, not the

@@ -11,7 +11,7 @@
 #include "model/input_error.hpp"
 #include "report/analysis.hpp"
 #include "report/fit_document.hpp"
-#include "server/page_assets.hpp"
+#include "internal/page_assets.hpp"
 #include "server/row_check.hpp"
 // Last: it includes <resolv.h>, whose `_res` macro breaks Eigen (a parameter of that name).
 #include <httplib.h>

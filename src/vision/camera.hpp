@@ -1,5 +1,5 @@
 // Camera: the pinhole camera with lens distortion that films the apparatus, and its pose in the
-// apparatus frame of PHYSICS.md (O the rails' meeting point, x along the centre line toward the
+// apparatus frame of docs/physics.md "Frame and apparatus" (O the rails' meeting point, x along the centre line toward the
 // rising end, y across, z up). Everything the vision layer computes goes through these few
 // functions, so that the renderer of synthetic clips, the calibration and the tracker agree on
 // one camera model: OpenCV's (cv::projectPoints, cv::undistortPoints).

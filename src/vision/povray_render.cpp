@@ -7,7 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
-#include "vision/internal/child_process.hpp"
+#include "internal/child_process.hpp"
 
 namespace uphill {
 

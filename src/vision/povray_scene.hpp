@@ -2,8 +2,8 @@
 // renders for the physically based test footage (footage_clip.hpp). Independent of the tracker
 // and of synthetic_clip.hpp: only the geometry (Scene, camera.hpp) is shared.
 //
-// What is drawn, in the apparatus frame of PHYSICS.md (O the rails' meeting point, x along the
-// centre line, y across, z up), in millimetres (POV-Ray's intersection tolerances are absolute,
+// What is drawn, in the apparatus frame of docs/physics.md "Frame and apparatus" (O the rails'
+// meeting point, x along the centre line, y across, z up), in millimetres (POV-Ray's intersection tolerances are absolute,
 // ~1e-6 units: metres would bring them near the size of a pixel's footprint on a rod):
 //  - the table: the plane z = table_z as a slab, wood (POV-Ray's `wood` rings along x with
 //    turbulence, fine grain noise, a satin finish with a faint reflection) or cloth (a woven

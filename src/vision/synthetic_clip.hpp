@@ -2,7 +2,8 @@
 // the tests and the benchmark of the tracker (src/vision/ball_tracker.hpp) and for
 // tools/make_video.
 //
-// What is drawn (apparatus frame of PHYSICS.md, metres): the body of a Scene (sphere or spheroid,
+// What is drawn (apparatus frame of docs/physics.md "Frame and apparatus",
+// metres): the body of a Scene (sphere or spheroid,
 // symmetry axis along y) with its centre at (x, 0, z); the two rails as round rods whose axes are
 // the rail lines (the scene's rod radius, or ClipApparatus::min_rod_radius when the scene has
 // line rails or thinner rods, so they are visible), from O to a little beyond the crossbar; the

@@ -6,7 +6,7 @@
 // and may have more columns after these (ignored here). frame: integer ≥ 0, strictly increasing;
 // t: seconds from the container's timestamps, finite, strictly increasing; u, v: the projected
 // ball centre in raw pixels; radius_px: pixels, > 0; x, z: the centre in millimetres in the
-// apparatus frame (PHYSICS.md); quality: a confidence in [0, 1]. Cells are plain numbers (the
+// apparatus frame (docs/physics.md "Frame and apparatus"); quality: a confidence in [0, 1]. Cells are plain numbers (the
 // units are fixed by the format, not written in the cells).
 //
 // Lost frames: a frame where the ball was not found keeps its row with t filled, u … z empty and

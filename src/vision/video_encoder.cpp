@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "vision/internal/child_process.hpp"
+#include "internal/child_process.hpp"
 
 namespace uphill {
 

@@ -7,7 +7,7 @@ of the C++ side). Prints a first line "versions|{JSON}", then one row per method
 
 Problem: release from rest at x0 (beyond X) of a spheroid on line rails; t(x) = integral of
 dx/xdot. As in src/motion: psi - psi0 = u0 cosh(w) removes the release singularity, and
-dt/dw = sqrt(K M / (g z_eq sinc(u0 ch^2) sinc(u0 sh^2))) is smooth (PHYSICS.md).
+dt/dw = sqrt(K M / (g z_eq sinc(u0 ch^2) sinc(u0 sh^2))) is smooth (docs/physics.md "Energy").
   quad        scipy.integrate.quad on each interval [w_{i-1}, w_i] (cumulative), epsrel = tol
   solve_ivp   dt/dw = f(w) integrated with t_eval = w_i (RK45, DOP853, LSODA), rtol = tol
   numpy GL    12-node Gauss-Legendre per interval in s, x = x0 + s^2 (removes the release

@@ -2,7 +2,8 @@
 //
 // The samples are synthetic, generated from the model so that the analysis has a known answer:
 // the lab spheroid (2 × 1.25 × 1.25 in: a = 15.875 mm, b = 25.4 mm) on line rails, H = 300 mm,
-// rolling resistance μ = 0.05 (slope threshold, PHYSICS.md), so the true farthest rest position
+// rolling resistance μ = 0.05 (slope threshold, docs/physics.md
+// "Rolling resistance"), so the true farthest rest position
 // is Y = x_rest(μ) of the true setting. Recorded L, H, D and Y carry Gaussian noise of the stated
 // standard uncertainties (seeded: the files are reproducible).
 //

@@ -1,7 +1,8 @@
 // `uphill paper-figures -o DIR`: the seed paper's model figures redrawn from uphill's model and
-// motion (SVG + PNG + the gnuplot script of each, and an index.html gallery). Where PHYSICS.md
-// shows the paper's formula wrong (eq. 8 and its speed: the separatrix, not a release at s), the
-// corrected physics is drawn and the paper's curve is added, labelled as such.
+// motion (SVG + PNG + the gnuplot script of each, and an index.html gallery). Where
+// docs/physics.md ("The seed paper's errors") shows the paper's formula wrong (eq. 8 and its
+// speed: the separatrix, not a release at s), the corrected physics is drawn and the paper's
+// curve is added, labelled as such.
 #include <boost/math/quadrature/tanh_sinh.hpp>
 #include <cmath>
 #include <cstdio>
@@ -138,7 +139,8 @@ std::vector<GnuplotFigure> SphereFigures() {
   const std::string caption_tail =
       " Sphere R = 20 mm, theta = 0, phi = 60 deg, released at rest at s = 0.1 R; ends at the fall-off x_max = "
       "R/sin(alpha/2). Dashed: the paper's eq. 8 (and its speed), which is the separatrix (energy of a body at "
-      "rest at x = 0, clock started at s), not the release from rest (PHYSICS.md).";
+      "rest at x = 0, clock started at s), not the release from rest (docs/physics.md, "
+      "\"Sphere at θ = 0\").";
   std::vector<GnuplotFigure> out;
   out.push_back({"fig_sphere_xz_t", "Sphere: x(t) and z(t)", "Position x and height z of the centre." + caption_tail,
                  traj + paper,
@@ -194,7 +196,8 @@ void Run(const std::string& dir, const std::string& data_dir) {
   Document gallery;
   gallery.title = "The seed paper's figures, redrawn by uphill";
   gallery.Paragraph("Each figure is drawn by gnuplot from the script (.gp) and data (.dat) kept beside its SVG "
-                    "and PNG in this folder. Where PHYSICS.md shows the paper's formula to be wrong, the "
+                    "and PNG in this folder. Where docs/physics.md (\"The seed paper's errors\") shows the "
+                    "paper's formula to be wrong, the "
                     "corrected physics is drawn and the paper's curve is added, labelled as such.");
   for (const auto& f : figures) {
     RenderFigure(f, dir);

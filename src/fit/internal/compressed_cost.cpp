@@ -1,4 +1,4 @@
-#include "fit/internal/compressed_cost.hpp"
+#include "compressed_cost.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>

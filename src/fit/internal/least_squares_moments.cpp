@@ -1,4 +1,4 @@
-#include "fit/internal/least_squares_moments.hpp"
+#include "least_squares_moments.hpp"
 
 #include <algorithm>
 

@@ -9,8 +9,8 @@
 // further pass over the rows, however many iterations it takes.
 #pragma once
 
-#include "fit/internal/compressed_cost.hpp"
-#include "fit/internal/line_problem.hpp"
+#include "compressed_cost.hpp"
+#include "line_problem.hpp"
 
 namespace uphill::internal {
 

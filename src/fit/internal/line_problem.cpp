@@ -1,4 +1,4 @@
-#include "fit/internal/line_problem.hpp"
+#include "line_problem.hpp"
 
 #include <Eigen/Cholesky>
 #include <algorithm>

@@ -1,4 +1,4 @@
-#include "vision/internal/child_process.hpp"
+#include "child_process.hpp"
 
 #include <fcntl.h>
 #include <signal.h>

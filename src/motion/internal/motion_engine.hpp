@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "motion/motion.hpp"
-#include "motion/path_coordinate.hpp"
+#include "path_coordinate.hpp"
 
 namespace uphill {
 

@@ -1,4 +1,4 @@
-// Closed forms of a spheroid on round rods (PHYSICS.md "Round rods"): the fall-off x_max(r) and
+// Closed forms of a spheroid on round rods (docs/physics.md "Round rods"): the fall-off x_max(r) and
 // the unstable equilibrium x_eq(r). Only z(x) needs SpheroidOnRods' numeric contact solve; these
 // two are explicit, and live here, templated on the scalar, so that ceres::Jet carries first-order
 // uncertainty propagation through exactly the expressions SpheroidOnRods evaluates.

@@ -3,7 +3,7 @@
 // derivative). Not part of the public API (see motion.hpp).
 //
 //   Ellipse (sphere, spheroid on line rails; sphere on rods as a sphere of radius R + r):
-//     q = u = ψ − ψ0, the ellipse parameter measured from the equilibrium X (PHYSICS.md
+//     q = u = ψ − ψ0, the ellipse parameter measured from the equilibrium X (docs/physics.md
 //     "Stable forms"): x = x_max·sin(ψ0 + u), z = z_eq·cos u. Measuring from ψ0 keeps full
 //     relative accuracy in u when the release is within 1e-9 of X (the escape time depends on
 //     ln u0). Range u_low = −γ − ψ0 (contact at O) … u_max = π/2 − ψ0 (fall-off, x_max); the
