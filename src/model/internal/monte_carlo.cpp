@@ -1,0 +1,410 @@
+#include "monte_carlo.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "coverage_windows.hpp"
+#include "model/batch_convert.hpp"
+#include "model/input_error.hpp"
+#include "spheroid_on_rods_closed_forms.hpp"
+
+namespace uphill::internal {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Monte Carlo.
+
+constexpr std::size_t kBlock = 1024;        // trials per block: the working set stays in L2
+constexpr std::uint64_t kPilot = 16 * kBlock;  // trials that place the coverage windows
+// Half-width of a coverage window in probability, in standard errors of the pilot's quantile
+// estimate (sqrt(p(1 − p)/pilot)): 4.5 makes a miss ≈ 7e-6 likely per window end, and a miss
+// costs a rerun (time), never accuracy; wider windows cost time on every run (~1 % of the values
+// are kept per window end).
+constexpr double kWindowSigmas = 4.5;
+
+// SplitMix64 (Steele, Lea, Flood 2014): decorrelated per-input seeds from one user seed.
+std::uint64_t SplitMix64(std::uint64_t z) {
+  z += 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+enum Reason : unsigned char {
+  kValid = 0,
+  kNonPositiveLength,
+  kNegativeHeight,
+  kAngleOutOfRange,
+  kImpossibleApparatus,
+  kConeCannotRest,
+};
+
+// Running statistics of one output: shifted sums for mean and variance (no cancellation: the
+// shift is a sample of the same output), and the two coverage windows (coverage_windows.hpp).
+struct OutputStats {
+  bool varies = true;  // false: depends on no uncertain input, every trial gives `shift`
+  bool shifted = false;
+  double shift = 0.0;
+  double sum = 0.0, sum_c = 0.0;    // Σ(y − shift), Neumaier compensation
+  double sum2 = 0.0, sum2_c = 0.0;  // Σ(y − shift)²
+  Window window[2];                 // low and high end of the coverage interval
+};
+
+void Neumaier(double* sum, double* comp, double x) {
+  const double t = *sum + x;
+  *comp += std::abs(*sum) >= std::abs(x) ? (*sum - t) + x : (x - t) + *sum;
+  *sum = t;
+}
+
+// Two-lane vectors (GCC vector extensions: SSE2 on the baseline x86-64 target, generic code
+// elsewhere); lane-wise IEEE arithmetic, so the sums are the same on every machine.
+using V2d = double __attribute__((vector_size(16)));
+using V2i = long __attribute__((vector_size(16)));  // what comparing two V2d gives
+
+void AccumulateMoments(OutputStats& s, const double* y, std::size_t n) {
+  // Four independent partial sums (two vectors of two) in a fixed order.
+  const V2d shift = {s.shift, s.shift};
+  V2d a0 = {0, 0}, a1 = {0, 0}, b0 = {0, 0}, b1 = {0, 0};
+  std::size_t j = 0;
+  for (; j + 4 <= n; j += 4) {
+    V2d y0, y1;
+    std::memcpy(&y0, y + j, sizeof y0);
+    std::memcpy(&y1, y + j + 2, sizeof y1);
+    const V2d d0 = y0 - shift, d1 = y1 - shift;
+    a0 += d0;
+    a1 += d1;
+    b0 += d0 * d0;
+    b1 += d1 * d1;
+  }
+  double a = (a0[0] + a0[1]) + (a1[0] + a1[1]), b = (b0[0] + b0[1]) + (b1[0] + b1[1]);
+  for (; j < n; ++j) {
+    const double d = y[j] - s.shift;
+    a += d;
+    b += d * d;
+  }
+  Neumaier(&s.sum, &s.sum_c, a);
+  Neumaier(&s.sum2, &s.sum2_c, b);
+}
+
+class MonteCarloRun {
+ public:
+  MonteCarloRun(const Problem& p, const PropagationOptions& o) : p_(p), o_(o) {
+    for (int k = 0; k < kOutCount; ++k)
+      if (HasOutput(p.body, k)) outputs_.push_back(k);
+    buffer_.assign(static_cast<std::size_t>(kNumInputs + kOutCount + 3) * kBlock, 0.0);
+    for (int i = 0; i < kNumInputs; ++i) std::fill_n(Input(i), kBlock, p.present[i] ? p.value[i] : 0.0);
+  }
+
+  // Runs all trials; false if a coverage window missed its order statistic. store_all keeps
+  // every value (exact selection: small M, and the rerun after a miss); otherwise a pilot of
+  // kPilot trials places the windows.
+  bool Run(bool store_all, PropagationResult* result) {
+    const std::size_t nout = outputs_.size();
+    std::vector<OutputStats> stats(nout);
+    for (std::size_t k = 0; k < nout; ++k) stats[k].varies = Varies(outputs_[k]);
+    std::vector<std::vector<double>> pilot(nout);
+    std::vector<std::vector<double>>* samples = o_.keep_samples ? &result->samples : nullptr;
+    if (samples) {
+      samples->assign(nout, {});
+      for (auto& s : *samples) s.reserve(o_.trials);
+    }
+    struct Stream {
+      int input;
+      GaussianStream gauss;
+    };
+    std::vector<Stream> streams;
+    streams.reserve(kNumInputs);
+    for (int i = 0; i < kNumInputs; ++i)
+      if (p_.present[i] && p_.u[i] > 0.0)
+        streams.push_back({i, GaussianStream(SplitMix64(o_.seed + SplitMix64(i)))});
+
+    const bool windows = !store_all && o_.trials > 4 * kPilot;
+    RejectedTrials rejected;
+    for (std::uint64_t done = 0; done < o_.trials;) {
+      const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(kBlock, o_.trials - done));
+      for (Stream& s : streams) {
+        double* in = Input(s.input);
+        s.gauss.Fill(n, in, o_.kernel);
+        const double v = p_.value[s.input], u = p_.u[s.input];
+        for (std::size_t j = 0; j < n; ++j) in[j] = v + u * in[j];
+      }
+      const std::size_t valid = Evaluate(n, &rejected);
+      for (std::size_t k = 0; k < nout; ++k) {
+        const double* y = Output(outputs_[k]);
+        OutputStats& s = stats[k];
+        if (samples) (*samples)[k].insert((*samples)[k].end(), y, y + valid);
+        if (valid == 0) continue;
+        if (!s.shifted) {
+          s.shifted = true;
+          s.shift = y[0];
+        }
+        if (!s.varies) continue;
+        AccumulateMoments(s, y, valid);
+        if (!windows) {  // one window holding everything serves both ends
+          s.window[0].kept.Append(y, valid);
+        } else if (done < kPilot) {
+          pilot[k].insert(pilot[k].end(), y, y + valid);
+        } else {
+          CountWindows(s.window, y, valid, o_.kernel);
+        }
+      }
+      done += n;
+      if (windows && done == kPilot) PlaceWindows(pilot, &stats);
+    }
+    return Finish(stats, rejected, windows, result);
+  }
+
+  const MonteCarloValue& value(int slot) const { return values_[slot]; }
+
+ private:
+  double* Input(int i) { return buffer_.data() + static_cast<std::size_t>(i) * kBlock; }
+  double* Output(int k) { return buffer_.data() + static_cast<std::size_t>(kNumInputs + k) * kBlock; }
+  double* Scratch(int s) {
+    return buffer_.data() + static_cast<std::size_t>(kNumInputs + kOutCount + s) * kBlock;
+  }
+  bool Uncertain(InputQuantity q) const { return p_.u[Index(q)] > 0.0; }
+
+  // Whether an output can vary between trials: whether any input it depends on is uncertain.
+  // An output that cannot vary gets u = 0 and the interval [y, y] without any statistics. (Were a
+  // constant output treated as varying, every value would land in its windows: slow, still exact.)
+  bool Varies(int slot) const {
+    using Q = InputQuantity;
+    auto bit = [](Q q) { return 1u << Index(q); };
+    const bool apparatus = p_.given == UncertainRails::Given::kApparatus;
+    const bool along_rail = apparatus && p_.convention == LConvention::kAlongRail;
+    const unsigned lh = along_rail ? bit(Q::kL) | bit(Q::kH) | bit(Q::kD) : bit(Q::kL);
+    // B = tanθ and T = tan(α/2) depend on:
+    const unsigned slope_b = apparatus ? lh | bit(Q::kH) : bit(Q::kTheta);
+    const unsigned slope_t = apparatus ? lh | bit(Q::kD) : bit(Q::kAlpha);
+    const unsigned body = bit(Q::kAcross) | bit(Q::kAlong) | bit(Q::kRodRadius);
+    unsigned deps = 0;
+    switch (slot) {
+      case kOutTheta: deps = slope_b; break;
+      case kOutAlpha: deps = slope_t; break;
+      case kOutPhi: deps = slope_b | slope_t; break;
+      case kOutXEq: deps = slope_b | slope_t | body; break;
+      case kOutXMax:  // hypot(a, b/T) (+ r/sin(α/2)); the cone's x_fall = h/T
+        deps = p_.body == BodyKind::kDoubleCone ? slope_t | bit(Q::kAlong) : slope_t | body;
+        break;
+      case kOutTheta0: deps = slope_t | bit(Q::kAcross) | bit(Q::kAlong); break;
+    }
+    for (int i = 0; i < kNumInputs; ++i)
+      if ((deps & (1u << i)) && p_.u[i] > 0.0) return true;
+    return false;
+  }
+
+  // Screens the block's draws, evaluates the model, and compacts the outputs to the valid trials.
+  std::size_t Evaluate(std::size_t n, RejectedTrials* rejected) {
+    // Reasons are assigned only once a draw fails: the common case is one vectorised count per
+    // uncertain input (the comparisons written with & so that there is no branch to vectorise).
+    unsigned char reason[kBlock];
+    bool any_bad = false;
+    auto mark = [&](std::size_t j, Reason why) {
+      if (!any_bad) {
+        std::fill(reason, reason + n, kValid);
+        any_bad = true;
+      }
+      if (reason[j] == kValid) reason[j] = why;
+    };
+    // `bad` is generic: on a double it gives a bool, on a V2d a lane mask (-1 or 0) to count with.
+    // Draws are finite (value + u·z), so the comparisons need no NaN care.
+    auto screen = [&](InputQuantity q, Reason why, auto bad) {
+      if (!Uncertain(q)) return;  // the nominal value passed the model's checks
+      const double* x = Input(Index(q));
+      V2i count = {0, 0};
+      std::size_t j = 0;
+      for (; j + 2 <= n; j += 2) {
+        V2d v;
+        std::memcpy(&v, x + j, sizeof v);
+        count -= bad(v);
+      }
+      bool any = count[0] != 0 || count[1] != 0;
+      for (; j < n; ++j) any |= bad(x[j]);
+      if (!any) return;
+      for (j = 0; j < n; ++j)
+        if (bad(x[j])) mark(j, why);
+    };
+    auto non_positive = [](auto v) { return v <= 0.0; };
+    screen(InputQuantity::kL, kNonPositiveLength, non_positive);
+    screen(InputQuantity::kD, kNonPositiveLength, non_positive);
+    screen(InputQuantity::kAcross, kNonPositiveLength, non_positive);
+    screen(InputQuantity::kAlong, kNonPositiveLength, non_positive);
+    screen(InputQuantity::kRodRadius, kNonPositiveLength, non_positive);
+    screen(InputQuantity::kH, kNegativeHeight, [](auto v) { return v < 0.0; });
+    screen(InputQuantity::kTheta, kAngleOutOfRange,
+           [](auto v) { return (v < 0.0) | (v >= std::numbers::pi / 2); });
+    screen(InputQuantity::kAlpha, kAngleOutOfRange,
+           [](auto v) { return (v <= 0.0) | (v >= std::numbers::pi); });
+    const bool apparatus = p_.given == UncertainRails::Given::kApparatus;
+    const double* L = Input(Index(InputQuantity::kL));
+    const double* H = Input(Index(InputQuantity::kH));
+    const double* D = Input(Index(InputQuantity::kD));
+    if (apparatus && p_.convention == LConvention::kAlongRail &&
+        (Uncertain(InputQuantity::kL) || Uncertain(InputQuantity::kH) || Uncertain(InputQuantity::kD))) {
+      for (std::size_t j = 0; j < n; ++j)
+        if (!(L[j] > std::hypot(H[j], D[j] / 2))) mark(j, kImpossibleApparatus);
+    }
+
+    double* B = Scratch(0);
+    double* T = Scratch(1);
+    RailsArrays rails;
+    rails.theta = Output(kOutTheta);
+    rails.alpha = Output(kOutAlpha);
+    rails.phi = Output(kOutPhi);
+    rails.tan_theta = B;
+    rails.tan_half_alpha = T;
+    if (apparatus) {
+      RailsFromApparatusBatch(n, L, H, D, p_.convention, rails, o_.kernel);
+    } else {
+      RailsFromAnglesBatch(n, Input(Index(InputQuantity::kTheta)), Input(Index(InputQuantity::kAlpha)),
+                           rails, o_.kernel);
+    }
+    const double* across = Input(Index(InputQuantity::kAcross));
+    const double* along = Input(Index(InputQuantity::kAlong));
+    const double* r = Input(Index(InputQuantity::kRodRadius));
+    switch (p_.body) {
+      case BodyKind::kSphere: {
+        const double* R = across;
+        if (p_.rods) {  // as Scene: the sphere of radius R + r on the rods' axes
+          double* enlarged = Scratch(2);
+          for (std::size_t j = 0; j < n; ++j) enlarged[j] = across[j] + r[j];
+          R = enlarged;
+        }
+        SpheroidBatch(n, R, R, nullptr, B, T, Output(kOutXEq), Output(kOutXMax), o_.kernel);
+        break;
+      }
+      case BodyKind::kSpheroid:
+        SpheroidBatch(n, across, along, p_.rods ? r : nullptr, B, T, Output(kOutXEq),
+                      Output(kOutXMax), o_.kernel);
+        break;
+      case BodyKind::kDoubleCone: {
+        double* q = Scratch(2);
+        DoubleConeBatch(n, across, along, B, T, Output(kOutXMax), Output(kOutTheta0), q, o_.kernel);
+        if (!streams_empty())
+          for (std::size_t j = 0; j < n; ++j)
+            if (!(q[j] > 0.0)) mark(j, kConeCannotRest);
+        break;
+      }
+    }
+
+    if (!any_bad) return n;
+    std::size_t bad = 0;
+    for (std::size_t j = 0; j < n; ++j) bad += reason[j] != kValid;
+    for (std::size_t j = 0; j < n; ++j) {
+      switch (reason[j]) {
+        case kValid: break;
+        case kNonPositiveLength: ++rejected->non_positive_length; break;
+        case kNegativeHeight: ++rejected->negative_height; break;
+        case kAngleOutOfRange: ++rejected->angle_out_of_range; break;
+        case kImpossibleApparatus: ++rejected->impossible_apparatus; break;
+        case kConeCannotRest: ++rejected->cone_cannot_rest; break;
+      }
+    }
+    for (int k : outputs_) {
+      double* y = Output(k);
+      std::size_t w = 0;
+      for (std::size_t j = 0; j < n; ++j)
+        if (reason[j] == kValid) y[w++] = y[j];
+    }
+    return n - bad;
+  }
+  bool streams_empty() const {
+    for (int i = 0; i < kNumInputs; ++i)
+      if (p_.u[i] > 0.0) return false;
+    return true;
+  }
+
+  // Windows from the pilot's order statistics at p ± kWindowSigmas·sqrt(p(1 − p)/pilot); the
+  // pilot's values then go through them like every later value.
+  void PlaceWindows(std::vector<std::vector<double>>& pilot, std::vector<OutputStats>* stats) {
+    const double ends[2] = {(1.0 - o_.coverage) / 2, (1.0 + o_.coverage) / 2};
+    for (std::size_t k = 0; k < outputs_.size(); ++k) {
+      std::vector<double>& v = pilot[k];
+      OutputStats& s = (*stats)[k];
+      if (!s.varies) continue;
+      const double m = static_cast<double>(v.size());
+      for (int e = 0; e < 2; ++e) {
+        Window& w = s.window[e];
+        w = Window{};
+        if (v.empty()) continue;  // every pilot trial rejected: the window keeps everything
+        const double half = kWindowSigmas * std::sqrt(ends[e] * (1.0 - ends[e]) / m);
+        const double lo_p = ends[e] - half, hi_p = ends[e] + half;
+        if (lo_p > 0.0) {
+          const auto it = v.begin() + static_cast<std::ptrdiff_t>(std::floor(lo_p * (m - 1)));
+          std::nth_element(v.begin(), it, v.end());
+          w.lo = *it;
+        }
+        if (hi_p < 1.0) {
+          const auto it = v.begin() + static_cast<std::ptrdiff_t>(std::ceil(hi_p * (m - 1)));
+          std::nth_element(v.begin(), it, v.end());
+          w.hi = *it;
+        }
+        w.kept.Reserve(static_cast<std::size_t>(2.5 * half * static_cast<double>(o_.trials)) + 64);
+      }
+      CountWindows(s.window, v.data(), v.size(), o_.kernel);
+      std::vector<double>().swap(v);
+    }
+  }
+
+  bool Finish(std::vector<OutputStats>& stats, const RejectedTrials& rejected, bool windows,
+              PropagationResult* result) {
+    result->rejected = rejected;
+    result->valid_trials = o_.trials - rejected.total();
+    const std::uint64_t m = result->valid_trials;
+    if (m < 2)
+      throw InputError("Monte Carlo", "only " + std::to_string(m) + " of " +
+                                          std::to_string(o_.trials) +
+                                          " trials are physical: the uncertainties are too large "
+                                          "for this configuration");
+    std::uint64_t rank[2];
+    CoverageRanks(m, o_.coverage, &rank[0], &rank[1]);
+    bool hit = true;
+    for (std::size_t k = 0; k < outputs_.size(); ++k) {
+      OutputStats& s = stats[k];
+      MonteCarloValue& v = values_[outputs_[k]];
+      if (!s.varies) {  // exactly the one value every trial gave
+        v = MonteCarloValue{s.shift, 0.0, s.shift, s.shift};
+        continue;
+      }
+      const double n = static_cast<double>(m);
+      const double sum = s.sum + s.sum_c, sum2 = s.sum2 + s.sum2_c;
+      v.mean = s.shift + sum / n;
+      v.u = std::sqrt(std::max(0.0, (sum2 - sum * (sum / n)) / (n - 1)));
+      for (int e = 0; e < 2; ++e) {
+        const std::optional<double> y = Select(windows ? s.window[e] : s.window[0], rank[e]);
+        if (!y) {
+          hit = false;
+          continue;
+        }
+        (e == 0 ? v.low : v.high) = *y;
+      }
+    }
+    return hit;
+  }
+
+  const Problem& p_;
+  const PropagationOptions& o_;
+  std::vector<int> outputs_;
+  std::vector<double> buffer_;
+  MonteCarloValue values_[kOutCount];
+};
+
+}  // namespace
+
+void MonteCarlo(const Problem& p, const PropagationOptions& options, PropagationResult* result,
+                MonteCarloValue (&values)[kOutCount]) {
+  MonteCarloRun mc(p, options);
+  if (!mc.Run(/*store_all=*/false, result)) {
+    // A window missed its order statistic (improbable by design): redo the same trials and
+    // select exactly from all of them.
+    ++result->window_reruns;
+    mc.Run(/*store_all=*/true, result);
+  }
+  for (int k = 0; k < kOutCount; ++k)
+    if (HasOutput(p.body, k)) values[k] = mc.value(k);
+}
+
+}  // namespace uphill::internal
