@@ -2,6 +2,7 @@
 // kAvx2 within a few ulp; both against the 60-digit references; and GaussianStream bit for bit
 // against boost::random::normal_distribution.
 #include "model/batch_convert.hpp"
+#include "model/gaussian_stream.hpp"
 
 #include <gtest/gtest.h>
 

@@ -31,7 +31,7 @@
 // (options.seed, the input's identity); the Gaussian draws are exactly the values of
 // boost::random::normal_distribution<double> on that stream (a fixed ziggurat, unlike
 // std::normal_distribution, whose algorithm is implementation-defined), produced by
-// GaussianStream (batch_convert.hpp), which has a vectorised fast path that is bit-identical to
+// GaussianStream (gaussian_stream.hpp), which has a vectorised fast path that is bit-identical to
 // Boost. So the trials' inputs depend only on the seed and the Boost version, not on the machine,
 // and a draw of D does not change when another input gains or loses its uncertainty. The outputs
 // come from the batch kernel (batch_convert.hpp): the same numbers on every run, to a few ulp the

@@ -8,8 +8,8 @@
 
 #include "coverage_windows.hpp"
 #include "model/batch_convert.hpp"
+#include "model/gaussian_stream.hpp"
 #include "model/input_error.hpp"
-#include "spheroid_on_rods_closed_forms.hpp"
 
 namespace uphill::internal {
 namespace {
