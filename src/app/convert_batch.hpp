@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "io/configuration.hpp"
-#include "io/conversion.hpp"
+#include "app/conversion.hpp"
 
 namespace uphill {
 

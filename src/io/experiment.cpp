@@ -1,11 +1,10 @@
 #include "io/experiment.hpp"
 
-#include <filesystem>
+#include <algorithm>
 #include <map>
 #include <set>
 
 #include "io/csv_table.hpp"
-#include "io/json_file.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 
@@ -14,14 +13,12 @@ namespace {
 
 using nlohmann::json;
 
-const std::set<std::string> kTopKeys = {"format", "title", "operator", "date", "notes", "body",
-                                         "apparatus", "uncertainties"};
-const std::set<std::string> kApparatusKeys = {"L", "H", "D", "theta", "alpha", "rod_diameter",
-                                              "L_convention"};
-const std::set<std::string> kUncertaintyKeys = {"L", "H", "D", "Y", "R", "a", "b", "h",
-                                                "theta", "alpha", "rod_diameter"};
-const std::set<std::string> kColumns = {"trial", "series", "note", "L", "H", "D", "Y",
-                                        "u_L", "u_H", "u_D", "u_Y"};
+bool IsColumn(const std::string& name) {
+  const auto& labels = MeasurementLabelColumns();
+  const auto& quantities = MeasurementQuantities();
+  return std::find(labels.begin(), labels.end(), name) != labels.end() ||
+         std::find(quantities.begin(), quantities.end(), name) != quantities.end();
+}
 
 // A JSON value for a message: scalars as written, arrays and objects by their type only. Dumping
 // them recursed once per nesting level: a value nested 2·10^5 deep (a 400 KB file) overflowed
@@ -71,15 +68,14 @@ std::vector<std::string> Experiment::Errors() const {
 }
 
 Experiment LoadExperiment(const std::string& directory) {
-  namespace fs = std::filesystem;
-  if (!fs::is_directory(directory)) throw InputError(directory, "is not an experiment folder");
-  const std::string json_path = (fs::path(directory) / "experiment.json").string();
-  const std::string csv_path = (fs::path(directory) / "measurements.csv").string();
+  ExperimentFolder folder = ReadExperimentJson(directory);
+  const std::string& json_path = folder.json_path;
+  const std::string& csv_path = folder.csv_path;
   Experiment e;
   e.directory = directory;
-  e.metadata = ReadJsonFile(json_path);
+  e.metadata = std::move(folder.metadata);
   const json& meta = e.metadata;
-  CheckKeys(meta, kTopKeys, json_path);
+  CheckKeys(meta, ExperimentKeys(), json_path);
   if (!meta.contains("format") || meta.at("format") != kExperimentFormat)
     throw InputError(json_path + ": format",
                      std::string("must be \"") + kExperimentFormat + "\" (got " +
@@ -90,7 +86,7 @@ Experiment LoadExperiment(const std::string& directory) {
   e.notes = OptionalString(meta, "notes", json_path);
   if (!meta.contains("body")) throw InputError(json_path + ": body", "is missing");
   const json& body = meta.at("body");
-  CheckKeys(body, {"type", "R", "a", "b", "h"}, json_path + ": body");
+  CheckKeys(body, BodyKeys(), json_path + ": body");
   // Without this check body.at("type") below threw json::out_of_range (found by fuzzing).
   if (!body.contains("type"))
     throw InputError(json_path + ": body.type", "is missing (sphere, spheroid or double-cone)");
@@ -98,9 +94,9 @@ Experiment LoadExperiment(const std::string& directory) {
   // nesting level.
   static const json kNone = json::object();
   const json& apparatus = meta.contains("apparatus") ? meta.at("apparatus") : kNone;
-  CheckKeys(apparatus, kApparatusKeys, json_path + ": apparatus");
+  CheckKeys(apparatus, ApparatusKeys(), json_path + ": apparatus");
   const json& defaults = meta.contains("uncertainties") ? meta.at("uncertainties") : kNone;
-  CheckKeys(defaults, kUncertaintyKeys, json_path + ": uncertainties");
+  CheckKeys(defaults, UncertaintyKeys(), json_path + ": uncertainties");
   // Every value of these objects is a string, checked now and not only when a row looks it up:
   // an unused value stays in `metadata`, which fit.json copies and dumps, recursively (a deeply
   // nested value overflowed the stack).
@@ -108,12 +104,13 @@ Experiment LoadExperiment(const std::string& directory) {
                                      {&apparatus, "apparatus"}, {&defaults, "uncertainties"}})
     for (const auto& [key, value] : object->items()) Text(value, json_path + ": " + name + "." + key);
 
+  // Required here (the page may create a folder before its first row; an analysis needs rows).
   const CsvTable table = ReadCsvFile(csv_path);
   std::map<std::string, int> column;  // quantity -> column index
   for (size_t i = 0; i < table.header.size(); ++i) {
     const std::string base = SplitUnitSuffix(table.header[i]).first;
     const std::string where = CellContext(table, 1, table.header[i]);
-    if (!kColumns.count(base)) throw InputError(where, "unknown column (see data/README.md)");
+    if (!IsColumn(base)) throw InputError(where, "unknown column (see data/README.md)");
     if (!column.emplace(base, static_cast<int>(i)).second)
       throw InputError(where, "gives '" + base + "' a second time");
     if (apparatus.contains(base))

@@ -1,5 +1,5 @@
 // Experiment: the folder lab technicians and the other tools share (format uphill-experiment/1,
-// documented in data/README.md):
+// documented in data/README.md), read through experiment_folder.hpp:
 //
 //   EXP/experiment.json    apparatus constants, body, L convention, default standard
 //                          uncertainties, operator, date, notes; values carry units ("300 mm")
@@ -21,10 +21,9 @@
 #include <vector>
 
 #include "io/configuration.hpp"
+#include "io/experiment_folder.hpp"
 
 namespace uphill {
-
-inline constexpr const char* kExperimentFormat = "uphill-experiment/1";
 
 struct ExperimentRow {
   int row = 0;  // spreadsheet row in measurements.csv (header = 1)

@@ -126,4 +126,17 @@ std::pair<std::string, std::string> SplitUnitSuffix(const std::string& header) {
   return {header, ""};
 }
 
+std::vector<double> ParseQuantityList(const std::string& text, Dimension dimension, const std::string& quantity) {
+  std::vector<double> out;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = text.find(',', start);
+    out.push_back(ParseQuantity(std::string_view(text).substr(start, comma == std::string::npos ? std::string::npos
+                                                                                                : comma - start),
+                                dimension, quantity));
+    if (comma == std::string::npos) return out;
+    start = comma + 1;
+  }
+}
+
 }  // namespace uphill

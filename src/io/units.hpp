@@ -15,6 +15,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace uphill {
 
@@ -32,6 +33,10 @@ double UnitFactor(Dimension dimension, std::string_view unit);
 // missing unit, or a unit of the wrong dimension.
 double ParseQuantity(std::string_view text, Dimension dimension, const std::string& quantity,
                      std::string_view default_unit = {});
+
+// A comma-separated list of quantities ("110mm,12cm"), each parsed as ParseQuantity does; an
+// empty item is an empty value (refused).
+std::vector<double> ParseQuantityList(const std::string& text, Dimension dimension, const std::string& quantity);
 
 // The number in `value_si` expressed in `unit` (e.g. 0.0254 m in "in" -> 1).
 double ToUnit(double value_si, Dimension dimension, std::string_view unit);

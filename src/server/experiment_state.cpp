@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "io/csv_table.hpp"
-#include "io/experiment.hpp"
+#include "io/experiment_folder.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 
@@ -20,14 +20,6 @@ namespace {
 
 using nlohmann::json;
 using nlohmann::ordered_json;
-
-const std::set<std::string> kTopKeys = {"format", "title", "operator", "date", "notes", "body",
-                                        "apparatus", "uncertainties"};
-const std::set<std::string> kBodyKeys = {"type", "R", "a", "b", "h"};
-const std::set<std::string> kApparatusKeys = {"L", "H", "D", "theta", "alpha", "rod_diameter",
-                                              "L_convention"};
-const std::set<std::string> kUncertaintyKeys = {"L", "H", "D", "Y", "R", "a", "b", "h",
-                                                "theta", "alpha", "rod_diameter"};
 
 // experiment.json's keys in the order of data/README.md, whatever order a request or the journal
 // (whose objects are sorted) has them in: the file on disk stays readable and stable.
@@ -107,10 +99,7 @@ std::string FormatNumber(double v) {
 
 }  // namespace
 
-const std::vector<std::string>& RowQuantities() {
-  static const std::vector<std::string> q = {"L", "H", "D", "Y", "u_L", "u_H", "u_D", "u_Y"};
-  return q;
-}
+const std::vector<std::string>& RowQuantities() { return MeasurementQuantities(); }
 
 const std::string& Row::Value(const std::string& quantity) const {
   static const std::string empty;
@@ -246,7 +235,7 @@ Row ValidateRow(const json& j, const ExperimentState& state) {
 ordered_json ValidateMetadata(const json& j) {
   if (!j.is_object()) throw InputError("experiment", "must be a JSON object");
   for (const auto& [key, value] : j.items())
-    if (!kTopKeys.count(key)) throw InputError("experiment." + key.substr(0, 32), "unknown key");
+    if (!ExperimentKeys().count(key)) throw InputError("experiment." + key.substr(0, 32), "unknown key");
   ordered_json out;
   out["format"] = kExperimentFormat;
   if (j.contains("format") && j.at("format") != kExperimentFormat)
@@ -276,7 +265,7 @@ ordered_json ValidateMetadata(const json& j) {
   const json& body = j.at("body");
   ordered_json out_body;
   for (const auto& [key, value] : body.items())
-    if (!kBodyKeys.count(key)) throw InputError("experiment.body." + key.substr(0, 32), "unknown key");
+    if (!BodyKeys().count(key)) throw InputError("experiment.body." + key.substr(0, 32), "unknown key");
   const std::string type = CheckText(body.value("type", json("")), "experiment.body.type", 32);
   if (type != "sphere" && type != "spheroid" && type != "double-cone")
     throw InputError("experiment.body.type", "must be sphere, spheroid or double-cone");
@@ -301,7 +290,7 @@ ordered_json ValidateMetadata(const json& j) {
     if (!j.contains(section)) continue;
     const json& s = j.at(section);
     if (!s.is_object()) throw InputError(std::string("experiment.") + section, "must be a JSON object");
-    const auto& keys = std::string(section) == "apparatus" ? kApparatusKeys : kUncertaintyKeys;
+    const auto& keys = std::string(section) == "apparatus" ? ApparatusKeys() : UncertaintyKeys();
     ordered_json o = ordered_json::object();
     for (const auto& [key, value] : s.items()) {
       const std::string field = std::string("experiment.") + section + "." + key.substr(0, 32);
@@ -374,30 +363,19 @@ json ApplyOperation(ExperimentState& state, const json& op) {
 }
 
 ExperimentState LoadStateFromFiles(const std::string& directory) {
-  namespace fs = std::filesystem;
-  const std::string json_path = (fs::path(directory) / "experiment.json").string();
-  const std::string csv_path = (fs::path(directory) / "measurements.csv").string();
+  const ExperimentFolder folder = ReadExperimentJson(directory);
   ExperimentState state;
-  std::ifstream in(json_path, std::ios::binary);
-  if (!in) throw InputError(json_path, "cannot be read");
-  std::stringstream text;
-  text << in.rdbuf();
-  json meta;
   try {
-    meta = json::parse(text.str());
-  } catch (const json::exception& e) {
-    throw InputError(json_path, std::string("is not valid JSON: ") + e.what());
-  }
-  try {
-    state.metadata = ValidateMetadata(meta);
+    state.metadata = ValidateMetadata(folder.metadata);
   } catch (const InputError& e) {
-    throw InputError(json_path + ": " + e.quantity(), e.rule());
+    throw InputError(folder.json_path + ": " + e.quantity(), e.rule());
   }
   // Keep what ValidateMetadata would drop only for being empty: the file is the authority here.
-  state.metadata = Canonical(meta);
+  state.metadata = Canonical(folder.metadata);
   state.exists = true;
-  if (!fs::exists(csv_path)) return state;
-  const CsvTable table = ReadCsvFile(csv_path);
+  const std::optional<CsvTable> measurements = ReadMeasurements(folder);
+  if (!measurements) return state;
+  const CsvTable& table = *measurements;
   const int y = [&] {
     for (std::size_t i = 0; i < table.header.size(); ++i)
       if (SplitUnitSuffix(table.header[i]).first == "Y") return static_cast<int>(i);

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "io/atomic_file.hpp"
+#include "io/experiment_folder.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill {
@@ -69,8 +70,8 @@ std::string ContentHash(const std::string& bytes) {
 }
 
 ExperimentStore::ExperimentStore(std::string directory) : directory_(std::move(directory)) {
-  const std::string json_path = (fs::path(directory_) / "experiment.json").string();
-  const std::string csv_path = (fs::path(directory_) / "measurements.csv").string();
+  const std::string json_path = (fs::path(directory_) / kExperimentJsonFile).string();
+  const std::string csv_path = (fs::path(directory_) / kMeasurementsCsvFile).string();
   const std::string journal_path = (fs::path(directory_) / kJournalFile).string();
   json_hash_ = HashOfFile(json_path);
   csv_hash_ = HashOfFile(csv_path);
@@ -194,11 +195,11 @@ void ExperimentStore::WriteFiles() {
   const std::string csv_text = state_.MeasurementsCsv();
   // experiment.json first: recovery accepts a new experiment.json with the previous CSV.
   if (const std::string h = ContentHash(json_text); h != json_hash_) {
-    WriteFileAtomically((fs::path(directory_) / "experiment.json").string(), json_text);
+    WriteFileAtomically((fs::path(directory_) / kExperimentJsonFile).string(), json_text);
     json_hash_ = h;
   }
   if (const std::string h = ContentHash(csv_text); h != csv_hash_) {
-    WriteFileAtomically((fs::path(directory_) / "measurements.csv").string(), csv_text);
+    WriteFileAtomically((fs::path(directory_) / kMeasurementsCsvFile).string(), csv_text);
     csv_hash_ = h;
   }
 }

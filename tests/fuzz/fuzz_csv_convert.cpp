@@ -1,52 +1,49 @@
-// Fuzz target: ReadCsv followed by what `uphill convert --batch` does with the table
-// (tools/uphill/convert_command.cpp, ConvertBatch, without command-line defaults): the column
-// check of ConfigurationTable, ParseConfiguration per row, Convert (first-order
-// uncertainties only: Monte Carlo trials = 0), a point on the path, and the JSON output.
-// Only uphill::InputError may escape a step; anything else (a crash, a sanitizer report, another
-// exception) is a bug.
+// Fuzz target: the batch path of `uphill convert --batch` itself (ConvertBatch of
+// src/app/convert_batch.hpp, reading the CSV record by record, without command-line defaults):
+// the column check, ParseConfiguration per row (or the numeric short path), Convert with
+// first-order uncertainties only (Monte Carlo trials = 0) and the rest band, and the JSON of
+// every row converted; then a point halfway along each path, as --at-x would ask for. Only
+// uphill::InputError may escape; anything else (a crash, a sanitizer report, another exception)
+// is a bug.
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <sstream>
 #include <string>
 
-#include "io/configuration.hpp"
-#include "io/configuration_table.hpp"
-#include "io/conversion.hpp"
-#include "io/csv_table.hpp"
-#include "io/units.hpp"
+#include "app/convert_batch.hpp"
 #include "model/input_error.hpp"
 
 namespace {
 
 using namespace uphill;
 
-void ConvertRow(const ConfigurationTable& configurations, const CsvRow& row) {
-  if (!row.error.empty()) return;
-  const Configuration c = ParseConfiguration(configurations.RowSource(row));
-  ConversionOptions options;
-  options.mu = 0.01;
-  options.propagation.trials = 0;  // first order only: Monte Carlo is the model's, not the reader's
-  const ConversionResult r = Convert(c, options);
-  (void)ToJson(r).dump();
-  // A point halfway along the path, as --at-x would ask for.
-  options.mu.reset();
-  options.at_x = {0.5 * (r.scene.x_low() + r.scene.x_max())};
-  (void)ToJson(Convert(c, options)).dump();
+// No command-line defaults: every field comes from the table.
+FieldSource NoDefaults() {
+  FieldSource s;
+  s.lookup = [](const std::string&) -> std::optional<FieldSource::Field> { return std::nullopt; };
+  s.context = [](const std::string& name) { return name; };
+  return s;
 }
 
 void Run(const std::string& text) {
   std::istringstream in(text);
-  const CsvTable table = ReadCsv(in, "fuzz.csv");
-  const ConfigurationTable configurations(table);
-  size_t converted = 0;
-  for (const CsvRow& row : table.rows) {
-    if (++converted > 32) break;  // enough rows to mix good and bad ones; keeps runs fast
+  ConversionOptions options;
+  options.mu = 0.01;
+  options.propagation.trials = 0;  // first order only: Monte Carlo is the model's, not the reader's
+  int rows = 0;
+  ConvertBatch(in, "fuzz.csv", NoDefaults(), options, [](const BatchHeader&) {}, [&](const ConvertedRow& row) {
+    if (++rows > 32 || !row.result) return;  // a bad row: reported by convert, the others go on
+    (void)ToJson(*row.result).dump();
+    ConversionOptions at_x;
+    at_x.propagation.trials = 0;
+    at_x.at_x = {0.5 * (row.result->scene.x_low() + row.result->scene.x_max())};
     try {
-      ConvertRow(configurations, row);
+      (void)ToJson(Convert(row.result->configuration, at_x)).dump();
     } catch (const InputError&) {
-      // A bad row: reported by convert, the other rows go on.
+      // A midpoint off the path of a degenerate scene: refused like any --at-x.
     }
-  }
+  });
 }
 
 }  // namespace

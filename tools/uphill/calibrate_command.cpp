@@ -3,7 +3,8 @@
 //   calibrate scene --camera cam.json --points POINTS.csv -o scene.json [--frame FRAME.png]
 //   calibrate scene --camera cam.json --board-image TABLE.png --cols … --board-origin … -o scene.json
 //   calibrate target --cols 9 --rows 6 --square 20mm -o board.svg|board.png
-// The numbers are printed with their units; the files' formats are in calibration/README.md.
+// The numbers are printed with their units; the files' formats are in calibration/README.md. The
+// points file and the target: src/app/calibration_inputs.hpp.
 #include <memory>
 #include <string>
 #include <vector>
@@ -20,8 +21,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "app/calibration_inputs.hpp"
 #include "io/atomic_file.hpp"
-#include "io/csv_table.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "vision/calibration.hpp"
@@ -54,7 +55,6 @@ void AddTargetFlags(CLI::App* cmd, TargetFlags* f, bool square_required) {
 }
 
 #if UPHILL_VISION_PROGRAM
-
 
 std::string Num(double v, int precision = 6) {
   std::ostringstream out;
@@ -121,52 +121,6 @@ void RunCamera(const CalibrateFlags& f) {
 
 // ---- scene ----
 
-// POINTS.csv: u, v in pixels (columns `u`, `v` or `u_px`, `v_px`), x, y, z in the apparatus
-// frame with a length unit in the header (`x_mm`) or in every cell (`x` = "120mm"); optional
-// `name` (used in messages) and `note` (ignored).
-std::vector<ScenePoint> ReadPoints(const std::string& path) {
-  const CsvTable table = ReadCsvFile(path);
-  int u = -1, v = -1, xyz[3] = {-1, -1, -1}, name = -1;
-  std::string xyz_unit[3];
-  for (size_t i = 0; i < table.header.size(); ++i) {
-    const std::string& h = table.header[i];
-    const int column = static_cast<int>(i);
-    const auto [stem, unit] = SplitUnitSuffix(h);
-    if (h == "u" || h == "u_px") {
-      u = column;
-    } else if (h == "v" || h == "v_px") {
-      v = column;
-    } else if ((stem == "x" || stem == "y" || stem == "z") &&
-               (unit.empty() || UnitFactor(Dimension::kLength, unit) > 0)) {
-      xyz[stem[0] - 'x'] = column;
-      xyz_unit[stem[0] - 'x'] = unit;
-    } else if (h == "name") {
-      name = column;
-    } else if (h != "note") {
-      throw InputError(CellContext(table, 1, h),
-                       "unknown column (expected u, v in pixels, x, y, z with a length unit as in x_mm, "
-                       "and optionally name, note)");
-    }
-  }
-  if (u < 0 || v < 0 || xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0)
-    throw InputError(table.source + ", row 1", "the header must have the columns u, v, x, y, z (e.g. u,v,x_mm,y_mm,z_mm)");
-  std::vector<ScenePoint> points;
-  for (const CsvRow& row : table.rows) {
-    if (!row.error.empty()) throw InputError(table.source + ", row " + std::to_string(row.row), row.error);
-    ScenePoint p;
-    const auto cell = [&](int column) -> const std::string& { return row.cells[column]; };
-    const auto where = [&](int column) { return CellContext(table, row.row, table.header[column]); };
-    p.label = table.source + ", row " + std::to_string(row.row);
-    if (name >= 0 && !cell(name).empty()) p.label += " (" + cell(name) + ")";
-    p.pixel = {ParseQuantity(cell(u), Dimension::kDimensionless, where(u)),
-               ParseQuantity(cell(v), Dimension::kDimensionless, where(v))};
-    for (int k = 0; k < 3; ++k)
-      p.position[k] = ParseQuantity(cell(xyz[k]), Dimension::kLength, where(xyz[k]), xyz_unit[k]);
-    points.push_back(p);
-  }
-  return points;
-}
-
 // "+x", "-y", "+z" etc.: a unit vector of the apparatus frame.
 Eigen::Vector3d Axis(const std::string& text, const std::string& flag) {
   if (text.size() == 2 && (text[0] == '+' || text[0] == '-') && text[1] >= 'x' && text[1] <= 'z') {
@@ -211,7 +165,7 @@ void RunScene(const CalibrateFlags& f) {
       frame_height = frame.rows;
     }
     try {
-      r = CalibrateScene(camera, ReadPoints(f.points), frame_width, frame_height);
+      r = CalibrateScene(camera, ReadScenePoints(f.points), frame_width, frame_height);
     } catch (const InputError& e) {
       // The library names rows (labels) or "points"/"frame"; say which file was meant.
       const std::string& q = e.quantity();
@@ -243,43 +197,20 @@ void RunScene(const CalibrateFlags& f) {
 
 // ---- target ----
 
-std::string TargetSvg(const ChessboardTarget& t) {
-  const double s = t.square * 1000;  // mm
-  const int nx = t.cols + 1, ny = t.rows + 1;
-  const double w = (nx + 2) * s, h = (ny + 2) * s;
-  std::ostringstream svg;
-  svg << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-      << "<!-- uphill calibrate target: " << t.cols << "x" << t.rows << " inner corners, " << Num(s)
-      << " mm squares. Print at 100 % (no scaling) and measure a square before calibrating. -->\n"
-      << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << Num(w) << "mm\" height=\"" << Num(h)
-      << "mm\" viewBox=\"0 0 " << Num(w) << " " << Num(h) << "\">\n"
-      << "<rect width=\"" << Num(w) << "\" height=\"" << Num(h) << "\" fill=\"white\"/>\n";
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i)
-      if ((i + j) % 2 == 0)
-        svg << "<rect x=\"" << Num((i + 1) * s) << "\" y=\"" << Num((j + 1) * s) << "\" width=\"" << Num(s)
-            << "\" height=\"" << Num(s) << "\" fill=\"black\"/>\n";
-  svg << "</svg>\n";
-  return svg.str();
-}
-
 void RunTarget(const CalibrateFlags& f) {
   const ChessboardTarget t = Target(f.target);
   const std::string extension = std::filesystem::path(f.output).extension().string();
   if (extension == ".svg") {
-    WriteFileAtomically(f.output, TargetSvg(t));
+    WriteFileAtomically(f.output, ChessboardTargetSvg(t));
     std::cout << "wrote " << f.output << ": print at 100 % (no \"fit to page\"), then measure a square: it must be "
               << Num(t.square * 1000) << " mm (give the measured value to --square)\n";
     return;
   }
   if (extension != ".png") throw InputError("-o", "must end in .svg or .png (got '" + f.output + "')");
   const double dpi = ParseQuantity(f.dpi, Dimension::kDimensionless, "--dpi");
-  const int pixels = static_cast<int>(std::lround(t.square / 0.0254 * dpi));
-  const cv::Mat image = ChessboardTargetImage(t, pixels);
-  std::vector<uchar> png;
-  cv::imencode(".png", image, png);
-  WriteFileAtomically(f.output, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
-  std::cout << "wrote " << f.output << ": " << image.cols << " × " << image.rows << " px, " << pixels
+  const TargetPng png = ChessboardTargetPng(t, dpi);
+  WriteFileAtomically(f.output, png.bytes);
+  std::cout << "wrote " << f.output << ": " << png.width << " × " << png.height << " px, " << png.pixels_per_square
             << " px per square; print at " << Num(dpi) << " dpi so that a square measures " << Num(t.square * 1000)
             << " mm (measure it and give the measured value to --square)\n";
 }

@@ -27,25 +27,12 @@ struct ConvertFlags {
   std::uint64_t seed = 20261121;
 };
 
-std::vector<double> ParseLengthList(const std::string& text, const std::string& flag) {
-  std::vector<double> out;
-  size_t start = 0;
-  while (start <= text.size()) {
-    const size_t comma = text.find(',', start);
-    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    out.push_back(ParseQuantity(item, Dimension::kLength, flag));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
-
 ConversionOptions Options(const ConvertFlags& f) {
   ConversionOptions o;
   if (UnitFactor(Dimension::kLength, f.length_unit) == 0.0)
     throw InputError("--length-unit", "must be one of " + AcceptedUnits(Dimension::kLength));
   o.length_unit = f.length_unit;
-  if (!f.at_x.empty()) o.at_x = ParseLengthList(f.at_x, "--at-x");
+  if (!f.at_x.empty()) o.at_x = ParseQuantityList(f.at_x, Dimension::kLength, "--at-x");
   if (!f.mu.empty()) o.mu = ParseQuantity(f.mu, Dimension::kDimensionless, "--mu");
   if (f.mc_trials < 100) throw InputError("--mc-trials", "must be at least 100");
   o.propagation.trials = f.mc_trials;

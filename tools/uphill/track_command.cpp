@@ -18,6 +18,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "app/tracking_inputs.hpp"
 #include "io/configuration.hpp"
 #include "model/input_error.hpp"
 #include "vision/camera.hpp"
@@ -53,23 +54,6 @@ Eigen::Vector2d ParsePixel(const std::string& text) {
   }
 }
 
-// The scene file carries the intrinsics it was calibrated with; they must be the camera file's.
-void RequireSameCamera(const CameraIntrinsics& cam, const CameraIntrinsics& in_scene,
-                       const TrackFlags& f) {
-  auto differs = [](double a, double b) { return std::abs(a - b) > 1e-9 * std::max(1.0, std::abs(a)); };
-  std::string what;
-  if (cam.width != in_scene.width || cam.height != in_scene.height) what = "image size";
-  else if (differs(cam.fx, in_scene.fx) || differs(cam.fy, in_scene.fy)) what = "focal length";
-  else if (differs(cam.cx, in_scene.cx) || differs(cam.cy, in_scene.cy)) what = "principal point";
-  else if (cam.distortion.size() != in_scene.distortion.size()) what = "distortion model";
-  else
-    for (size_t i = 0; i < cam.distortion.size(); ++i)
-      if (differs(cam.distortion[i], in_scene.distortion[i])) what = "distortion coefficients";
-  if (!what.empty())
-    throw InputError(f.scene_file, "was calibrated with another camera than " + f.camera + " (the " + what +
-                                       " differs): run `uphill calibrate scene` with this camera file");
-}
-
 void Run(const TrackFlags& f) {
   if (f.camera.empty()) throw InputError("--camera", "is required (the camera file of `uphill calibrate camera`)");
   if (f.scene_file.empty()) throw InputError("--scene", "is required (the scene file of `uphill calibrate scene`)");
@@ -78,10 +62,7 @@ void Run(const TrackFlags& f) {
   const Scene scene = configuration.MakeScene();
   if (scene.body().kind == BodyKind::kDoubleCone)
     throw InputError("--body", "tracking supports a sphere or a spheroid, not a double cone");
-  const CameraIntrinsics camera = ReadCameraFile(f.camera);
-  SceneCalibration calibration = ReadSceneFile(f.scene_file);
-  RequireSameCamera(camera, calibration.camera, f);
-  calibration.camera = camera;
+  const SceneCalibration calibration = ReadTrackingCalibration(f.camera, f.scene_file);
 
   TrackVideoOptions options;
   options.calibration_name = f.scene_file;

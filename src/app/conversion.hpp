@@ -1,10 +1,13 @@
-// Conversion: what `uphill convert` computes for one configuration, and its JSON form (the
-// stable machine interface documented in README.md, "JSON output of convert").
+// Conversion: the use case behind `uphill convert` (docs/convert.md) for one configuration —
+// the scene, points on the path, the rest band, the propagated uncertainties and plain-language
+// verdicts — and the JSON form of a result (the stable machine interface of docs/convert.md,
+// "JSON output"). A batch of configurations: convert_batch.hpp.
 //
 // All numbers SI (m, rad). Keys: theta, alpha, phi, x_eq (null for the double cone), z_eq,
 // x_max (fall-off; for the double cone x_fall), x_low, rolls_up, theta0 and theta0_fixed_phi
 // (double cone), L_horizontal and x_eq_beyond_crossbar (apparatus input), points (with at_x),
-// x_rest, x_rest_low (with mu; rests_everywhere for the double cone), u_<key> and u_mc_<key> (inputs with uncertainties), verdict.
+// x_rest, x_rest_low (with mu; rests_everywhere for the double cone), u_<key> and u_mc_<key>
+// (inputs with uncertainties), verdict.
 #pragma once
 
 #include <nlohmann/json.hpp>

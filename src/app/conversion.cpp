@@ -1,4 +1,4 @@
-#include "io/conversion.hpp"
+#include "app/conversion.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -10,7 +10,6 @@
 
 namespace uphill {
 namespace {
-
 
 std::string Length(double metres, const std::string& unit) {
   return Printf("%.6g", ToUnit(metres, Dimension::kLength, unit)) + " " + unit;

@@ -1,0 +1,53 @@
+// ExperimentFolder: the one reader of an experiment folder's files (format uphill-experiment/1,
+// data/README.md), and the one place that names them, the keys of experiment.json and the columns
+// of measurements.csv. LoadExperiment (experiment.hpp: the rows as configurations, for analysis)
+// and the server's editable state (server/experiment_state.hpp: the rows as typed) both read the
+// folder through it; the server writes the files it names.
+//
+//   EXP/experiment.json    read whole (ReadJsonFile); its keys are checked by the callers, each
+//                          with its own strictness (analysis vs. the page's edits)
+//   EXP/measurements.csv   read whole (ReadCsvFile); may be absent in a folder the page has just
+//                          created
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "io/csv_table.hpp"
+
+namespace uphill {
+
+inline constexpr const char* kExperimentFormat = "uphill-experiment/1";
+inline constexpr const char* kExperimentJsonFile = "experiment.json";
+inline constexpr const char* kMeasurementsCsvFile = "measurements.csv";
+
+// The keys experiment.json may have: at the top, in "body", in "apparatus" (constants of the
+// apparatus) and in "uncertainties" (default standard uncertainties).
+const std::set<std::string>& ExperimentKeys();    // format title operator date notes body apparatus uncertainties
+const std::set<std::string>& BodyKeys();          // type R a b h
+const std::set<std::string>& ApparatusKeys();     // L H D theta alpha rod_diameter L_convention
+const std::set<std::string>& UncertaintyKeys();   // L H D Y R a b h theta alpha rod_diameter
+
+// The columns of measurements.csv: the label columns, then the numeric quantities (a length unit
+// in the header, `L_mm`, or in every cell), in the order the server writes them.
+const std::vector<std::string>& MeasurementLabelColumns();  // trial series note
+const std::vector<std::string>& MeasurementQuantities();    // L H D Y u_L u_H u_D u_Y
+
+struct ExperimentFolder {
+  std::string directory;
+  std::string json_path, csv_path;  // directory/experiment.json, directory/measurements.csv
+  nlohmann::json metadata;          // experiment.json as parsed, not yet checked
+};
+
+// The folder's paths and experiment.json. Throws InputError naming the folder when it is not a
+// folder, or the file when it cannot be opened or is not valid JSON.
+ExperimentFolder ReadExperimentJson(const std::string& directory);
+
+// measurements.csv of the folder, or nullopt when the file does not exist. Throws InputError
+// naming the file when it exists but cannot be read or is malformed CSV.
+std::optional<CsvTable> ReadMeasurements(const ExperimentFolder& folder);
+
+}  // namespace uphill
