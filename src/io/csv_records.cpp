@@ -24,6 +24,12 @@ namespace {
 
 constexpr std::size_t kBlock = std::size_t{1} << 20;
 
+// memchr over [b, e): an empty range (the buffer not yet allocated, so data() may be null)
+// finds nothing rather than passing memchr a null pointer.
+const char* Find(const char* b, const char* e, char c) {
+  return b < e ? static_cast<const char*>(std::memchr(b, c, static_cast<std::size_t>(e - b))) : nullptr;
+}
+
 bool IsSpace(char c) { return c == ' ' || c == '\t'; }
 
 std::string_view Trim(std::string_view s) {
@@ -77,8 +83,6 @@ bool CsvRecords::Fill() {
     end_ -= begin_;
     begin_ = 0;
   }
-  const std::size_t capacity = options_.max_record_bytes + 2 * kBlock;
-  if (buffer_.size() < capacity) buffer_.resize(capacity);
   const std::size_t room = std::min(kBlock, buffer_.size() - end_);
   std::size_t got = 0;
   if (stream_) {
@@ -99,9 +103,9 @@ bool CsvRecords::Fill() {
 void CsvRecords::SkipLine(std::size_t from) {
   for (;;) {
     const char* start = buffer_.data() + std::max(from, begin_);
-    const void* newline = std::memchr(start, '\n', buffer_.data() + end_ - start);
+    const char* newline = Find(start, buffer_.data() + end_, '\n');
     if (newline) {
-      begin_ = static_cast<std::size_t>(static_cast<const char*>(newline) - buffer_.data()) + 1;
+      begin_ = static_cast<std::size_t>(newline - buffer_.data()) + 1;
       return;
     }
     consumed_ += end_;
@@ -131,8 +135,8 @@ CsvRecords::Got CsvRecords::Quoted(std::size_t line_begin, Record* record) {
     // Feed libcsv up to the next line end ('\n' or '\r': a lone CR ends a record too, and
     // two records must not share one feed), or what there is of the line.
     const char* start = buffer_.data() + at;
-    const char* line_feed = static_cast<const char*>(std::memchr(start, '\n', buffer_.data() + end_ - start));
-    const char* carriage = static_cast<const char*>(std::memchr(start, '\r', (line_feed ? line_feed : buffer_.data() + end_) - start));
+    const char* line_feed = Find(start, buffer_.data() + end_, '\n');
+    const char* carriage = Find(start, line_feed ? line_feed : buffer_.data() + end_, '\r');
     const char* newline = carriage ? carriage : line_feed;
     if (!newline && !eof_ && end_ - at < kBlock) {
       const std::size_t offset = at - begin_;
@@ -178,7 +182,7 @@ CsvRecords::Got CsvRecords::NextRaw(Record* record) {
   non_ascii_ = false;
   for (;;) {
     const char* start = buffer_.data() + begin_;
-    const void* newline = std::memchr(start, '\n', end_ - begin_);
+    const char* newline = Find(start, buffer_.data() + end_, '\n');
     if (!newline) {
       if (end_ - begin_ > options_.max_record_bytes) {
         SkipLine(begin_);
@@ -190,21 +194,21 @@ CsvRecords::Got CsvRecords::NextRaw(Record* record) {
       if (begin_ == end_) return Got::kEnd;  // the last line has no line end: take it as it is
     }
     const char* b = buffer_.data() + begin_;
-    const char* e = newline ? static_cast<const char*>(newline) : buffer_.data() + end_;
+    const char* e = newline ? newline : buffer_.data() + end_;
     if (static_cast<std::size_t>(e - b) > options_.max_record_bytes) {
       begin_ = static_cast<std::size_t>(e - buffer_.data()) + (newline ? 1 : 0);
       record->error = "is longer than " + std::to_string(options_.max_record_bytes) + " bytes (not a CSV file?)";
       return Got::kRecord;
     }
     const char* content_end = (e > b && e[-1] == '\r') ? e - 1 : e;
-    if (std::memchr(b, '"', content_end - b) || std::memchr(b, '\r', content_end - b))
+    if (Find(b, content_end, '"') || Find(b, content_end, '\r'))
       return Quoted(begin_, record);
     begin_ = static_cast<std::size_t>(e - buffer_.data()) + (newline ? 1 : 0);
     // Split at the commas, in place.
     const char* cell = b;
     for (;;) {
-      const void* comma = std::memchr(cell, ',', content_end - cell);
-      const char* cell_end = comma ? static_cast<const char*>(comma) : content_end;
+      const char* comma = Find(cell, content_end, ',');
+      const char* cell_end = comma ? comma : content_end;
       record->cells.push_back(Trim(std::string_view(cell, cell_end - cell)));
       if (!comma) break;
       cell = cell_end + 1;
@@ -219,6 +223,8 @@ CsvRecords::Got CsvRecords::NextRaw(Record* record) {
 }
 
 void CsvRecords::ReadHeader() {
+  // One allocation for the whole read: the longest record and two blocks around it.
+  buffer_.resize(options_.max_record_bytes + 2 * kBlock);
   Record record;
   Got got;
   do got = NextRaw(&record);
