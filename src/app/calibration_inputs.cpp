@@ -8,17 +8,13 @@
 #include "io/csv_table.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
+#include "model/number_text.hpp"
 
 namespace uphill {
 namespace {
 
 // 6 significant digits: millimetres in the SVG to well below a printer's dot.
-std::string Num(double v) {
-  std::ostringstream out;
-  out.precision(6);
-  out << v;
-  return out.str();
-}
+std::string Num(double v) { return Printf("%.6g", v); }
 
 }  // namespace
 

@@ -1,21 +1,16 @@
 #include "app/simulation.hpp"
 
 #include <cmath>
-#include <sstream>
 #include <string>
 
 #include "model/input_error.hpp"
+#include "model/number_text.hpp"
 
 namespace uphill {
 namespace {
 
 // 10 significant digits: what a message needs to name a time or a position.
-std::string Short(double v) {
-  std::ostringstream out;
-  out.precision(10);
-  out << v;
-  return out.str();
-}
+std::string Short(double v) { return Printf("%.10g", v); }
 
 MotionMethod ChooseMethod(const Scene& scene, const SimulationRequest& r) {
   switch (r.method) {
