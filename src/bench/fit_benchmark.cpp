@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "bench/results_document.hpp"
+#include "bench/synthetic_data.hpp"
 #include "bench/support.hpp"
 #include "fit/friction_fit.hpp"
 #include "fit/least_squares_line.hpp"
@@ -25,28 +26,6 @@ namespace uphill::bench {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Y = c + k·t + u(Y)·n₁, X = t + u(X)·n₂: true t uniform on [t0, t0 + spread], u(X) and u(Y)
-// varying per row (so that the weighted fits differ from OLS), Gaussian errors.
-LineData StraightLine(std::size_t n, std::uint64_t seed, double t0, double spread, double ux_scale) {
-  boost::random::mt19937_64 engine(seed);
-  boost::random::uniform_real_distribution<double> unit(0.0, 1.0);
-  boost::random::normal_distribution<double> normal;
-  const double k = 2.0, c = 1.0;
-  LineData d;
-  d.x.resize(n);
-  d.y.resize(n);
-  d.u_x.resize(n);
-  d.u_y.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double t = t0 + spread * unit(engine);
-    d.u_x[i] = ux_scale * (0.05 + 0.15 * unit(engine));
-    d.u_y[i] = ux_scale * (0.1 + 0.3 * unit(engine));
-    d.x[i] = t + d.u_x[i] * normal(engine);
-    d.y[i] = c + k * (t - t0) + d.u_y[i] * normal(engine);
-  }
-  return d;
-}
 
 // The lab spheroid on settings around the sample experiments (L 1.10-1.25 m, D 0.10-0.20 m,
 // H = 0.3 m), Y = x_rest(μ = 0.05) + N(0, (0.5 mm)²).
@@ -64,18 +43,6 @@ FrictionData FrictionRows(std::size_t n, std::uint64_t seed) {
     d.u_y.push_back(kUy);
   }
   return d;
-}
-
-// k, c, se_k, se_c in the method's primary convention (OLS: scaled).
-std::vector<double> ReferenceValues(const oracle::LineSolution& s, bool scaled) {
-  return {s.k, s.c, std::sqrt(scaled ? s.ScaledVarK() : s.var_k), std::sqrt(scaled ? s.ScaledVarC() : s.var_c)};
-}
-
-double MaxRelDev(const std::vector<double>& values, const std::vector<double>& reference) {
-  double worst = 0.0;
-  for (std::size_t i = 0; i < values.size(); ++i)
-    worst = std::max(worst, std::abs(values[i] - reference[i]) / std::abs(reference[i]));
-  return worst;
 }
 
 std::vector<double> LineValues(const FitReport& fit) {
@@ -111,14 +78,8 @@ Table ResultTable() {
                 {"peer RSS", 8}});
 }
 
-std::string Power(std::size_t n) {
-  const double e = std::log10(static_cast<double>(n));
-  return std::abs(e - std::round(e)) < 1e-9 ? "10^" + std::to_string(static_cast<int>(std::round(e)))
-                                             : std::to_string(n);
-}
-
 void AddRows(Table& table, const Measured& m) {
-  std::vector<std::string> first = {m.method, Power(m.n), FormatSeconds(m.m.seconds), FormatDeviation(m.dev),
+  std::vector<std::string> first = {m.method, FormatCount(m.n), FormatSeconds(m.m.seconds), FormatDeviation(m.dev),
                                     FormatBytes(m.m.peak_bytes)};
   if (m.peers.empty()) {
     table.Add(first);
@@ -154,7 +115,7 @@ PeerResult Peer(const nlohmann::json& peers, const std::string& key, const std::
   r.name = name;
   r.m.seconds = p.at("seconds");
   r.m.peak_bytes = p.value("peak_bytes", std::uint64_t{0});
-  r.dev = MaxRelDev({p.at("slope").get<double>(), p.at("intercept").get<double>()}, {reference[0], reference[1]});
+  r.dev = MaxRelativeDeviation({p.at("slope").get<double>(), p.at("intercept").get<double>()}, {reference[0], reference[1]});
   return r;
 }
 
@@ -162,14 +123,14 @@ PeerResult Peer(const nlohmann::json& peers, const std::string& key, const std::
 std::vector<Measured> MeasureLines(const FitBenchmarkOptions& f, const LineData& d,
                                    const std::optional<nlohmann::json>& peers, bool robust) {
   const std::size_t n = d.size();
-  const std::vector<double> ols_ref = ReferenceValues(oracle::OrdinaryLeastSquares(d), true);
-  const std::vector<double> wls_ref = ReferenceValues(oracle::WeightedLeastSquares(d), false);
-  const std::vector<double> york_ref = ReferenceValues(oracle::YorkLine(d), false);
+  const std::vector<double> ols_ref = oracle::OrdinaryLeastSquares(d).Values(true);
+  const std::vector<double> wls_ref = oracle::WeightedLeastSquares(d).Values(false);
+  const std::vector<double> york_ref = oracle::YorkLine(d).Values(false);
   std::vector<Measured> out;
   const auto measure = [&](const std::string& name, auto fit, const std::vector<double>& ref) {
     FitReport report;
     Measured m{name, n, Measure(f.repeats, [&] { report = fit(); }), 0.0, {}};
-    m.dev = MaxRelDev(LineValues(report), ref);
+    m.dev = MaxRelativeDeviation(LineValues(report), ref);
     return m;
   };
   // The rows computed in the fit's last pass, not stored: what `uphill fit --xy` does (line_rows.hpp).
@@ -183,8 +144,8 @@ std::vector<Measured> MeasureLines(const FitBenchmarkOptions& f, const LineData&
   if (robust) {
     RobustOptions robust_options;
     robust_options.fit.keep_rows = false;
-    huber_ref = ReferenceValues(oracle::HuberLine(d), false);
-    huber_mad_ref = ReferenceValues(oracle::HuberLineMadScale(without_u), false);
+    huber_ref = oracle::HuberLine(d).Values(false);
+    huber_mad_ref = oracle::HuberLineMadScale(without_u).Values(false);
     out.push_back(measure("robust", [&] { return FitRobust(d, robust_options); }, huber_ref));
     out.push_back(measure("rob. MAD", [&] { return FitRobust(without_u, robust_options); }, huber_mad_ref));
   }
@@ -269,7 +230,7 @@ void RunFitBenchmark(const FitBenchmarkOptions& f, std::ostream& out) {
     Measured m{"friction", d.size(), Measure(f.repeats, [&] { report = FitFriction(d); }), 0.0, {}};
     std::vector<double> tan_theta, tan_half_alpha;
     const oracle::FrictionSolution ref = oracle::FrictionMu(OracleRows(d, &tan_theta, &tan_half_alpha), kMu);
-    m.dev = MaxRelDev({report.Parameter("mu").value, report.Parameter("mu").se_unscaled}, {ref.mu, std::sqrt(ref.var_mu)});
+    m.dev = MaxRelativeDeviation({report.Parameter("mu").value, report.Parameter("mu").se_unscaled}, {ref.mu, std::sqrt(ref.var_mu)});
     AddRows(table, m);
   }
   section.tables.emplace_back("", &table);
@@ -289,7 +250,7 @@ void RunFitBenchmark(const FitBenchmarkOptions& f, std::ostream& out) {
   const std::size_t big = f.sizes.empty() ? 0 : static_cast<std::size_t>(f.sizes.back());
   if (york_at.count(big) && !york_at[big].peers.empty()) {
     const Measured& m = york_at[big];
-    std::string line = "Goal at N = " + Power(big) + " (errors in both variables):";
+    std::string line = "Goal at N = " + FormatCount(big) + " (errors in both variables):";
     bool all = m.dev <= 1e-12;
     for (const PeerResult& p : m.peers) {
       const double goal = p.name == "scipy.odr" ? 10.0 : 3.0;

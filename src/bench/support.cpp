@@ -194,4 +194,17 @@ std::string FormatDeviation(double relative) { return Format("%.2g", relative); 
 
 std::string FormatRatio(double ratio) { return Format(ratio < 10 ? "%.1fx" : "%.0fx", ratio); }
 
+std::string FormatCount(std::uint64_t n) {
+  const double e = std::log10(static_cast<double>(n));
+  return std::abs(e - std::round(e)) < 1e-9 ? "10^" + std::to_string(static_cast<int>(std::round(e)))
+                                             : std::to_string(n);
+}
+
+double MaxRelativeDeviation(const std::vector<double>& values, const std::vector<double>& reference) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < values.size(); ++i)
+    worst = std::max(worst, std::abs(values[i] - reference[i]) / std::abs(reference[i]));
+  return worst;
+}
+
 }  // namespace uphill::bench

@@ -129,5 +129,9 @@ std::string FormatBytes(std::uint64_t bytes);
 std::string FormatDeviation(double relative);
 // "3.4x".
 std::string FormatRatio(double ratio);
+// "10^6" for powers of ten, else the number.
+std::string FormatCount(std::uint64_t n);
+// The largest |values[i] − reference[i]|/|reference[i]|.
+double MaxRelativeDeviation(const std::vector<double>& values, const std::vector<double>& reference);
 
 }  // namespace uphill::bench

@@ -132,6 +132,10 @@ std::vector<L> CentredX(LineRows d, double xc) {
 
 }  // namespace
 
+std::vector<double> LineSolution::Values(bool scaled) const {
+  return {k, c, std::sqrt(scaled ? ScaledVarK() : var_k), std::sqrt(scaled ? ScaledVarC() : var_c)};
+}
+
 LineSolution OrdinaryLeastSquares(LineRows d) { return LeastSquares(d, false); }
 LineSolution WeightedLeastSquares(LineRows d) { return LeastSquares(d, true); }
 

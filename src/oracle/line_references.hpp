@@ -56,6 +56,8 @@ struct LineSolution {
 
   double ScaledVarK() const { return var_k * chi2 / dof; }
   double ScaledVarC() const { return var_c * chi2 / dof; }
+  // (k, c, σ_k, σ_c) with the scaled (OLS's convention) or the unscaled standard errors.
+  std::vector<double> Values(bool scaled) const;
 };
 
 LineSolution OrdinaryLeastSquares(LineRows d);

@@ -5,6 +5,7 @@
 
 #include "bench/convert_benchmark.hpp"
 #include "bench/fit_benchmark.hpp"
+#include "bench/io_benchmark.hpp"
 #include "bench/motion_benchmark.hpp"
 #include "bench/track_benchmark.hpp"
 #include "commands.hpp"
@@ -45,6 +46,27 @@ void AddFit(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& ar
   cmd->callback([o, argv] {
     o->common.command = CommandLine(*argv);
     bench::RunFitBenchmark(*o, std::cout);
+  });
+}
+
+void AddIo(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
+  auto o = std::make_shared<bench::IoBenchmarkOptions>();
+  CLI::App* cmd = bench.add_subcommand(
+      "io", "fit --xy and convert --batch end to end on large files, against NumPy; bad input at scale");
+  cmd->add_option("--sizes", o->sizes, "rows of the files")->delimiter(',')->capture_default_str();
+  cmd->add_option("--seed", o->seed, "seed of the synthetic files")->capture_default_str();
+  cmd->add_option("--repeats", o->repeats, "runs per workload at up to 10^6 rows (the best counts)")
+      ->capture_default_str();
+  cmd->add_option("--folder", o->folder, "folder for the files (default: a temporary one, removed after)");
+  AddCommonFlags(cmd, &o->common, "Python with NumPy for the peer");
+  cmd->add_option("--peer-script", o->script, "path of tools/bench/io_peers.py");
+  cmd->add_flag("--no-peers", o->no_peers, "skip the NumPy peer");
+  cmd->add_flag("--no-bad-input", o->no_bad_input, "skip the bad-input cases");
+  cmd->add_option("--long-line-bytes", o->long_line_bytes, "length of the line without a line end")
+      ->capture_default_str();
+  cmd->callback([o, argv] {
+    o->common.command = CommandLine(*argv);
+    bench::RunIoBenchmark(*o, std::cout);
   });
 }
 
@@ -106,6 +128,7 @@ void AddBenchCommand(CLI::App& app, const std::vector<std::string>& arguments) {
   const auto argv = std::make_shared<std::vector<std::string>>(arguments);
   AddConvert(*bench, argv);
   AddFit(*bench, argv);
+  AddIo(*bench, argv);
   AddMotion(*bench, argv);
   AddTrack(*bench, argv);
 }

@@ -101,9 +101,11 @@ OptionalColumns ColumnsOf(const ConversionResult& r) {
 ConversionPrinter::ConversionPrinter(std::ostream& out, OutputFormat format, bool batch, std::string unit,
                                      OptionalColumns any)
     : out_(out), format_(format), batch_(batch), unit_(std::move(unit)) {
-  const std::string unit_copy = unit_;
+  // ToUnit's division, with the unit looked up once (a batch prints millions of lengths).
+  const double factor = UnitFactor(Dimension::kLength, unit_);
+  if (factor == 0.0) ToUnit(1.0, Dimension::kLength, unit_);  // throws its message
   const auto deg = [](double rad) { return Fixed6(rad * 180.0 / std::numbers::pi); };
-  const auto len = [unit_copy](double m) { return General6(ToUnit(m, Dimension::kLength, unit_copy)); };
+  const auto len = [factor](double m) { return General6(m / factor); };
   std::vector<Column>& cols = columns_;
   if (any.label) cols.push_back({"label", [](const ConversionResult& r) { return r.configuration.label; }});
   cols.push_back({"body", [](const ConversionResult& r) { return r.scene.body().Name(); }});
@@ -190,13 +192,15 @@ void ConversionPrinter::Row(const ConvertedRow& row) {
   }
   std::vector<std::string> line = Cells(row);
   if (format_ == OutputFormat::kCsv) {
-    csv_line_.clear();
     for (std::size_t i = 0; i < line.size(); ++i) {
       if (i) csv_line_ += ',';
       AppendCsv(&csv_line_, line[i]);
     }
     csv_line_ += '\n';
-    out_.write(csv_line_.data(), static_cast<std::streamsize>(csv_line_.size()));
+    if (csv_line_.size() >= kCsvBlock) {
+      out_.write(csv_line_.data(), static_cast<std::streamsize>(csv_line_.size()));
+      csv_line_.clear();
+    }
     return;
   }
   if (!table_started_) {
@@ -237,6 +241,8 @@ void ConversionPrinter::TableLine(const std::vector<std::string>& cells, bool he
 void ConversionPrinter::Finish() {
   if (finished_) return;
   finished_ = true;
+  out_.write(csv_line_.data(), static_cast<std::streamsize>(csv_line_.size()));
+  csv_line_.clear();
   if (format_ == OutputFormat::kJson && batch_) out_ << (rows_ ? "\n]\n" : "[]\n");
   if (format_ == OutputFormat::kTable && batch_) {
     if (!table_started_) FlushTable();

@@ -59,7 +59,8 @@ class ConversionPrinter {
   std::vector<std::vector<std::string>> held_;
   std::vector<std::size_t> width_;
   bool error_column_ = false, table_started_ = false, finished_ = false;
-  std::string csv_line_;  // reused for every CSV line
+  std::string csv_line_;  // CSV lines not yet written (written in blocks of kCsvBlock bytes)
+  static constexpr std::size_t kCsvBlock = std::size_t{1} << 16;
 };
 
 }  // namespace uphill::cli
