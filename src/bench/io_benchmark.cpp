@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <malloc.h>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -237,13 +239,21 @@ void RunIoBenchmark(const IoBenchmarkOptions& f, std::ostream& out) {
     const int repeats = n <= 1'000'000 ? f.repeats : 1;
     const std::string tag = FormatCount(n64);
     // --- fit --xy ---
-    const LineData d = StraightLine(n, f.seed + n, 0.0, 10.0, 1.0);
+    // The data, their file and the oracles' references; then the data go before any program runs:
+    // a child's ru_maxrss includes the anonymous memory of the process it was forked from.
     const fs::path xy = dir / ("xy_" + std::to_string(n) + ".csv");
-    const auto marks = WriteXy(xy, d);
+    std::pair<std::uint64_t, std::uint64_t> marks;
+    std::map<std::string, std::vector<double>> references;
+    {
+      const LineData d = StraightLine(n, f.seed + n, 0.0, 10.0, 1.0);
+      marks = WriteXy(xy, d);
+      references["ols"] = oracle::OrdinaryLeastSquares(d).Values(true);
+      references["york"] = oracle::YorkLine(d).Values(false);
+    }
+    malloc_trim(0);
     const std::uint64_t xy_bytes = fs::file_size(xy);
     for (const std::string method : {"ols", "york"}) {
-      const std::vector<double> ref =
-          method == std::string("ols") ? oracle::OrdinaryLeastSquares(d).Values(true) : oracle::YorkLine(d).Values(false);
+      const std::vector<double>& ref = references.at(method);
       const Outcome ours = Repeat(repeats, {self, "fit", "--xy", xy.string(), "--method", method}, dir, "fit", false);
       if (ours.run.exit_status != 0) throw std::runtime_error("uphill fit failed: " + FirstLine(ours.err_path));
       const Outcome exact =

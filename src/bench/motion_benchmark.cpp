@@ -168,8 +168,8 @@ void RunMotionBenchmark(const MotionBenchmarkOptions& f, std::ostream& out) {
       std::string part;
       while (std::getline(ss, part, '|')) parts.push_back(part);
       if (parts.size() == 2 && parts[0] == "versions") {
-        for (const auto& [name, version] : nlohmann::json::parse(parts[1]).items())
-          section.versions.emplace_back(name, version.get<std::string>());
+        const nlohmann::json versions = nlohmann::json::parse(parts[1]);  // alive through the loop
+        for (const auto& [name, version] : versions.items()) section.versions.emplace_back(name, version.get<std::string>());
       } else if (parts.size() == 5) {
         Row row{parts[0], parts[1], std::stod(parts[2]), std::stod(parts[3])};
         row.peak_bytes = std::stoull(parts[4]);

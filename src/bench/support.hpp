@@ -73,7 +73,8 @@ struct ProcessRun {
   int exit_status = -1;          // exit code, or -1 if it did not exit normally
   double wall_seconds = 0.0;     // from fork to the child's exit
   double cpu_seconds = 0.0;      // the child's user + system time
-  std::uint64_t peak_bytes = 0;  // its ru_maxrss
+  std::uint64_t peak_bytes = 0;  // its ru_maxrss (which includes this process's anonymous
+                                 // memory at the fork: keep it small before running children)
 };
 // Runs argv[0] with arguments (PATH searched), stdout to `stdout_path` ("" = /dev/null), stdin from
 // /dev/null, stderr to `stderr_path` ("" = inherited). Throws std::runtime_error if it cannot start.

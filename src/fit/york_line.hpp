@@ -31,7 +31,9 @@
 // Both conventions are reported, as the literature does: unscaled (York's; primary) and scaled
 // by sqrt(MSWD) = sqrt(S/(N − 2)) (as e.g. scipy.odr's sd_beta and Isoplot's "external" errors).
 //
-// Per row: residual Y_i − c − k·X_i, σ_i = sqrt(u(Y_i)² + k²u(X_i)²), chi2 = S.
+// Per row: residual Y_i − c − k·X_i, σ_i = sqrt(u(Y_i)² + k²u(X_i)²), chi2 = S; stored in
+// FitReport::rows with FitOptions::keep_rows, else computed in the last pass and given on demand
+// by LineRowResults (line_rows.hpp).
 // Test: Pearson's (1901) data with York's (1966) weights gives k = −0.480533407,
 // c = 5.479910224, σ_k = 0.0579850, σ_c = 0.2949707 (unscaled), MSWD = 1.483294.
 //
