@@ -13,6 +13,7 @@
 #include "model/input_error.hpp"
 #include "model/propagation.hpp"
 #include "oracle/friction_reference.hpp"
+#include "fit_test_support.hpp"
 
 namespace uphill::testing {
 namespace {
@@ -47,26 +48,6 @@ FrictionData Synthetic(std::vector<Scene> scenes, double mu, double u, std::uint
   }
   d.scenes = std::move(scenes);
   return d;
-}
-
-::testing::AssertionResult RelNear(double actual, double expected, double rel) {
-  const double err = std::abs(actual - expected);
-  if (err <= rel * std::abs(expected)) return ::testing::AssertionSuccess();
-  std::ostringstream msg;
-  msg.precision(17);
-  msg << "actual " << actual << ", expected " << expected << ", relative error "
-      << err / std::abs(expected) << " > " << rel;
-  return ::testing::AssertionFailure() << msg.str();
-}
-
-template <typename F>
-void ExpectInputError(F&& f, const std::string& quantity) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError (expected one about " << quantity << ")";
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.quantity(), quantity) << e.what();
-  }
 }
 
 bool HasNote(const FitReport& fit, const std::string& text) {

@@ -28,7 +28,7 @@
 // differs from the certified value in the 13th digit. Against the 50-digit closed form (src/oracle)
 // every parameter and standard error agrees to ~1e-15 relative, at 10^6 rows too (`uphill bench
 // fit`). Shifting X by 1e9 changes the slope by
-// < 1e-12 relative (tests/fit_test.cpp).
+// < 1e-12 relative (tests/fit_certified_test.cpp, tests/fit_oracle_test.cpp).
 // N = 2: the exact line, exact = true, ν = 0, with a note; OLS then has no standard error.
 // Errors: InputError from ValidateLineData (N < 2, all X equal, non-finite values; WLS: u(Y)
 // missing, non-finite or ≤ 0).

@@ -33,7 +33,7 @@
 // likelihood). Primary scaling: unscaled.
 //
 // Accuracy: against Newton's iteration on the same objective in long double (src/oracle,
-// tests/fit_test.cpp): ≤ 1e-13 relative in k, c and ≤ 1e-12 in the covariance with u(Y); with
+// tests/fit_robust_test.cpp, tests/fit_oracle_test.cpp): ≤ 1e-13 relative in k, c and ≤ 1e-12 in the covariance with u(Y); with
 // the estimated σ ≤ 1e-12. Cost: O(N) per Ceres iteration or Newton step (typically under 10),
 // plus, without u(Y), a median (nth_element) per σ round. Per-row results: FitOptions::keep_rows
 // and line_rows.hpp.

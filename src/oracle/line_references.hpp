@@ -1,6 +1,6 @@
 // Reference solutions of the straight-line fits Y = k·X + c, in extended precision, written
 // without the fit layer's code (no centring by the library's rules, no Ceres): the truth that
-// tests/fit_test.cpp and `uphill bench fit` compare the fits with.
+// tests/fit_oracle_test.cpp and `uphill bench fit` compare the fits with.
 //
 // Inputs are the doubles as given, treated as exact. Outputs are rounded once to double.
 //
