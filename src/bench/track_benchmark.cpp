@@ -15,6 +15,7 @@
 
 #include "bench/results_document.hpp"
 #include "bench/support.hpp"
+#include "bench/track_matrix.hpp"
 #include "vision/ball_tracker.hpp"
 #include "vision/synthetic_clip.hpp"
 #include "vision/video_tracking.hpp"
@@ -135,6 +136,29 @@ constexpr const char* kMethod =
     "CSRT and KCF trackers and HoughCircles on the same files, started from the true first box. \"peak RSS\": "
     "the process's peak resident memory over the row.";
 
+// The robustness table (bench/track_matrix.hpp) added to the section, then the record.
+void RunMatrix(const TrackBenchmarkOptions& f, Section& section, std::unique_ptr<TrackMatrixRecord>& matrix,
+               std::ostream& out) {
+  TrackMatrixOptions m;
+  m.cache = f.footage_cache;
+  m.conditions = f.conditions;
+  m.fresh = f.fresh;
+  m.python = f.common.python;
+  m.script = f.script.empty() ? FindUpward("tools/bench/track_peers.py") : f.script;
+  m.why_not_peers = PeerUnavailable(f.no_python ? "--no-python" : "", f.common.python, m.script,
+                                    "tools/bench/track_peers.py not found (use --script)", "cv2");
+  matrix = RunTrackMatrix(m, out);
+  section.method += std::string("\n\n") + kTrackMatrixMethod;
+  section.tables.emplace_back("Robustness on ray-traced footage (one condition per row):", &matrix->robustness);
+  if (!matrix->bad_input.empty()) section.tables.emplace_back("Bad input:", &matrix->bad_input);
+  section.notes.insert(section.notes.end(), matrix->notes.begin(), matrix->notes.end());
+  const std::string goal = "Goal (issue 10): every condition RMS (u, v) <= 0.3 px and (x, z) <= 0.5 mm with all "
+                           "frames found; clean <= 0.1 px.";
+  out << "\n" << goal << "\n";
+  section.results.push_back(goal);
+  Record(section, f.common.doc, f.common.no_doc, out);
+}
+
 }  // namespace
 
 void RunTrackBenchmark(const TrackBenchmarkOptions& f, std::ostream& out) {
@@ -144,6 +168,8 @@ void RunTrackBenchmark(const TrackBenchmarkOptions& f, std::ostream& out) {
   // process clock (OPENCV_FFMPEG_CAPTURE_OPTIONS reaches only the demuxer in OpenCV 4.6).
   setenv("OPENCV_FFMPEG_CAPTURE_OPTIONS", "threads;1", 1);
   cv::setNumThreads(1);
+  std::unique_ptr<TrackMatrixRecord> matrix;
+  if (f.only_matrix) return RunMatrix(f, section, matrix, out);
   const fs::path cache = fs::path(f.cache) / kClipVersion;
   fs::create_directories(cache);
   std::vector<Clip> clips = {{"720p-clean", 1280, 720, false, "", "", {}},
@@ -248,6 +274,7 @@ void RunTrackBenchmark(const TrackBenchmarkOptions& f, std::ostream& out) {
   const std::string goal = "Goal: tracking >= 80% of decode-only fps on one core at <= 0.1 px RMS (u, v).";
   out << "\n" << goal << "\n";
   section.results.push_back(goal);
+  if (!f.no_matrix) return RunMatrix(f, section, matrix, out);
   Record(section, f.common.doc, f.common.no_doc, out);
 }
 

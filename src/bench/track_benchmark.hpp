@@ -6,6 +6,7 @@
 
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "bench/options.hpp"
 
@@ -17,6 +18,10 @@ struct TrackBenchmarkOptions {
   std::string script;                             // default: tools/bench/track_peers.py found upward
   bool no_python = false;
   bool fresh = false;  // render the clips again
+  // The robustness table on the ray-traced footage (bench/track_matrix.hpp).
+  bool no_matrix = false, only_matrix = false;
+  std::vector<std::string> conditions;  // empty: the whole matrix
+  std::string footage_cache;            // "": vision::FootageCacheRoot()
 };
 
 void RunTrackBenchmark(const TrackBenchmarkOptions& options, std::ostream& out);

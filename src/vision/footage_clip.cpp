@@ -274,8 +274,9 @@ class FootageRenderer {
     ClipTruth truth;
     std::vector<std::optional<BodyPose>> bodies;  // sub-frames (empty: the static scene only)
     double i0 = 0, dt = 0;                        // sub-frame k covers [i0 + k·dt, i0 + (k + 1)·dt]
-    cv::Rect box, window;                         // raw pixels composited, pinhole window rendered
-    std::vector<cv::Mat> raw;                     // the box, per sub-frame, once rendered
+    cv::Rect box;                                 // raw pixels composited: all sub-frames' boxes
+    std::vector<cv::Rect> boxes, windows;         // per sub-frame: its raw box, its pinhole window
+    std::vector<cv::Mat> raw;                     // per sub-frame: its raw box, once rendered
   };
 
   FramePlan Plan(int f) const {
@@ -331,15 +332,34 @@ class FootageRenderer {
     const int K =
         std::clamp(static_cast<int>(std::ceil((i1 - plan.i0) * speed / c_.max_step_px)), 1, c_.max_subframes);
     plan.dt = (i1 - plan.i0) / K;
+    // Each sub-frame renders only the window around its own body (a long blur would otherwise
+    // render the whole smear K times); the windows share one size, so that one POV-Ray run
+    // renders several.
+    cv::Size size;
     for (int k = 0; k < K; ++k) {
       plan.bodies.push_back(BodyAt(plan.i0 + (k + 0.5) * plan.dt));
-      plan.box |= RawBox(*plan.bodies.back(), pi);
+      plan.boxes.push_back(RawBox(*plan.bodies.back(), pi));
+      plan.box |= plan.boxes.back();
+      if (!plan.boxes.back().empty()) {
+        plan.windows.push_back(lens_.PinholeWindow(plan.boxes.back()));
+        size.width = std::max(size.width, plan.windows.back().width);
+        size.height = std::max(size.height, plan.windows.back().height);
+      } else {
+        plan.windows.emplace_back();
+      }
     }
     if (plan.box.empty()) {
       plan.bodies.clear();
+      plan.boxes.clear();
+      plan.windows.clear();
       return plan;
     }
-    plan.window = lens_.PinholeWindow(plan.box);
+    const cv::Rect pinhole(0, 0, lens_.pinhole().width, lens_.pinhole().height);
+    for (cv::Rect& w : plan.windows) {
+      // Grown to the common size about its own corner, moved back inside the picture.
+      w = cv::Rect(std::clamp(w.x, 0, pinhole.width - size.width), std::clamp(w.y, 0, pinhole.height - size.height),
+                   size.width, size.height);
+    }
     return plan;
   }
 
@@ -376,9 +396,11 @@ class FootageRenderer {
       const size_t chunks = (K + 5) / 6, per = (K + chunks - 1) / chunks;
       for (size_t first = 0; first < K; first += per) {
         PovrayJob job;
+        const size_t last = std::min(K, first + per);
         job.shot.camera = {lens_.pinhole(), poses_[plan.pose_index]};
-        job.shot.crop = plan.window;
-        job.shot.bodies.assign(plan.bodies.begin() + first, plan.bodies.begin() + std::min(K, first + per));
+        job.shot.crop = plan.windows[first];
+        job.shot.bodies.assign(plan.bodies.begin() + first, plan.bodies.begin() + last);
+        for (size_t k = first; k < last; ++k) job.shot.crop_offsets.push_back(plan.windows[k].tl());
         jobs.push_back(job);
         parts.push_back({&plan, first});
       }
@@ -386,8 +408,10 @@ class FootageRenderer {
     RunJobs(jobs, 1);
     for (size_t j = 0; j < jobs.size(); ++j) {
       FramePlan& plan = *parts[j].plan;
-      for (size_t k = 0; k < jobs[j].pictures.size(); ++k)
-        plan.raw[parts[j].first + k] = lens_.ToRaw(jobs[j].pictures[k], plan.window, plan.box);
+      for (size_t k = 0; k < jobs[j].pictures.size(); ++k) {
+        const size_t i = parts[j].first + k;
+        if (!plan.boxes[i].empty()) plan.raw[i] = lens_.ToRaw(jobs[j].pictures[k], plan.windows[i], plan.boxes[i]);
+      }
       if (plan.bodies.size() == 1) {
         if (rest_.size() > 8) rest_.clear();
         rest_[RestKey(plan)] = plan.raw[0];
@@ -418,13 +442,17 @@ class FootageRenderer {
     }
     if (plan.bodies.empty()) return frame;
     const size_t K = plan.bodies.size();
-    cv::Mat acc = cv::Mat::zeros(plan.box.size(), CV_32FC3);
-    for (int r = 0; r < plan.box.height; ++r) {
-      const auto [wa, wb] = window(plan.box.y + r);
-      for (size_t k = 0; k < K; ++k) {
+    const cv::Mat still = static_raw_[plan.pose_index](plan.box);
+    cv::Mat acc = cv::Mat::zeros(plan.box.size(), CV_32FC3), picture;
+    for (size_t k = 0; k < K; ++k) {
+      // Sub-frame k over the whole box: the static scene, its own body's box pasted in.
+      still.copyTo(picture);
+      if (!plan.boxes[k].empty()) plan.raw[k].copyTo(picture(plan.boxes[k] - plan.box.tl()));
+      for (int r = 0; r < plan.box.height; ++r) {
+        const auto [wa, wb] = window(plan.box.y + r);
         const double a = std::max(wa, plan.i0 + k * plan.dt), b = std::min(wb, plan.i0 + (k + 1) * plan.dt);
         if (b <= a) continue;
-        cv::scaleAdd(plan.raw[k].row(r), c_.light.Integral(a, b) / E, acc.row(r), acc.row(r));
+        cv::scaleAdd(picture.row(r), c_.light.Integral(a, b) / E, acc.row(r), acc.row(r));
       }
     }
     acc.copyTo(frame(plan.box));
@@ -496,9 +524,9 @@ class FootageRenderer {
   std::string RestKey(const FramePlan& plan) const {
     const BodyPose& b = *plan.bodies[0];
     char text[200];
-    std::snprintf(text, sizeof text, "%d %d %d %d %d %d %d %d %d %.17g %.17g %.17g", plan.pose_index, plan.window.x,
-                  plan.window.y, plan.window.width, plan.window.height, plan.box.x, plan.box.y, plan.box.width,
-                  plan.box.height, b.x, b.z, b.angle);
+    const cv::Rect& w = plan.windows[0];
+    std::snprintf(text, sizeof text, "%d %d %d %d %d %d %d %d %d %.17g %.17g %.17g", plan.pose_index, w.x, w.y,
+                  w.width, w.height, plan.box.x, plan.box.y, plan.box.width, plan.box.height, b.x, b.z, b.angle);
     return text;
   }
 

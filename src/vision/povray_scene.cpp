@@ -34,7 +34,22 @@ std::string PovMatrix(const Matrix3d& a, const Vector3d& t) {
   return s + Num(t.x()) + ", " + Num(t.y()) + ", " + Num(t.z()) + ">";
 }
 
-void AppendCamera(std::ostringstream& out, const PovrayShot& shot) { out << PovrayCameraText(shot); }
+// The camera; with per-frame windows, one camera per animation frame.
+void AppendCamera(std::ostringstream& out, const PovrayShot& shot) {
+  PovrayShot one = shot;
+  one.crop_offsets.clear();
+  if (shot.crop_offsets.size() <= 1) {  // a single picture is no animation: no frame_number
+    if (!shot.crop_offsets.empty()) one.crop = cv::Rect(shot.crop_offsets[0], shot.crop.size());
+    out << PovrayCameraText(one);
+    return;
+  }
+  out << "#switch (frame_number)\n";
+  for (size_t k = 0; k < shot.crop_offsets.size(); ++k) {
+    one.crop = cv::Rect(shot.crop_offsets[k], shot.crop.size());
+    out << "#case (" << k + 1 << ")\n" << PovrayCameraText(one) << "#break\n";
+  }
+  out << "#end\n";
+}
 
 }  // namespace
 
@@ -176,6 +191,8 @@ void AppendBoard(std::ostringstream& out, const PovrayShot& shot, const BoardInV
 }
 
 void CheckShot(const PovrayShot& shot) {
+  if (!shot.crop_offsets.empty() && shot.crop_offsets.size() != shot.bodies.size())
+    throw InputError("crop offsets", "give one per frame, or none");
   if (!shot.camera.camera.distortion.empty())
     throw InputError("camera", "POV-Ray renders the pinhole camera; the lens distortion is applied afterwards");
   if (shot.crop.width <= 0 || shot.crop.height <= 0) throw InputError("crop", "must not be empty");

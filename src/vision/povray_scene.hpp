@@ -90,6 +90,8 @@ struct PovrayShot {
   SceneCalibration camera;
   cv::Rect crop;
   std::vector<std::optional<BodyPose>> bodies;  // one animation frame each (≥ 1)
+  // Optional, one per frame: frame k renders the window of crop's size at this corner instead.
+  std::vector<cv::Point> crop_offsets;
   std::optional<BoardInView> board;             // the same board in every frame
 };
 

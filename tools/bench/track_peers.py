@@ -1,11 +1,14 @@
 """Peers of `uphill bench track`: OpenCV's CSRT and KCF trackers (centre of their box) and
 HoughCircles (circle nearest the previous one), on the same clips, decoding included.
 
-Usage: track_peers.py NAME VIDEO TRUTH_CSV R0 [NAME VIDEO TRUTH_CSV R0 ...]
+Usage: track_peers.py [--positions DIR] NAME VIDEO TRUTH_CSV R0 [NAME VIDEO TRUTH_CSV R0 ...]
   TRUTH_CSV: frame,t,x,z,u,v,visibility (synthetic_clip.hpp); R0: the ball's outline radius in
   the first frame, px. The trackers start from the true box of the first frame.
 Prints a first line "versions Python X OpenCV Y", then one line per method and clip:
 method clip fps rms_px frames_compared peak_bytes (peak resident memory, peak_memory.py)
+With --positions DIR, each method's centre in every frame also goes to DIR/NAME.METHOD.csv
+(frame,u,v; u and v empty where the method reports nothing), for the robustness table of
+`uphill bench track`, which scores them itself (pixels and millimetres).
 fps: frames per CPU-second of the process (time.process_time(), cv2.setNumThreads(1)), as uphill's.
 RMS of (u, v) over the frames with the ball present and at least half visible, where the
 method reports a position (frames it misses are not counted; their number shows in frames).
@@ -91,7 +94,17 @@ def score(truth, found):
     return (math.sqrt(s / n) if n else float("nan")), n
 
 
+def write_positions(path, found):
+    with open(path, "w") as f:
+        f.write("frame,u,v\n")
+        for k, p in enumerate(found):
+            f.write("%d,%s,%s\n" % (k, "" if p is None else "%.4f" % p[0], "" if p is None else "%.4f" % p[1]))
+
+
 def main(args):
+    positions = None
+    if args[:1] == ["--positions"]:
+        positions, args = args[1], args[2:]
     print("versions Python %s OpenCV %s" % (sys.version.split()[0], cv2.__version__), flush=True)
     for i in range(0, len(args), 4):
         name, video, truth_csv, r0 = args[i], args[i + 1], args[i + 2], float(args[i + 3])
@@ -105,6 +118,8 @@ def main(args):
             found, seconds = run()
             peak = peak_memory.peak_bytes()
             rms, n = score(truth, found)
+            if positions:
+                write_positions("%s/%s.%s.csv" % (positions, name, method), found)
             print("%s %s %.3f %.6f %d %d" % (method, name, len(found) / seconds, rms, n, peak),
                   flush=True)
 

@@ -110,6 +110,10 @@ void AddTrack(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& 
   AddCommonFlags(cmd, &o->common, "Python with cv2 for the peers");
   cmd->add_option("--script", o->script, "path of tools/bench/track_peers.py");
   cmd->add_flag("--no-python", o->no_python, "skip the OpenCV peers");
+  cmd->add_flag("--no-matrix", o->no_matrix, "skip the robustness table on the ray-traced footage");
+  cmd->add_flag("--only-matrix", o->only_matrix, "only the robustness table");
+  cmd->add_option("--conditions", o->conditions, "robustness conditions to run (default: all)")->delimiter(',');
+  cmd->add_option("--footage-cache", o->footage_cache, "ray-traced clips (default ~/.cache/uphill/clips)");
   cmd->callback([o, argv] {
     o->common.command = CommandLine(*argv);
 #if UPHILL_VISION_PROGRAM
