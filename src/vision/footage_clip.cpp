@@ -182,8 +182,8 @@ class FootageRenderer {
     return BodyPose{s.x, s.z, s.angle};
   }
 
-  // Raw pixel box of the body, its soft shadow on the table and its mirror image in the table
-  // (empty when off the frame).
+  // Raw pixel box of the body, its soft shadow on the table and its mirror image in a wooden
+  // table (empty when off the frame).
   cv::Rect RawBox(const BodyPose& p, int pose_index) const {
     const SceneCalibration cal{c_.camera.camera, poses_[pose_index]};
     const SoftBox light = FootageSoftBox(c_.apparatus);
@@ -192,7 +192,8 @@ class FootageRenderer {
     for (int k = 0; k < 8; ++k) {
       const Vector3d q(p.x + (k & 1 ? a_ : -a_), k & 2 ? b_ : -b_, p.z + (k & 4 ? a_ : -a_));
       points.push_back(q);
-      points.emplace_back(q.x(), q.y(), 2 * zt - q.z());
+      // Its mirror image in the varnished wood (the cloth reflects nothing).
+      if (c_.look.table == TableCover::kWood) points.emplace_back(q.x(), q.y(), 2 * zt - q.z());
       for (int l = 0; l < 4; ++l) {
         const Vector3d lamp = light.centre + Vector3d(l & 1 ? light.half_size : -light.half_size,
                                                       l & 2 ? light.half_size : -light.half_size, 0);
