@@ -26,6 +26,7 @@
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "motion/motion.hpp"
+#include "internal/content_key.hpp"
 #include "vision/lens_remap.hpp"
 
 namespace uphill {
@@ -39,18 +40,6 @@ using ordered_json = nlohmann::ordered_json;
 // Bump when the renderer changes what a condition's pixels are.
 constexpr int kGeneratorVersion = 1;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-std::uint64_t Fnv1a(const std::string& text) {
-  std::uint64_t h = 14695981039346656037ull;
-  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
-  return h;
-}
-
-std::string Hex(std::uint64_t h) {
-  char buffer[24];
-  std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(h));
-  return buffer;
-}
 
 ordered_json DescribeCamera(const CameraIntrinsics& c) {
   return {{"width_px", c.width}, {"height_px", c.height}, {"fx_px", c.fx}, {"fy_px", c.fy},
@@ -147,8 +136,9 @@ std::vector<Vector2d> ProjectOrOutside(const CameraIntrinsics& camera, const Cam
 
 class FootageRenderer {
  public:
-  FootageRenderer(const FootageCondition& c, const fs::path& work)
-      : c_(c), work_(work), lens_(c.camera.camera), motion_(c.scene, c.x0) {
+  // work: a private folder for POV-Ray's files; pictures: the shared cache of POV-Ray renders.
+  FootageRenderer(const FootageCondition& c, const fs::path& work, const fs::path& pictures)
+      : c_(c), work_(work), pictures_(pictures), lens_(c.camera.camera), motion_(c.scene, c.x0) {
     timing_ = c.shutter;
     timing_.height = c.camera.camera.height;
     vignetting_ = lens_.Vignetting(c.vignetting);
@@ -478,7 +468,7 @@ class FootageRenderer {
   }
 
   const cv::Mat& vignetting() const { return vignetting_; }
-  int povray_runs = 0, subframes = 0;
+  int povray_runs = 0, povray_cached = 0, subframes = 0;
   double povray_cpu = 0;
 
  private:
@@ -502,10 +492,11 @@ class FootageRenderer {
                                                   : PovraySceneText(c_.scene, c_.apparatus, c_.look, job.shot);
           PovrayOptions options = c_.povray;
           options.threads = threads;
+          options.picture_cache = pictures_.empty() ? std::string() : pictures_.string();
           PovrayRun run = RunPovray(text, job.shot.crop.size(), static_cast<int>(job.shot.bodies.size()), dir, options);
           job.pictures = std::move(run.pictures);
           std::lock_guard<std::mutex> lock(mutex);
-          ++povray_runs;
+          (run.cached ? povray_cached : povray_runs) += 1;
           povray_cpu += run.cpu_seconds;
         } catch (...) {
           std::lock_guard<std::mutex> lock(mutex);
@@ -532,7 +523,7 @@ class FootageRenderer {
   }
 
   const FootageCondition& c_;
-  fs::path work_;
+  fs::path work_, pictures_;
   LensRemap lens_;
   Motion motion_;
   ShutterTiming timing_;
@@ -579,7 +570,7 @@ double ProcessCpuSeconds() { return static_cast<double>(std::clock()) / CLOCKS_P
 // that camera and sensor), unless they are there.
 std::vector<std::string> EnsureBoards(const FootageCondition& c, const fs::path& root, FootageRenderer& renderer,
                                       const FootageProgress& progress) {
-  const fs::path folder = root / ("boards-" + Hex(Fnv1a(DescribeBoards(c).dump())));
+  const fs::path folder = root / ("boards-" + internal::ContentKey(DescribeBoards(c).dump()));
   std::vector<std::string> paths;
   for (int k = 0; k < c.boards; ++k) paths.push_back((folder / FileName("board_%02d.png", k)).string());
   if (fs::exists(folder / "complete")) return paths;
@@ -648,7 +639,7 @@ ordered_json DescribeFootage(const FootageCondition& c) {
   return j;
 }
 
-std::string FootageKey(const FootageCondition& c) { return Hex(Fnv1a(DescribeFootage(c).dump())); }
+std::string FootageKey(const FootageCondition& c) { return internal::ContentKey(DescribeFootage(c).dump()); }
 
 std::string FootageCacheRoot() {
   const char* xdg = std::getenv("XDG_CACHE_HOME");
@@ -702,7 +693,7 @@ FootageFiles RenderFootage(const FootageCondition& condition, const std::string&
   files.first_frame = (folder / "frame0.png").string();
   files.camera_truth = (folder / "camera_truth.json").string();
   files.scene_truth = (folder / "scene_truth.json").string();
-  const fs::path boards_marker = root / ("boards-" + Hex(Fnv1a(DescribeBoards(condition).dump()))) / "complete";
+  const fs::path boards_marker = root / ("boards-" + internal::ContentKey(DescribeBoards(condition).dump())) / "complete";
   if (!fresh && fs::exists(folder / "condition.json") && (condition.boards == 0 || fs::exists(boards_marker))) {
     const nlohmann::json saved = ReadJsonFile((folder / "condition.json").string());
     files.from_cache = true;
@@ -720,7 +711,7 @@ FootageFiles RenderFootage(const FootageCondition& condition, const std::string&
   const fs::path partial = root / (FootageKey(condition) + ".partial-" + std::to_string(getpid()));
   fs::remove_all(partial);
   fs::create_directories(partial);
-  FootageRenderer renderer(condition, partial);
+  FootageRenderer renderer(condition, partial, fresh ? fs::path() : root / "pictures");
   files.boards = EnsureBoards(condition, root, renderer, progress);
   if (progress.report) progress.report("static scene", 0, condition.frames);
   renderer.RenderStatic();

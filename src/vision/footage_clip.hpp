@@ -44,8 +44,11 @@
 //
 // Caching: a clip lives in <cache root>/<key>/ (FootageCacheRoot: ${XDG_CACHE_HOME:-~/.cache}/
 // uphill/clips), the key a 64-bit FNV-1a hash of the condition's description (DescribeFootage,
-// kept as condition.json beside the clip with the rendering time). A folder counts only once its
-// `complete` marker is written; RenderFootage reuses it unless asked for a fresh render.
+// kept as condition.json beside the clip with the rendering time); it is written under a private
+// name and renamed into place when complete. RenderFootage reuses it unless asked for a fresh
+// render. POV-Ray's pictures are cached too, in <cache root>/pictures/, keyed by their scene
+// text: clips with the same camera, scene and motion (baseline, h265, flicker, ae-drift, the
+// first second of two bad-input clips) render their sub-frames once. Any of it may be deleted.
 #pragma once
 
 #include <functional>
@@ -115,7 +118,7 @@ struct FootageFiles {
   bool from_cache = false;
   double render_wall_seconds = 0;     // when it was rendered (kept in condition.json)
   double render_cpu_seconds = 0;      // POV-Ray's and ours
-  int povray_runs = 0, subframes = 0;
+  int povray_runs = 0, subframes = 0;  // POV-Ray runs (not counting pictures from the cache)
 };
 
 struct FootageProgress {

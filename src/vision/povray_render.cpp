@@ -1,5 +1,7 @@
 #include "vision/povray_render.hpp"
 
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -8,6 +10,7 @@
 #include <stdexcept>
 
 #include "internal/child_process.hpp"
+#include "internal/content_key.hpp"
 
 namespace uphill {
 
@@ -17,6 +20,36 @@ PovrayRun RunPovray(const std::string& scene_text, cv::Size size, int frames, co
                     const PovrayOptions& options) {
   if (size.width <= 0 || size.height <= 0) throw std::invalid_argument("RunPovray: empty picture size");
   if (frames < 1) throw std::invalid_argument("RunPovray: frames must be >= 1");
+  char quality[80];
+  std::snprintf(quality, sizeof quality, "%dx%d %d frames, aa %.6g depth %d\n", size.width, size.height, frames,
+                options.antialias_threshold, options.antialias_depth);
+  const fs::path cached =
+      options.picture_cache.empty() ? fs::path() : fs::path(options.picture_cache) / internal::ContentKey(quality + scene_text);
+  const int digits = static_cast<int>(std::to_string(frames).size());
+  auto picture_name = [&](int f) {
+    // POV-Ray numbers animation frames with as many digits as the last one has; one frame: none.
+    if (frames == 1) return std::string("shot.png");
+    char number[16];
+    std::snprintf(number, sizeof number, "%0*d", digits, f);
+    return std::string("shot") + number + ".png";
+  };
+  auto read = [&](const fs::path& folder, PovrayRun* run, const std::string& log) {
+    for (int f = 1; f <= frames; ++f) {
+      const fs::path path = folder / picture_name(f);
+      cv::Mat picture = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+      if (picture.empty() || picture.size() != size || picture.depth() != CV_16U || picture.channels() != 3)
+        throw std::runtime_error(path.string() + ": POV-Ray wrote no 16-bit RGB picture of the requested size (" +
+                                 internal::TailOfFile(log) + ")");
+      picture.convertTo(picture, CV_32FC3, 1.0 / 65535.0);
+      run->pictures.push_back(picture);
+    }
+  };
+  if (!cached.empty() && fs::exists(cached / "complete")) {
+    PovrayRun run;
+    run.cached = true;
+    read(cached, &run, "");
+    return run;
+  }
   const fs::path dir = fs::absolute(work_dir);
   fs::create_directories(dir);
   {
@@ -56,24 +89,18 @@ PovrayRun RunPovray(const std::string& scene_text, cv::Size size, int frames, co
     throw std::runtime_error("POV-Ray failed on " + (dir / "shot.pov").string() + " (exit " +
                              std::to_string(status.exit_code) + ", signal " + std::to_string(status.signal) +
                              "): " + internal::TailOfFile(log));
-  // POV-Ray numbers animation frames with as many digits as the last one has; one frame: none.
-  const int digits = static_cast<int>(std::to_string(frames).size());
-  for (int f = 1; f <= frames; ++f) {
-    std::string name = "shot.png";
-    if (frames > 1) {
-      char number[16];
-      std::snprintf(number, sizeof number, "%0*d", digits, f);
-      name = std::string("shot") + number + ".png";
-    }
-    const fs::path path = dir / name;
-    cv::Mat picture = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-    if (picture.empty() || picture.size() != size || picture.depth() != CV_16U || picture.channels() != 3)
-      throw std::runtime_error(path.string() + ": POV-Ray wrote no 16-bit RGB picture of the requested size (" +
-                               internal::TailOfFile(log) + ")");
-    fs::remove(path);
-    picture.convertTo(picture, CV_32FC3, 1.0 / 65535.0);
-    run.pictures.push_back(picture);
+  read(dir, &run, log);
+  if (!cached.empty()) {
+    // Into the cache under a private name, then renamed: a folder there is complete.
+    std::error_code ec;
+    const fs::path partial = cached.string() + ".partial-" + std::to_string(getpid()) + "-" + dir.filename().string();
+    fs::create_directories(partial, ec);
+    for (int f = 1; f <= frames && !ec; ++f) fs::rename(dir / picture_name(f), partial / picture_name(f), ec);
+    if (!ec) std::ofstream(partial / "complete") << "";
+    if (!ec) fs::rename(partial, cached, ec);
+    if (ec) fs::remove_all(partial, ec);  // another process cached it first, or the disk is full
   }
+  for (int f = 1; f <= frames; ++f) fs::remove(dir / picture_name(f));
   return run;
 }
 

@@ -25,12 +25,17 @@ struct PovrayOptions {
   int antialias_depth = 2;            // +R: up to (2^depth + 1)^2 = 25 samples per pixel
   int threads = 2;                    // +WT
   std::string program = "povray";
+  // If set: a folder of earlier renders, keyed by the scene text, size, frame count and quality;
+  // a render found there is read instead of run again (the same text renders the same pictures:
+  // no jitter), a new one is added. Any part of it may be deleted at any time.
+  std::string picture_cache;
 };
 
 struct PovrayRun {
   std::vector<cv::Mat> pictures;  // CV_32FC3, BGR, linear, one per frame, `size` each
   double wall_seconds = 0;
-  double cpu_seconds = 0;         // CPU time of the povray process (all its threads)
+  double cpu_seconds = 0;         // CPU time of the povray process (all its threads); 0 if cached
+  bool cached = false;            // read from PovrayOptions::picture_cache
 };
 
 // Throws std::invalid_argument for an empty size or frames < 1.
