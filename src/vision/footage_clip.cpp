@@ -172,32 +172,91 @@ class FootageRenderer {
     return BodyPose{s.x, s.z, s.angle};
   }
 
-  // Raw pixel box of the body, its soft shadow on the table and its mirror image in a wooden
-  // table (empty when off the frame).
-  cv::Rect RawBox(const BodyPose& p, int pose_index) const {
-    const SceneCalibration cal{c_.camera.camera, poses_[pose_index]};
-    const SoftBox light = FootageSoftBox(c_.apparatus);
+  // Raw pixel box of the body with what it changes near itself: its mirror image in a wooden
+  // table, its reflections in the rods (a margin of half its radius), its soft shadow on the
+  // rods. Empty when off the frame.
+  cv::Rect BodyBox(const BodyPose& p, int pose_index) const {
     std::vector<Vector3d> points;
     const double zt = c_.apparatus.table_z;
     for (int k = 0; k < 8; ++k) {
-      const Vector3d q(p.x + (k & 1 ? a_ : -a_), k & 2 ? b_ : -b_, p.z + (k & 4 ? a_ : -a_));
+      const Vector3d q = Corner(p, k);
       points.push_back(q);
-      // Its mirror image in the varnished wood (the cloth reflects nothing).
       if (c_.look.table == TableCover::kWood) points.emplace_back(q.x(), q.y(), 2 * zt - q.z());
+    }
+    AddRodShadowPoints(p, &points);
+    const Vector3d centre = poses_[pose_index].rotation * Vector3d(p.x, 0, p.z) + poses_[pose_index].translation;
+    return PixelBox(points, pose_index, 0.5 * a_ * c_.camera.camera.fx / centre.z() + 4);
+  }
+
+  // Raw pixel box of the body's soft shadow on the table (from every corner of the soft box).
+  cv::Rect ShadowBox(const BodyPose& p, int pose_index) const {
+    std::vector<Vector3d> points;
+    AddShadowPoints(p, c_.apparatus.table_z, &points);
+    return PixelBox(points, pose_index, 4);
+  }
+
+  // Raw pixel of the centre of the body's shadow on the table (from the soft box's centre).
+  Vector2d ShadowCentre(const BodyPose& p, int pose_index) const {
+    const Vector3d lamp = FootageSoftBox(c_.apparatus).centre, q(p.x, 0, p.z);
+    const double s = (lamp.z() - c_.apparatus.table_z) / (lamp.z() - q.z());
+    return ProjectOrOutside(c_.camera.camera, poses_[pose_index], {lamp + s * (q - lamp)}, lens_.max_ray_radius())[0];
+  }
+
+  Vector3d Corner(const BodyPose& p, int k) const {
+    return Vector3d(p.x + (k & 1 ? a_ : -a_), k & 2 ? b_ : -b_, p.z + (k & 4 ? a_ : -a_));
+  }
+
+  // Points of the rods that the body shades from part of the soft box: along each rod's axis
+  // (2 mm steps within 0.4 m of the body), those whose segment to a corner or the centre of the
+  // soft box passes within the body's bounding sphere (a conservative penumbra).
+  void AddRodShadowPoints(const BodyPose& p, std::vector<Vector3d>* points) const {
+    const SoftBox light = FootageSoftBox(c_.apparatus);
+    const Vector3d centre(p.x, 0, p.z);
+    const double reach = std::max(a_, b_) + occluders_[0].r;
+    std::vector<Vector3d> lamps = {light.centre};
+    for (int l = 0; l < 4; ++l)
+      lamps.push_back(light.centre + Vector3d(l & 1 ? light.half_size : -light.half_size,
+                                              l & 2 ? light.half_size : -light.half_size, 0));
+    for (int rod = 0; rod < 2; ++rod) {
+      const Cylinder& c = occluders_[rod];
+      for (double t = 0; t <= c.length; t += 0.002) {
+        const Vector3d q = c.p0 + t * c.e;
+        if (std::abs(q.x() - p.x) > 0.4) continue;
+        for (const Vector3d& lamp : lamps) {
+          const Vector3d d = lamp - q;
+          const double u = std::clamp((centre - q).dot(d) / d.squaredNorm(), 0.0, 1.0);
+          if ((q + u * d - centre).norm() < reach) {
+            points->push_back(q);
+            break;
+          }
+        }
+      }
+    }
+  }
+
+  // The body's bounding box projected from each corner of the soft box onto the plane z.
+  void AddShadowPoints(const BodyPose& p, double z, std::vector<Vector3d>* points) const {
+    const SoftBox light = FootageSoftBox(c_.apparatus);
+    for (int k = 0; k < 8; ++k) {
+      const Vector3d q = Corner(p, k);
+      if (q.z() <= z) continue;
       for (int l = 0; l < 4; ++l) {
         const Vector3d lamp = light.centre + Vector3d(l & 1 ? light.half_size : -light.half_size,
                                                       l & 2 ? light.half_size : -light.half_size, 0);
-        const double s = (lamp.z() - zt) / (lamp.z() - q.z());
-        points.push_back(lamp + s * (q - lamp));
+        const double s = (lamp.z() - z) / (lamp.z() - q.z());
+        points->push_back(lamp + s * (q - lamp));
       }
     }
-    const std::vector<Vector2d> pixels = ProjectOrOutside(cal.camera, cal.pose, points, lens_.max_ray_radius());
+  }
+
+  cv::Rect PixelBox(const std::vector<Vector3d>& points, int pose_index, double margin) const {
+    if (points.empty()) return {};
+    const std::vector<Vector2d> pixels =
+        ProjectOrOutside(c_.camera.camera, poses_[pose_index], points, lens_.max_ray_radius());
     double u0 = kInf, v0 = kInf, u1 = -kInf, v1 = -kInf;
     for (const Vector2d& q : pixels) {
       u0 = std::min(u0, q.x()), u1 = std::max(u1, q.x()), v0 = std::min(v0, q.y()), v1 = std::max(v1, q.y());
     }
-    const Vector3d centre = poses_[pose_index].rotation * Vector3d(p.x, 0, p.z) + poses_[pose_index].translation;
-    const double margin = 0.5 * a_ * c_.camera.camera.fx / centre.z() + 4;  // reflections in the rods
     const cv::Rect box(static_cast<int>(std::floor(u0 - margin)), static_cast<int>(std::floor(v0 - margin)),
                        static_cast<int>(std::ceil(u1 - u0 + 2 * margin)) + 1,
                        static_cast<int>(std::ceil(v1 - v0 + 2 * margin)) + 1);
@@ -258,16 +317,28 @@ class FootageRenderer {
     for (PovrayJob& job : jobs) static_raw_.push_back(lens_.ToRaw(job.pictures[0]));
   }
 
-  // What frame f needs: its truth, and the sub-frames that show the body.
+  // A part of the picture that the moving body changes, rendered at its own sub-frame times:
+  // sub-frame k covers [i0 + k·dt, i0 + (k + 1)·dt] and renders the pinhole window around its own
+  // raw box (a long blur would otherwise render the whole smear K times); the windows share one
+  // size, so that one POV-Ray run renders several.
+  struct Region {
+    double i0 = 0, dt = 0;
+    std::vector<std::optional<BodyPose>> bodies;  // per sub-frame
+    std::vector<cv::Rect> boxes, windows;         // per sub-frame: its raw box, its pinhole window
+    cv::Rect box;                                 // all sub-frames' boxes: the pixels composited
+    std::vector<cv::Mat> raw;                     // per sub-frame: its raw box, once rendered
+  };
+
+  // What frame f needs: its truth, and the regions the body changes. Usually one region (the body
+  // with its shadow). A body high above the table casts its soft shadow far from itself: then
+  // the shadow on the table is a region of its own, sampled in time by its own, slower measure
+  // (a penumbra of p px moving by p/6 px between sub-frames changes the picture as little as a
+  // sharp edge moving by max_step_px), while the body's region keeps the body's fine steps.
   struct FramePlan {
     int frame = 0, pose_index = 0;
     double exposure = 0;
     ClipTruth truth;
-    std::vector<std::optional<BodyPose>> bodies;  // sub-frames (empty: the static scene only)
-    double i0 = 0, dt = 0;                        // sub-frame k covers [i0 + k·dt, i0 + (k + 1)·dt]
-    cv::Rect box;                                 // raw pixels composited: all sub-frames' boxes
-    std::vector<cv::Rect> boxes, windows;         // per sub-frame: its raw box, its pinhole window
-    std::vector<cv::Mat> raw;                     // per sub-frame: its raw box, once rendered
+    std::vector<Region> regions;  // disjoint boxes; empty: the static scene only
   };
 
   FramePlan Plan(int f) const {
@@ -295,7 +366,7 @@ class FootageRenderer {
     bool ends = false;
     for (int k = 0; k <= 16; ++k) {
       const std::optional<BodyPose> b = BodyAt(t_first + (t_last - t_first) * k / 16);
-      if (b) box0 |= RawBox(*b, pi);
+      if (b) box0 |= BodyBox(*b, pi) | ShadowBox(*b, pi);
       else ends = true;
     }
     const std::optional<BodyPose> at_truth = BodyAt(truth.t);
@@ -308,113 +379,137 @@ class FootageRenderer {
     }
     // A body whose motion ends during the exposure is not drawn (see the header).
     if (ends || box0.empty()) return plan;
-    plan.i0 = timing_.RowTime(f, box0.y) - E / 2;
+    const double i0 = timing_.RowTime(f, box0.y) - E / 2;
     const double i1 = timing_.RowTime(f, box0.y + box0.height - 1) + E / 2;
-    double speed = 0;  // px/s of the fastest point of the body (of its pattern, if painted)
+    // Speeds in px/s: of the fastest point of the body (of its pattern, if painted), and of its
+    // shadow's centre; the shadow's penumbra in px.
+    double speed = 0, shadow_speed = 0, penumbra = kInf;
     constexpr int n = 16;
     for (int k = 0; k < n; ++k) {
-      const double ta = plan.i0 + (i1 - plan.i0) * k / n, tb = plan.i0 + (i1 - plan.i0) * (k + 1) / n;
+      const double ta = i0 + (i1 - i0) * k / n, tb = i0 + (i1 - i0) * (k + 1) / n;
       const BodyPose a = *BodyAt(ta), b = *BodyAt(tb);
       const Vector3d cc = poses_[pi].rotation * Vector3d(b.x, 0, b.z) + poses_[pi].translation;
-      const double r_px = a_ * c_.camera.camera.fx / cc.z();
-      const double spin = c_.look.band_half_width > 0 ? r_px * std::abs(b.angle - a.angle) : 0;
+      const double px_per_m = c_.camera.camera.fx / cc.z();
+      const double spin = c_.look.band_half_width > 0 ? a_ * px_per_m * std::abs(b.angle - a.angle) : 0;
       speed = std::max(speed, ((Project(b, pi) - Project(a, pi)).norm() + spin) / (tb - ta));
+      shadow_speed = std::max(shadow_speed, (ShadowCentre(b, pi) - ShadowCentre(a, pi)).norm() / (tb - ta));
+      const SoftBox light = FootageSoftBox(c_.apparatus);
+      const double height = b.z - c_.apparatus.table_z;
+      penumbra = std::min(penumbra, 2 * light.half_size * height / (light.centre.z() - b.z) * px_per_m);
     }
-    const int K =
-        std::clamp(static_cast<int>(std::ceil((i1 - plan.i0) * speed / c_.max_step_px)), 1, c_.max_subframes);
-    plan.dt = (i1 - plan.i0) / K;
-    // Each sub-frame renders only the window around its own body (a long blur would otherwise
-    // render the whole smear K times); the windows share one size, so that one POV-Ray run
-    // renders several.
-    cv::Size size;
-    for (int k = 0; k < K; ++k) {
-      plan.bodies.push_back(BodyAt(plan.i0 + (k + 0.5) * plan.dt));
-      plan.boxes.push_back(RawBox(*plan.bodies.back(), pi));
-      plan.box |= plan.boxes.back();
-      if (!plan.boxes.back().empty()) {
-        plan.windows.push_back(lens_.PinholeWindow(plan.boxes.back()));
-        size.width = std::max(size.width, plan.windows.back().width);
-        size.height = std::max(size.height, plan.windows.back().height);
-      } else {
-        plan.windows.emplace_back();
-      }
-    }
-    if (plan.box.empty()) {
-      plan.bodies.clear();
-      plan.boxes.clear();
-      plan.windows.clear();
+    auto subframes = [&](double px_per_s, double step_px) {
+      return std::clamp(static_cast<int>(std::ceil((i1 - i0) * px_per_s / step_px)), 1, c_.max_subframes);
+    };
+    const int K = subframes(speed, c_.max_step_px);
+    Region body = MakeRegion(i0, i1, K, pi, /*body=*/true, /*shadow=*/false);
+    const int K_shadow = subframes(shadow_speed, c_.max_step_px * std::max(1.0, penumbra / 6));
+    Region shadow = MakeRegion(i0, i1, K_shadow, pi, /*body=*/false, /*shadow=*/true);
+    const cv::Rect grown(body.box.x - 2, body.box.y - 2, body.box.width + 4, body.box.height + 4);
+    if (!(grown & shadow.box).empty()) {
+      // Overlapping: one region with both, at the body's steps.
+      body = MakeRegion(i0, i1, K, pi, /*body=*/true, /*shadow=*/true);
+      if (!body.box.empty()) plan.regions.push_back(std::move(body));
       return plan;
     }
+    if (!body.box.empty()) plan.regions.push_back(std::move(body));
+    if (!shadow.box.empty()) plan.regions.push_back(std::move(shadow));
+    return plan;
+  }
+
+  // K sub-frames over [i0, i1] with the windows of the body (and its nearby shadow and
+  // reflections) and/or of its shadow on the table.
+  Region MakeRegion(double i0, double i1, int K, int pi, bool body, bool shadow) const {
+    Region region;
+    region.i0 = i0;
+    region.dt = (i1 - i0) / K;
+    cv::Size size;
+    for (int k = 0; k < K; ++k) {
+      region.bodies.push_back(BodyAt(i0 + (k + 0.5) * region.dt));
+      cv::Rect box;
+      if (body) box |= BodyBox(*region.bodies.back(), pi);
+      if (shadow) box |= ShadowBox(*region.bodies.back(), pi);
+      region.boxes.push_back(box);
+      region.box |= box;
+      if (!box.empty()) {
+        region.windows.push_back(lens_.PinholeWindow(box));
+        size.width = std::max(size.width, region.windows.back().width);
+        size.height = std::max(size.height, region.windows.back().height);
+      } else {
+        region.windows.emplace_back();
+      }
+    }
     const cv::Rect pinhole(0, 0, lens_.pinhole().width, lens_.pinhole().height);
-    for (cv::Rect& w : plan.windows) {
+    for (cv::Rect& w : region.windows) {
       // Grown to the common size about its own corner, moved back inside the picture.
       w = cv::Rect(std::clamp(w.x, 0, pinhole.width - size.width), std::clamp(w.y, 0, pinhole.height - size.height),
                    size.width, size.height);
     }
-    return plan;
+    return region;
   }
 
   // Renders the sub-frames of the plans, several POV-Ray processes at once (POV-Ray 3.7 idles
   // ~0.2 s per picture in its own polling loops, so one process at a time leaves the CPU idle).
-  // A body at rest (one sub-frame, the same pose and window as one already rendered) is reused.
+  // A region of one sub-frame with the same pose and window as one already rendered (a body at
+  // rest) is reused.
   void Render(std::vector<FramePlan>& plans) {
     std::vector<PovrayJob> jobs;
     struct Part {
-      FramePlan* plan;
+      Region* region;
+      int pose_index;
       size_t first;
     };
     std::vector<Part> parts;
-    std::map<std::string, size_t> pending;              // rest key -> its job in this batch
-    std::vector<std::pair<FramePlan*, size_t>> copies;  // plans that take a pending job's picture
-    for (FramePlan& plan : plans) {
-      plan.raw.assign(plan.bodies.size(), cv::Mat());
-      if (plan.bodies.empty()) continue;
-      if (plan.bodies.size() == 1) {
-        const std::string key = RestKey(plan);
-        if (const auto it = rest_.find(key); it != rest_.end()) {
-          plan.raw[0] = it->second;
-          continue;
+    std::map<std::string, size_t> pending;           // rest key -> its job in this batch
+    std::vector<std::pair<Region*, size_t>> copies;  // regions that take a pending job's picture
+    for (FramePlan& plan : plans)
+      for (Region& region : plan.regions) {
+        const size_t K = region.bodies.size();
+        region.raw.assign(K, cv::Mat());
+        subframes += static_cast<int>(K);
+        if (K == 1) {
+          const std::string key = RestKey(region, plan.pose_index);
+          if (const auto it = rest_.find(key); it != rest_.end()) {
+            region.raw[0] = it->second;
+            continue;
+          }
+          if (const auto it = pending.find(key); it != pending.end()) {
+            copies.emplace_back(&region, it->second);
+            continue;
+          }
+          pending[key] = jobs.size();
         }
-        if (const auto it = pending.find(key); it != pending.end()) {
-          copies.emplace_back(&plan, it->second);
-          continue;
+        // Chunks of ≤ 6 sub-frames: one process per chunk, so that a region's sub-frames spread
+        // over the workers.
+        const size_t chunks = (K + 5) / 6, per = (K + chunks - 1) / chunks;
+        for (size_t first = 0; first < K; first += per) {
+          PovrayJob job;
+          const size_t last = std::min(K, first + per);
+          job.shot.camera = {lens_.pinhole(), poses_[plan.pose_index]};
+          job.shot.crop = region.windows[first];
+          job.shot.bodies.assign(region.bodies.begin() + first, region.bodies.begin() + last);
+          for (size_t k = first; k < last; ++k) job.shot.crop_offsets.push_back(region.windows[k].tl());
+          jobs.push_back(job);
+          parts.push_back({&region, plan.pose_index, first});
         }
-        pending[key] = jobs.size();
       }
-      // Chunks of ≤ 6 sub-frames: one process per chunk, so that a frame's sub-frames spread
-      // over the workers.
-      const size_t K = plan.bodies.size();
-      const size_t chunks = (K + 5) / 6, per = (K + chunks - 1) / chunks;
-      for (size_t first = 0; first < K; first += per) {
-        PovrayJob job;
-        const size_t last = std::min(K, first + per);
-        job.shot.camera = {lens_.pinhole(), poses_[plan.pose_index]};
-        job.shot.crop = plan.windows[first];
-        job.shot.bodies.assign(plan.bodies.begin() + first, plan.bodies.begin() + last);
-        for (size_t k = first; k < last; ++k) job.shot.crop_offsets.push_back(plan.windows[k].tl());
-        jobs.push_back(job);
-        parts.push_back({&plan, first});
-      }
-    }
     RunJobs(jobs, 1);
     for (size_t j = 0; j < jobs.size(); ++j) {
-      FramePlan& plan = *parts[j].plan;
+      Region& region = *parts[j].region;
       for (size_t k = 0; k < jobs[j].pictures.size(); ++k) {
         const size_t i = parts[j].first + k;
-        if (!plan.boxes[i].empty()) plan.raw[i] = lens_.ToRaw(jobs[j].pictures[k], plan.windows[i], plan.boxes[i]);
+        if (!region.boxes[i].empty())
+          region.raw[i] = lens_.ToRaw(jobs[j].pictures[k], region.windows[i], region.boxes[i]);
       }
-      if (plan.bodies.size() == 1) {
-        if (rest_.size() > 8) rest_.clear();
-        rest_[RestKey(plan)] = plan.raw[0];
+      if (region.bodies.size() == 1) {
+        if (rest_.size() > 16) rest_.clear();
+        rest_[RestKey(region, parts[j].pose_index)] = region.raw[0];
       }
     }
-    for (auto& [plan, job] : copies) plan->raw[0] = parts[job].plan->raw[0];
-    subframes += static_cast<int>(std::accumulate(plans.begin(), plans.end(), size_t{0},
-                                                  [](size_t n, const FramePlan& p) { return n + p.bodies.size(); }));
+    for (auto& [region, job] : copies) region->raw[0] = parts[job].region->raw[0];
   }
 
   // The linear raw frame of a rendered plan (before vignetting, gain and noise): each row the
-  // static scene times the light's mean over its window, the body's box Σ_k w_k·picture_k.
+  // static scene times the light's mean over its window; each region's box Σ_k w_k·picture_k.
   cv::Mat Compose(const FramePlan& plan) const {
     const int H = timing_.height, f = plan.frame;
     const double E = plan.exposure;
@@ -431,22 +526,22 @@ class FootageRenderer {
       }
       frame.row(r) *= gain0;
     }
-    if (plan.bodies.empty()) return frame;
-    const size_t K = plan.bodies.size();
-    const cv::Mat still = static_raw_[plan.pose_index](plan.box);
-    cv::Mat acc = cv::Mat::zeros(plan.box.size(), CV_32FC3), picture;
-    for (size_t k = 0; k < K; ++k) {
-      // Sub-frame k over the whole box: the static scene, its own body's box pasted in.
-      still.copyTo(picture);
-      if (!plan.boxes[k].empty()) plan.raw[k].copyTo(picture(plan.boxes[k] - plan.box.tl()));
-      for (int r = 0; r < plan.box.height; ++r) {
-        const auto [wa, wb] = window(plan.box.y + r);
-        const double a = std::max(wa, plan.i0 + k * plan.dt), b = std::min(wb, plan.i0 + (k + 1) * plan.dt);
-        if (b <= a) continue;
-        cv::scaleAdd(picture.row(r), c_.light.Integral(a, b) / E, acc.row(r), acc.row(r));
+    for (const Region& region : plan.regions) {
+      const cv::Mat still = static_raw_[plan.pose_index](region.box);
+      cv::Mat acc = cv::Mat::zeros(region.box.size(), CV_32FC3), picture;
+      for (size_t k = 0; k < region.bodies.size(); ++k) {
+        // Sub-frame k over the region's box: the static scene, its own box pasted in.
+        still.copyTo(picture);
+        if (!region.boxes[k].empty()) region.raw[k].copyTo(picture(region.boxes[k] - region.box.tl()));
+        for (int r = 0; r < region.box.height; ++r) {
+          const auto [wa, wb] = window(region.box.y + r);
+          const double a = std::max(wa, region.i0 + k * region.dt), b = std::min(wb, region.i0 + (k + 1) * region.dt);
+          if (b <= a) continue;
+          cv::scaleAdd(picture.row(r), c_.light.Integral(a, b) / E, acc.row(r), acc.row(r));
+        }
       }
+      acc.copyTo(frame(region.box));
     }
-    acc.copyTo(frame(plan.box));
     return frame;
   }
 
@@ -513,12 +608,12 @@ class FootageRenderer {
     if (failure) std::rethrow_exception(failure);
   }
 
-  std::string RestKey(const FramePlan& plan) const {
-    const BodyPose& b = *plan.bodies[0];
+  std::string RestKey(const Region& region, int pose_index) const {
+    const BodyPose& b = *region.bodies[0];
+    const cv::Rect &w = region.windows[0], &x = region.box;
     char text[200];
-    const cv::Rect& w = plan.windows[0];
-    std::snprintf(text, sizeof text, "%d %d %d %d %d %d %d %d %d %.17g %.17g %.17g", plan.pose_index, w.x, w.y,
-                  w.width, w.height, plan.box.x, plan.box.y, plan.box.width, plan.box.height, b.x, b.z, b.angle);
+    std::snprintf(text, sizeof text, "%d %d %d %d %d %d %d %d %d %.17g %.17g %.17g", pose_index, w.x, w.y, w.width,
+                  w.height, x.x, x.y, x.width, x.height, b.x, b.z, b.angle);
     return text;
   }
 
