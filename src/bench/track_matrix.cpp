@@ -20,7 +20,6 @@ namespace uphill::bench {
 namespace {
 
 namespace fs = std::filesystem;
-using namespace uphill::vision;
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
@@ -82,9 +81,9 @@ bool RayOnCentrePlane(const SceneCalibration& cal, const Vector2d& pixel, double
 std::vector<Position> ReadPeerPositions(const std::string& path, const SceneCalibration& cal) {
   std::vector<Position> out;
   if (!fs::exists(path)) return out;
-  const io::CsvTable table = io::ReadCsvFile(path);
+  const CsvTable table = ReadCsvFile(path);
   const int cu = table.Column("u"), cv = table.Column("v");
-  for (const io::CsvRow& row : table.rows) {
+  for (const CsvRow& row : table.rows) {
     Position p;
     if (row.error.empty() && cu >= 0 && cv >= 0 && !row.cells[cu].empty()) {
       p.u = std::stod(row.cells[cu]);
