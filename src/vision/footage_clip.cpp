@@ -206,30 +206,40 @@ class FootageRenderer {
     return Vector3d(p.x + (k & 1 ? a_ : -a_), k & 2 ? b_ : -b_, p.z + (k & 4 ? a_ : -a_));
   }
 
-  // Points of the rods that the body shades from part of the soft box: along each rod's axis
-  // (2 mm steps within 0.4 m of the body), those whose segment to a corner or the centre of the
-  // soft box passes within the body's bounding sphere (a conservative penumbra).
+  // Points of the rods that the body shades from part of the soft box (a conservative penumbra):
+  // along each rod's axis (2 mm steps within 0.4 m of the body), those from which the body's
+  // bounding sphere (grown by the rod's radius) hides some of the soft box. Seen from a rod point
+  // q the sphere is a cone of half angle α about q → centre; it meets the lamp's plane in an
+  // ellipse about the point Lc where q → centre does, inside the circle of radius
+  // |Lc − q|·tan α / cos(θ + α) (θ the cone axis' angle from the vertical); the point is kept when
+  // that circle meets the square. Sampling a few points of the soft box instead misses the far
+  // penumbra, where the sphere hides a spot smaller than their spacing.
   void AddRodShadowPoints(const BodyPose& p, std::vector<Vector3d>* points) const {
     const SoftBox light = FootageSoftBox(c_.apparatus);
     const Vector3d centre(p.x, 0, p.z);
     const double reach = std::max(a_, b_) + occluders_[0].r;
-    std::vector<Vector3d> lamps = {light.centre};
-    for (int l = 0; l < 4; ++l)
-      lamps.push_back(light.centre + Vector3d(l & 1 ? light.half_size : -light.half_size,
-                                              l & 2 ? light.half_size : -light.half_size, 0));
     for (int rod = 0; rod < 2; ++rod) {
       const Cylinder& c = occluders_[rod];
       for (double t = 0; t <= c.length; t += 0.002) {
         const Vector3d q = c.p0 + t * c.e;
         if (std::abs(q.x() - p.x) > 0.4) continue;
-        for (const Vector3d& lamp : lamps) {
-          const Vector3d d = lamp - q;
-          const double u = std::clamp((centre - q).dot(d) / d.squaredNorm(), 0.0, 1.0);
-          if ((q + u * d - centre).norm() < reach) {
-            points->push_back(q);
-            break;
-          }
+        const Vector3d v = centre - q;
+        const double distance = v.norm();
+        if (distance <= reach) {
+          points->push_back(q);
+          continue;
         }
+        if (v.z() <= 0 || light.centre.z() <= q.z()) continue;  // the body is not towards the lamp
+        const double alpha = std::asin(reach / distance), theta = std::acos(v.z() / distance);
+        if (theta + alpha >= 0.5 * M_PI) {
+          points->push_back(q);  // the cone reaches the horizon: keep the point
+          continue;
+        }
+        const Vector3d lc = q + v * ((light.centre.z() - q.z()) / v.z());
+        const double radius = (lc - q).norm() * std::tan(alpha) / std::cos(theta + alpha);
+        const double dx = std::max(std::abs(lc.x() - light.centre.x()) - light.half_size, 0.0);
+        const double dy = std::max(std::abs(lc.y() - light.centre.y()) - light.half_size, 0.0);
+        if (std::hypot(dx, dy) <= radius) points->push_back(q);
       }
     }
   }
