@@ -1,5 +1,5 @@
-// `uphill bench motion`: work–precision of the motion methods (src/motion) on one release
-// trajectory, against a 50-digit reference (src/oracle) and SciPy/NumPy (tools/bench/
+// `uphill bench motion`: work–precision of the motion methods (src/motion) on three
+// trajectories (oracle/motion_problems.hpp), against 50-digit references (src/oracle) and SciPy/NumPy (tools/bench/
 // motion_peers.py), with a gnuplot figure of time against error. What it measures and how:
 // docs/bench.md; its latest results: docs/benchmarks.md.
 #pragma once
