@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <sstream>
+#include <cstdio>
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include "cli_test_support.hpp"
@@ -153,6 +156,56 @@ TEST(ConvertCli, FlagsAreDefaultsForBatchColumnsAndCsvNamesItsUnits) {
   // Row 3 has D = 4 in = 101.6 mm: a little smaller X than row 2's 100 mm.
   EXPECT_NE(r.out.find("\n2,spheroid,14.44"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\n3,spheroid,14.44"), std::string::npos) << r.out;
+}
+
+// The whole CSV output and stderr of a batch whose numeric rows take the block path, against the
+// same rows sent through the full path (an empty label column in front, which the block path does
+// not take; its column removed from the output): good rows, rows with X beyond the crossbar, bad
+// cells, a short row, an empty cell filled from the flags, over more rows than one block.
+// Truth: the full path's output, byte for byte.
+TEST(ConvertCli, BatchCsvOfNumericRowsIsTheFullPathsOutput) {
+  std::string numeric = "L_mm,H_mm,D_mm\n", labelled = "label,L_mm,H_mm,D_mm\n";
+  const std::vector<std::string> odd = {"1165,-3,100", "1165,abc,100", "1165,300", "0,300,100", "1165,,100",
+                                        "1165,300,1e999", "1165,0,100", "1e-300,300,100"};
+  for (int i = 0; i < 5000; ++i) {
+    std::string row;
+    if (i % 211 == 17) {
+      row = odd[static_cast<std::size_t>(i / 211) % odd.size()];
+    } else {
+      char text[64];
+      const long long k = i;
+      std::snprintf(text, sizeof text, "%.2f,%.2f,%.2f", 500.0 + static_cast<double>(k * 7919 % 150000) / 100.0,
+                    1.0 + static_cast<double>(k * 104729 % 49900) / 100.0,
+                    20.0 + static_cast<double>(k * 15485863 % 23000) / 100.0);
+      row = text;
+    }
+    numeric += row + "\n";
+    labelled += "," + row + "\n";
+  }
+  const std::string flags = "--body spheroid --a 15.875mm --b 25.4mm --H 250mm --csv";
+  const auto fast = RunUphill("convert --batch - " + flags, numeric);
+  const auto full = RunUphill("convert --batch - " + flags, labelled);
+  EXPECT_EQ(fast.status, 2);
+  EXPECT_EQ(full.status, 2);
+  // The short row's message counts the label column too.
+  const auto counted = [](std::string text) {
+    for (std::size_t at; (at = text.find("has 3 fields, the header has 4")) != std::string::npos;)
+      text.replace(at, 30, "has 2 fields, the header has 3");
+    return text;
+  };
+  EXPECT_EQ(fast.err, counted(full.err));
+  EXPECT_GE(std::count(fast.err.begin(), fast.err.end(), '\n'), 15);
+  // Drop the (empty) label column: the second field of every line.
+  std::string without_label;
+  std::istringstream lines(full.out);
+  for (std::string line; std::getline(lines, line);) {
+    const std::size_t first = line.find(',');
+    without_label += line.erase(first, line.find(',', first + 1) - first) + "\n";
+  }
+  EXPECT_EQ(fast.out.substr(0, fast.out.find('\n')), "row,body,theta_deg,alpha_deg,phi_deg,X_mm,x_max_mm,rolls_up,note,error");
+  EXPECT_EQ(fast.out, counted(without_label));
+  EXPECT_NE(fast.out.find(",yes,X beyond crossbar,\n"), std::string::npos);
+  EXPECT_EQ(std::count(fast.out.begin(), fast.out.end(), '\n'), 5001);
 }
 
 }  // namespace

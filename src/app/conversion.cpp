@@ -107,6 +107,29 @@ ConversionResult Convert(const Configuration& configuration, const ConversionOpt
   return r;
 }
 
+ConversionSummary Summarize(const ConversionResult& r) {
+  const Scene& s = r.scene;
+  ConversionSummary v;
+  v.label = r.configuration.label;
+  v.body = s.body().kind;
+  v.theta = s.rails().theta;
+  v.alpha = s.rails().alpha;
+  v.phi = s.rails().HalfAngleBetweenRails();
+  v.x_eq = s.x_eq();
+  v.x_max = s.x_max();
+  if (r.propagation && r.propagation->x_eq) {
+    v.u_x_eq = r.propagation->x_eq->u_first_order;
+    v.u_mc_x_eq = r.propagation->x_eq->u_monte_carlo;
+  }
+  v.rest = r.rest;
+  v.theta0 = s.theta0();
+  v.rolls_up = s.rolls_up();
+  const auto crossbar = r.configuration.CrossbarDistance();
+  v.x_eq_beyond_crossbar = crossbar && v.x_eq && *v.x_eq > *crossbar;
+  v.uncertainty_disagrees = r.propagation && r.propagation->disagrees;
+  return v;
+}
+
 nlohmann::ordered_json ToJson(const ConversionResult& r) {
   using nlohmann::ordered_json;
   const Scene& s = r.scene;

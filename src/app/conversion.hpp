@@ -41,6 +41,23 @@ struct ConversionResult {
 // Throws InputError (quantity "--at-x" or "--mu") for a position off the path or a bad μ.
 ConversionResult Convert(const Configuration& configuration, const ConversionOptions& options);
 
+// The values of a result that the table and the CSV of `uphill convert` show (SI: m, rad): what a
+// batch hands on per row when nothing else is printed (convert_batch.hpp, BatchDetail::kSummary).
+struct ConversionSummary {
+  std::string label;
+  BodyKind body = BodyKind::kSpheroid;
+  double theta = 0.0, alpha = 0.0, phi = 0.0;
+  std::optional<double> x_eq;                // none for the double cone
+  double x_max = 0.0;                        // x_fall for the double cone
+  std::optional<double> u_x_eq, u_mc_x_eq;   // first-order and Monte Carlo u(x_eq)
+  std::optional<RestBand> rest;              // with mu
+  std::optional<double> theta0;              // double cone
+  bool rolls_up = true;
+  bool x_eq_beyond_crossbar = false;         // apparatus input with X > L (horizontal)
+  bool uncertainty_disagrees = false;        // first order and Monte Carlo differ by > 5 %
+};
+ConversionSummary Summarize(const ConversionResult& result);
+
 nlohmann::ordered_json ToJson(const ConversionResult& result);
 
 }  // namespace uphill

@@ -86,7 +86,8 @@ void Run(const ConvertFlags& f) {
         if (row.error.empty()) return;
         std::cerr << "uphill: " << row.error << "\n";
         ExitStatus() = 2;
-      });
+      },
+      format == OutputFormat::kJson ? BatchDetail::kFull : BatchDetail::kSummary);
   printer->Finish();
 }
 

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
-#include <functional>
+#include <cstring>
+#include <optional>
+#include <string_view>
 #include <numbers>
 
 #include "io/units.hpp"
@@ -13,36 +15,36 @@ namespace uphill::cli {
 namespace {
 
 
-// printf's %.6f and %.6g (std::to_chars with a precision is specified as printf is, and is
-// several times faster: a large batch prints millions of these).
-std::string Fixed6(double v) {
-  char buf[64];
-  return std::string(buf, std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, 6).ptr);
-}
-std::string General6(double v) {
-  char buf[64];
-  return std::string(buf, std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 6).ptr);
+// The longest text of one number below: printf's %.6f of the largest double (309 digits, sign,
+// point, 6 decimals), longer than any %.6g.
+constexpr std::size_t kNumberText = 320;
+
+// printf's %.6f and %.6g written at p, which has room for kNumberText characters (std::to_chars
+// with a precision is specified as printf is, and is several times faster: a large batch prints
+// millions of these).
+char* Fixed6(char* p, double v) { return std::to_chars(p, p + kNumberText, v, std::chars_format::fixed, 6).ptr; }
+char* General6(char* p, double v) { return std::to_chars(p, p + kNumberText, v, std::chars_format::general, 6).ptr; }
+
+char* Copy(char* p, std::string_view s) {
+  if (!s.empty()) std::memcpy(p, s.data(), s.size());
+  return p + s.size();
 }
 
+// Writes a CSV cell at p (room for 2·size + 2 characters), quoted when it holds a comma, a quote
+// or a line break.
+char* CsvText(char* p, std::string_view s) {
+  if (s.find_first_of(",\"\n") == std::string_view::npos) return Copy(p, s);
+  *p++ = '"';
+  for (char c : s) {
+    if (c == '"') *p++ = '"';
+    *p++ = c;
+  }
+  *p++ = '"';
+  return p;
+}
 
 std::string Pad(const std::string& s, size_t width) {
   return s.size() < width ? s + std::string(width - s.size(), ' ') : s + " ";
-}
-
-// Appends a CSV cell, quoted when it holds a comma, a quote or a line break.
-void AppendCsv(std::string* line, const std::string& s) {
-  bool plain = true;
-  for (char c : s) plain &= c != ',' && c != '"' && c != '\n';
-  if (plain) {
-    *line += s;
-    return;
-  }
-  *line += '"';
-  for (char c : s) {
-    if (c == '"') *line += '"';
-    *line += c;
-  }
-  *line += '"';
 }
 
 void PrintSingle(std::ostream& out, const ConvertedRow& row, const std::string& unit) {
@@ -102,46 +104,30 @@ ConversionPrinter::ConversionPrinter(std::ostream& out, OutputFormat format, boo
                                      OptionalColumns any)
     : out_(out), format_(format), batch_(batch), unit_(std::move(unit)) {
   // ToUnit's division, with the unit looked up once (a batch prints millions of lengths).
-  const double factor = UnitFactor(Dimension::kLength, unit_);
-  if (factor == 0.0) ToUnit(1.0, Dimension::kLength, unit_);  // throws its message
-  const auto deg = [](double rad) { return Fixed6(rad * 180.0 / std::numbers::pi); };
-  const auto len = [factor](double m) { return General6(m / factor); };
+  unit_factor_ = UnitFactor(Dimension::kLength, unit_);
+  if (unit_factor_ == 0.0) ToUnit(1.0, Dimension::kLength, unit_);  // throws its message
+  for (BodyKind kind : {BodyKind::kSphere, BodyKind::kSpheroid, BodyKind::kDoubleCone})
+    body_names_[static_cast<std::size_t>(kind)] = Body{kind}.Name();
+  if (format_ == OutputFormat::kCsv) csv_.resize(kCsvBlock + 4096);
   std::vector<Column>& cols = columns_;
-  if (any.label) cols.push_back({"label", [](const ConversionResult& r) { return r.configuration.label; }});
-  cols.push_back({"body", [](const ConversionResult& r) { return r.scene.body().Name(); }});
-  cols.push_back({"theta_deg", [deg](const ConversionResult& r) { return deg(r.scene.rails().theta); }});
-  cols.push_back({"alpha_deg", [deg](const ConversionResult& r) { return deg(r.scene.rails().alpha); }});
-  cols.push_back({"phi_deg", [deg](const ConversionResult& r) { return deg(r.scene.rails().HalfAngleBetweenRails()); }});
-  cols.push_back({"X_" + unit_, [len](const ConversionResult& r) {
-                    return r.scene.x_eq() ? len(*r.scene.x_eq()) : std::string("-");
-                  }});
+  if (any.label) cols.push_back({"label", Cell::kLabel});
+  cols.push_back({"body", Cell::kBody});
+  cols.push_back({"theta_deg", Cell::kTheta});
+  cols.push_back({"alpha_deg", Cell::kAlpha});
+  cols.push_back({"phi_deg", Cell::kPhi});
+  cols.push_back({"X_" + unit_, Cell::kX});
   if (any.uncertainty) {
-    cols.push_back({"u_X_" + unit_, [len](const ConversionResult& r) {
-                      return r.propagation && r.propagation->x_eq ? len(r.propagation->x_eq->u_first_order) : std::string("-");
-                    }});
-    cols.push_back({"u_X_mc_" + unit_, [len](const ConversionResult& r) {
-                      return r.propagation && r.propagation->x_eq ? len(r.propagation->x_eq->u_monte_carlo) : std::string("-");
-                    }});
+    cols.push_back({"u_X_" + unit_, Cell::kUX});
+    cols.push_back({"u_X_mc_" + unit_, Cell::kUXMc});
   }
-  cols.push_back({"x_max_" + unit_, [len](const ConversionResult& r) { return len(r.scene.x_max()); }});
+  cols.push_back({"x_max_" + unit_, Cell::kXMax});
   if (any.rest) {
-    cols.push_back({"x_rest_low_" + unit_, [len](const ConversionResult& r) { return r.rest ? len(r.rest->low) : std::string("-"); }});
-    cols.push_back({"x_rest_" + unit_, [len](const ConversionResult& r) { return r.rest ? len(r.rest->high) : std::string("-"); }});
+    cols.push_back({"x_rest_low_" + unit_, Cell::kRestLow});
+    cols.push_back({"x_rest_" + unit_, Cell::kRest});
   }
-  if (any.cone)
-    cols.push_back({"theta0_deg", [deg](const ConversionResult& r) {
-                      return r.scene.theta0() ? deg(*r.scene.theta0()) : std::string("-");
-                    }});
-  cols.push_back({"rolls_up", [](const ConversionResult& r) { return std::string(r.scene.rolls_up() ? "yes" : "no"); }});
-  cols.push_back({"note", [](const ConversionResult& r) {
-                    std::string note;
-                    if (const auto crossbar = r.configuration.CrossbarDistance();
-                        crossbar && r.scene.x_eq() && *r.scene.x_eq() > *crossbar)
-                      note = "X beyond crossbar";
-                    if (r.propagation && r.propagation->disagrees)
-                      note += std::string(note.empty() ? "" : "; ") + "u: first order != MC";
-                    return note;
-                  }});
+  if (any.cone) cols.push_back({"theta0_deg", Cell::kTheta0});
+  cols.push_back({"rolls_up", Cell::kRollsUp});
+  cols.push_back({"note", Cell::kNote});
   if (format_ == OutputFormat::kCsv) {
     out_ << "row";
     for (const Column& c : columns_) out_ << "," << c.header;
@@ -151,11 +137,58 @@ ConversionPrinter::ConversionPrinter(std::ostream& out, OutputFormat format, boo
 
 ConversionPrinter::~ConversionPrinter() = default;
 
+std::size_t ConversionPrinter::CellRoom(const ConversionSummary& v) const {
+  return kNumberText + 2 * v.label.size() + 2;
+}
+
+char* ConversionPrinter::WriteCell(char* p, Cell cell, const ConversionSummary& v, bool csv) const {
+  const auto deg = [](char* q, double rad) { return Fixed6(q, rad * 180.0 / std::numbers::pi); };
+  const auto len = [this](char* q, double m) { return General6(q, m / unit_factor_); };
+  const auto len_or_dash = [&](const std::optional<double>& m) {
+    if (m) return len(p, *m);
+    *p = '-';
+    return p + 1;
+  };
+  switch (cell) {
+    case Cell::kLabel: return csv ? CsvText(p, v.label) : Copy(p, v.label);
+    case Cell::kBody: return Copy(p, body_names_[static_cast<std::size_t>(v.body)]);
+    case Cell::kTheta: return deg(p, v.theta);
+    case Cell::kAlpha: return deg(p, v.alpha);
+    case Cell::kPhi: return deg(p, v.phi);
+    case Cell::kX: return len_or_dash(v.x_eq);
+    case Cell::kUX: return len_or_dash(v.u_x_eq);
+    case Cell::kUXMc: return len_or_dash(v.u_mc_x_eq);
+    case Cell::kXMax: return len(p, v.x_max);
+    case Cell::kRestLow: return len_or_dash(v.rest ? std::optional<double>(v.rest->low) : std::nullopt);
+    case Cell::kRest: return len_or_dash(v.rest ? std::optional<double>(v.rest->high) : std::nullopt);
+    case Cell::kTheta0:
+      if (v.theta0) return deg(p, *v.theta0);
+      *p = '-';
+      return p + 1;
+    case Cell::kRollsUp: return Copy(p, v.rolls_up ? "yes" : "no");
+    case Cell::kNote:
+      // Neither part holds a comma or a quote: no CSV quoting.
+      if (v.x_eq_beyond_crossbar) p = Copy(p, "X beyond crossbar");
+      if (v.uncertainty_disagrees) p = Copy(p, v.x_eq_beyond_crossbar ? "; u: first order != MC" : "u: first order != MC");
+      return p;
+  }
+  return p;
+}
+
 std::vector<std::string> ConversionPrinter::Cells(const ConvertedRow& row) const {
+  std::optional<ConversionSummary> from_result;
+  if (!row.summary && row.result) from_result = Summarize(*row.result);
+  const ConversionSummary* v = row.summary ? &*row.summary : from_result ? &*from_result : nullptr;
   std::vector<std::string> line;
   line.reserve(columns_.size() + 2);
   line.push_back(std::to_string(row.row));
-  for (const Column& c : columns_) line.push_back(row.result ? c.text(*row.result) : "");
+  for (const Column& c : columns_) {
+    line.emplace_back();
+    if (!v) continue;
+    std::string& text = line.back();
+    text.resize(CellRoom(*v));
+    text.resize(static_cast<std::size_t>(WriteCell(text.data(), c.cell, *v, false) - text.data()));
+  }
   line.push_back(row.error);
   return line;
 }
@@ -190,25 +223,41 @@ void ConversionPrinter::Row(const ConvertedRow& row) {
     if (row.result) PrintSingle(out_, row, unit_);
     return;
   }
-  std::vector<std::string> line = Cells(row);
   if (format_ == OutputFormat::kCsv) {
-    for (std::size_t i = 0; i < line.size(); ++i) {
-      if (i) csv_line_ += ',';
-      AppendCsv(&csv_line_, line[i]);
+    std::optional<ConversionSummary> from_result;
+    if (!row.summary && row.result) from_result = Summarize(*row.result);
+    const ConversionSummary* v = row.summary ? &*row.summary : from_result ? &*from_result : nullptr;
+    // Room for the line: the row number, every cell, the error (quoted) and the separators.
+    const std::size_t room = 24 + columns_.size() * (v ? CellRoom(*v) + 1 : 1) + 2 * row.error.size() + 4;
+    if (csv_used_ + room > csv_.size()) {
+      FlushCsv();
+      if (room > csv_.size()) csv_.resize(room);
     }
-    csv_line_ += '\n';
-    if (csv_line_.size() >= kCsvBlock) {
-      out_.write(csv_line_.data(), static_cast<std::streamsize>(csv_line_.size()));
-      csv_line_.clear();
+    char* p = csv_.data() + csv_used_;
+    p = std::to_chars(p, p + 24, row.row).ptr;
+    for (const Column& c : columns_) {
+      *p++ = ',';
+      if (v) p = WriteCell(p, c.cell, *v, true);
     }
+    *p++ = ',';
+    p = CsvText(p, row.error);
+    *p++ = '\n';
+    csv_used_ = static_cast<std::size_t>(p - csv_.data());
+    if (csv_used_ >= kCsvBlock) FlushCsv();
     return;
   }
+  std::vector<std::string> line = Cells(row);
   if (!table_started_) {
     held_.push_back(std::move(line));
     if (held_.size() >= kTableSample) FlushTable();
     return;
   }
   TableLine(line);
+}
+
+void ConversionPrinter::FlushCsv() {
+  out_.write(csv_.data(), static_cast<std::streamsize>(csv_used_));
+  csv_used_ = 0;
 }
 
 void ConversionPrinter::FlushTable() {
@@ -241,8 +290,7 @@ void ConversionPrinter::TableLine(const std::vector<std::string>& cells, bool he
 void ConversionPrinter::Finish() {
   if (finished_) return;
   finished_ = true;
-  out_.write(csv_line_.data(), static_cast<std::streamsize>(csv_line_.size()));
-  csv_line_.clear();
+  FlushCsv();
   if (format_ == OutputFormat::kJson && batch_) out_ << (rows_ ? "\n]\n" : "[]\n");
   if (format_ == OutputFormat::kTable && batch_) {
     if (!table_started_) FlushTable();
