@@ -60,27 +60,29 @@ class NumericRows {
     usable_ = true;
   }
 
-  // The configuration of `cells` if this row can take the short path (and a template exists).
-  std::optional<Configuration> Of(const std::vector<std::string_view>& cells) const {
-    if (!usable_ || !first_) return std::nullopt;
-    Configuration c = *first_;
+  // The configuration of `cells` if this row can take the short path (and a template exists);
+  // valid until the next call. (It is the template with every numeric column replaced: each call
+  // sets them all, so a row refused half-way leaves nothing behind for the next.)
+  const Configuration* Of(const std::vector<std::string_view>& cells) {
+    if (!usable_ || !row_) return nullptr;
+    Configuration& c = *row_;
     for (std::size_t j = 0; j < cells.size(); ++j) {
       if (columns_[j].name.empty()) continue;
       double number = 0;
-      if (!Plain(cells[j], &number)) return std::nullopt;
+      if (!Plain(cells[j], &number)) return nullptr;
       const double si = number * columns_[j].factor;  // as ParseQuantity
-      if (!std::isfinite(si) || !SetNumericField(c, columns_[j].name, si)) return std::nullopt;
+      if (!std::isfinite(si) || !SetNumericField(c, columns_[j].name, si)) return nullptr;
     }
-    return c;
+    return &c;
   }
 
   // Offers a row parsed in full as the template of the later ones.
   void Offer(const std::vector<std::string_view>& cells, const Configuration& c) {
-    if (!usable_ || first_) return;
+    if (!usable_ || row_) return;
     double number = 0;
     for (std::size_t j = 0; j < cells.size(); ++j)
       if (!columns_[j].name.empty() && !Plain(cells[j], &number)) return;
-    first_ = c;
+    row_ = c;
   }
 
  private:
@@ -103,7 +105,7 @@ class NumericRows {
   };
   std::vector<Column> columns_;
   bool usable_ = false;
-  std::optional<Configuration> first_;
+  std::optional<Configuration> row_;  // the template, then the last row's configuration
 };
 
 // Rows of the short path gathered for the batch kernels (BatchDetail::kSummary) and handed on
@@ -218,7 +220,7 @@ void Run(CsvRecords& records, const FieldSource& flag_defaults, const Conversion
     if (!any) on_header({records.source(), records.header()});
     any = true;
     if (record.error.empty()) {
-      if (const std::optional<Configuration> c = numeric.Of(record.cells)) {
+      if (const Configuration* c = numeric.Of(record.cells)) {
         if (summary && SummaryBlock::Covers(*c, options)) {
           block.Add(record.row, *c);
           continue;

@@ -304,7 +304,6 @@ void RunIoBenchmark(const IoBenchmarkOptions& f, std::ostream& out) {
     std::vector<std::string> row = {"convert --batch --csv", tag, FormatBytes(settings_bytes),
                                     FormatSeconds(ours.run.cpu_seconds), FormatBytes(ours.run.peak_bytes),
                                     OfFile(ours.run.peak_bytes, settings_bytes), ""};
-    double ratio = 0;
     if (!script.empty()) {
       std::vector<std::string> argv = python;
       argv.insert(argv.end(), {"convert", settings.string(), "--a", std::to_string(kAm), "--b", std::to_string(kBm)});
@@ -326,16 +325,17 @@ void RunIoBenchmark(const IoBenchmarkOptions& f, std::ostream& out) {
       char accuracy[64];
       std::snprintf(accuracy, sizeof accuracy, "%.0e deg, %.0e", angle, length);
       row[6] = accuracy;
-      ratio = bare.run.cpu_seconds / ours.run.cpu_seconds;
       row.insert(row.end(), {"loadtxt + convert", FormatSeconds(bare.run.cpu_seconds), FormatBytes(bare.run.peak_bytes),
                              Ratio(bare.run.cpu_seconds, ours.run.cpu_seconds), "(no output)"});
       table.Add(row);
       table.Add({"", "", "", "", "", "", "", "+ savetxt", FormatSeconds(written.run.cpu_seconds),
                  FormatBytes(written.run.peak_bytes), Ratio(written.run.cpu_seconds, ours.run.cpu_seconds),
                  "same formats"});
+      // The goal's peer does the same work as the command: read, convert and write the columns.
       if (n == 1'000'000)
-        at_million.push_back({"convert --batch (vs + savetxt: " + Ratio(written.run.cpu_seconds, ours.run.cpu_seconds) + ")",
-                              ratio, static_cast<double>(ours.run.peak_bytes) / static_cast<double>(settings_bytes)});
+        at_million.push_back({"convert --batch --csv vs NumPy + savetxt (without output: " + Ratio(bare.run.cpu_seconds, ours.run.cpu_seconds) + ")",
+                              written.run.cpu_seconds / ours.run.cpu_seconds,
+                              static_cast<double>(ours.run.peak_bytes) / static_cast<double>(settings_bytes)});
     } else {
       table.Add(row);
     }
