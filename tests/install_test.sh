@@ -42,6 +42,10 @@ grep -q '"york"' fit.json || fail "fit of the installed sample experiment has no
 uphill paper-figures -o figures > /dev/null
 [[ -f figures/series2-fixed-L/fit_y_vs_x.svg ]] || fail "paper-figures did not find the installed sample data"
 
+# A vision command (OpenCV; run by a sibling executable when the program is split).
+uphill calibrate target --cols 9 --rows 6 --square 20mm -o board.svg > /dev/null
+grep -q "<svg" board.svg || fail "calibrate target wrote no SVG"
+
 # The docs and the service files.
 for f in share/doc/uphill/README.md share/doc/uphill/data/README.md share/doc/uphill/calibration/README.md \
          share/systemd/user/uphill-serve.service share/applications/uphill-serve.desktop \
@@ -100,5 +104,21 @@ got=$(complete_words uphill convert --bat)
 got=$(complete_words uphill convert --body sphere --batch "$data/convert_b")
 [[ $got == "$data/convert_batch.csv" ]] || fail "completion of a --batch file gave '$got'"
 
-echo "install_test: installed into $prefix: --version, convert, fit, paper-figures from another folder;" \
-     "$pages manual pages render and list every flag; bash completion"
+# --- the Python module, where Debian's python3 finds it under this prefix ---
+if [[ -n ${UPHILL_PYTHON:-} ]]; then
+  module_dir=$prefix/${UPHILL_PYTHON_INSTALL_DIR}
+  ls "$module_dir"/uphill*.so > /dev/null 2>&1 || fail "no Python module in $module_dir"
+  got=$(PYTHONPATH=$module_dir "$UPHILL_PYTHON" -c '
+import sys, numpy as np, uphill
+print(uphill.__version__)
+t, a, x = uphill.convert_apparatus(np.array([1.165]), np.array([0.3]), np.array([0.12]), "15.875 mm", "25.4 mm")
+one = uphill.convert_setting(body="spheroid", a="15.875mm", b="25.4mm", L="1165mm", H="300mm", D="120mm", mc_trials=1000)
+print("same" if abs(one["x_eq"] / x[0] - 1) < 3e-15 else "differs")  # batch kernel vs Scene: a few ulp
+print(uphill.analyse_experiment(sys.argv[1], mc_trials=1000).fits["york"].slope > 0)
+' "$data/series2-fixed-L")
+  [[ $got == "$version"$'\n'"same"$'\n'"True" ]] || fail "the installed Python module printed: $got"
+  python_note=", and the Python module"
+fi
+
+echo "install_test: installed into $prefix: --version, convert, fit, paper-figures, calibrate target from another folder;" \
+     "$pages manual pages render and list every flag; bash completion${python_note:-}"

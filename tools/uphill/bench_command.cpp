@@ -7,6 +7,7 @@
 #include "bench/fit_benchmark.hpp"
 #include "bench/io_benchmark.hpp"
 #include "bench/motion_benchmark.hpp"
+#include "bench/python_benchmark.hpp"
 #include "bench/track_benchmark.hpp"
 #include "commands.hpp"
 #include "vision_program.hpp"
@@ -124,6 +125,22 @@ void AddTrack(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& 
   });
 }
 
+void AddPython(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
+  auto o = std::make_shared<bench::PythonBenchmarkOptions>();
+  CLI::App* cmd = bench.add_subcommand(
+      "python", "The Python module's calls against the C++ kernels and NumPy, in one Python process");
+  cmd->add_option("--elements", o->elements, "elements (and York rows) per call")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "seed of the synthetic data")->capture_default_str();
+  cmd->add_option("--repeats", o->repeats, "timed repeats per row (the best counts)")->capture_default_str();
+  AddCommonFlags(cmd, &o->common, "Python with NumPy that imports the module");
+  cmd->add_option("--script", o->script, "path of tools/bench/python_module.py");
+  cmd->add_option("--module-dir", o->module_dir, "folder of the module to import (default: this build's)");
+  cmd->callback([o, argv] {
+    o->common.command = CommandLine(*argv);
+    bench::RunPythonBenchmark(*o, std::cout);
+  });
+}
+
 }  // namespace
 
 void AddBenchCommand(CLI::App& app, const std::vector<std::string>& arguments) {
@@ -135,6 +152,7 @@ void AddBenchCommand(CLI::App& app, const std::vector<std::string>& arguments) {
   AddIo(*bench, argv);
   AddMotion(*bench, argv);
   AddTrack(*bench, argv);
+  AddPython(*bench, argv);
 }
 
 }  // namespace uphill::cli

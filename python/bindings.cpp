@@ -1,0 +1,184 @@
+#include "bindings.hpp"
+
+#include <pybind11/eval.h>
+
+#include <cmath>
+#include <cstring>
+
+namespace uphill::python {
+
+namespace {
+
+// uphill.InputError, defined in Python so that it is an ordinary ValueError subclass with
+// attributes (pickles, prints and compares like any exception).
+constexpr const char* kInputErrorSource = R"py(
+class InputError(ValueError):
+    """Bad input: a value outside the model's domain, a malformed file, arrays that do not match.
+
+    Attributes:
+        quantity: what is wrong, as the command line would name it ("D", "u(Y)", a file and column).
+        rule: the rule broken, in words ("must be > 0 (got -0.003)").
+        row: the index of the offending element of an array argument (flat, C order), or the
+            file's row, or None when the error is not about one row.
+    """
+
+    def __init__(self, quantity, rule, row=None):
+        where = quantity if row is None else f"{quantity}, element {row}"
+        super().__init__(f"{where}: {rule}")
+        self.quantity = quantity
+        self.rule = rule
+        self.row = row
+
+    def __reduce__(self):
+        return (type(self), (self.quantity, self.rule, self.row))
+)py";
+
+py::object& InputErrorType() {
+  static py::object type;  // set once at import; lives as long as the module
+  return type;
+}
+
+}  // namespace
+
+void RegisterErrors(py::module_& m) {
+  py::dict scope;
+  scope["__name__"] = "uphill";
+  py::exec(kInputErrorSource, scope);
+  InputErrorType() = scope["InputError"];
+  m.attr("InputError") = InputErrorType();
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const RowInputError& e) {
+      py::object error = InputErrorType()(e.quantity(), e.rule(), e.row());
+      PyErr_SetObject(InputErrorType().ptr(), error.ptr());
+    } catch (const InputError& e) {
+      py::object error = InputErrorType()(e.quantity(), e.rule(), py::none());
+      PyErr_SetObject(InputErrorType().ptr(), error.ptr());
+    }
+  });
+}
+
+Float64Argument::Float64Argument(const py::handle& value, std::string name) : name_(std::move(name)) {
+  if (py::isinstance<py::bool_>(value))
+    throw py::type_error(name_ + ": expected a number or a float64 array, got a bool");
+  if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) {
+    scalar_ = value.cast<double>();
+    data_ = &scalar_;
+    return;
+  }
+  py::array array;
+  if (py::isinstance<py::array>(value)) {
+    array = py::reinterpret_borrow<py::array>(value);
+  } else if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
+    array = py::array::ensure(value);  // NumPy's own conversion; its dtype is checked below
+  } else {
+    throw py::type_error(name_ + ": expected a number or a float64 array, got " +
+                         std::string(py::str(py::type::of(value).attr("__name__"))));
+  }
+  if (!array || !array.dtype().is(py::dtype::of<double>()))
+    throw py::type_error(name_ + ": expected float64, got " +
+                         (array ? std::string(py::str(array.dtype())) : std::string("a list of mixed types")) +
+                         " (uphill casts nothing silently: pass np.asarray(" + name_ + ", dtype=np.float64))");
+  if (array.ndim() == 0) {
+    scalar_ = *static_cast<const double*>(array.data());
+    data_ = &scalar_;
+    return;
+  }
+  if (!(array.flags() & py::array::c_style)) array = py::array_t<double, py::array::c_style>::ensure(array);
+  shape_.assign(array.shape(), array.shape() + array.ndim());
+  size_ = static_cast<std::size_t>(array.size());
+  data_ = static_cast<const double*>(array.data());
+  array_ = std::move(array);
+}
+
+std::size_t ElementCount(const std::vector<py::ssize_t>& shape) {
+  std::size_t n = 1;
+  for (py::ssize_t d : shape) n *= static_cast<std::size_t>(d);
+  return n;
+}
+
+std::vector<py::ssize_t> CommonShape(const std::vector<const Float64Argument*>& arguments) {
+  const Float64Argument* first = nullptr;
+  for (const Float64Argument* a : arguments) {
+    if (a == nullptr || a->is_scalar()) continue;
+    if (first == nullptr) {
+      first = a;
+    } else if (a->shape() != first->shape()) {
+      auto text = [](const std::vector<py::ssize_t>& s) {
+        std::string t = "(";
+        for (std::size_t i = 0; i < s.size(); ++i) t += (i ? ", " : "") + std::to_string(s[i]);
+        return t + (s.size() == 1 ? ",)" : ")");
+      };
+      throw InputError(a->name(), "has shape " + text(a->shape()) + ", but " + first->name() + " has shape " +
+                                      text(first->shape()) + " (array arguments must match element for element)");
+    }
+  }
+  return first ? first->shape() : std::vector<py::ssize_t>{};
+}
+
+py::array_t<double> NewArray(const std::vector<py::ssize_t>& shape) { return py::array_t<double>(shape); }
+
+py::array_t<double> OutputArray(const py::object& out, const std::string& name, const std::vector<py::ssize_t>& shape) {
+  if (out.is_none()) return NewArray(shape);
+  if (!py::isinstance<py::array>(out)) throw py::type_error(name + ": out array must be a NumPy array");
+  auto array = py::reinterpret_borrow<py::array>(out);
+  if (!array.dtype().is(py::dtype::of<double>()))
+    throw py::type_error(name + ": out array must be float64, got " + std::string(py::str(array.dtype())));
+  if (!(array.flags() & py::array::c_style) || !array.writeable())
+    throw py::type_error(name + ": out array must be C-contiguous and writeable");
+  if (std::vector<py::ssize_t>(array.shape(), array.shape() + array.ndim()) != shape)
+    throw InputError(name, "out array has the wrong shape (it must be the inputs' shape)");
+  return py::reinterpret_borrow<py::array_t<double>>(out);
+}
+
+double* MutableData(py::array_t<double>& array) { return static_cast<double*>(array.mutable_data()); }
+
+double Quantity(const py::handle& value, Dimension dimension, const std::string& name) {
+  if (py::isinstance<py::str>(value)) return ParseQuantity(value.cast<std::string>(), dimension, name);
+  if (py::isinstance<py::bool_>(value) || !(py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)))
+    throw py::type_error(name + ": expected a number in SI units or a text with its unit (e.g. \"45 mm\")");
+  const double v = value.cast<double>();
+  if (!std::isfinite(v)) throw InputError(name, "must be a finite number (got " + std::string(py::str(value)) + ")");
+  return v;
+}
+
+std::optional<double> OptionalQuantity(const py::object& value, Dimension dimension, const std::string& name) {
+  if (value.is_none()) return std::nullopt;
+  return Quantity(value, dimension, name);
+}
+
+template <typename Json>
+py::object JsonToPython(const Json& value) {
+  switch (value.type()) {
+    case nlohmann::json::value_t::null:
+      return py::none();
+    case nlohmann::json::value_t::boolean:
+      return py::bool_(value.template get<bool>());
+    case nlohmann::json::value_t::number_integer:
+      return py::int_(value.template get<std::int64_t>());
+    case nlohmann::json::value_t::number_unsigned:
+      return py::int_(value.template get<std::uint64_t>());
+    case nlohmann::json::value_t::number_float:
+      return py::float_(value.template get<double>());
+    case nlohmann::json::value_t::string:
+      return py::str(value.template get<std::string>());
+    case nlohmann::json::value_t::array: {
+      py::list list;
+      for (const auto& item : value) list.append(JsonToPython(item));
+      return list;
+    }
+    case nlohmann::json::value_t::object: {
+      py::dict dict;
+      for (auto it = value.begin(); it != value.end(); ++it) dict[py::str(it.key())] = JsonToPython(it.value());
+      return dict;
+    }
+    default:
+      return py::none();  // binary and discarded values do not occur in uphill's JSON
+  }
+}
+
+py::object ToPython(const nlohmann::ordered_json& value) { return JsonToPython(value); }
+py::object ToPython(const nlohmann::json& value) { return JsonToPython(value); }
+
+}  // namespace uphill::python

@@ -1,0 +1,104 @@
+// What the binding files of the Python module share: arrays from and to NumPy, quantities with
+// units, errors, JSON. The bindings only translate: every number is computed by the library.
+//
+// Arrays in. A NumPy array (or a list of floats) of dtype float64, any shape; the array
+// arguments of one call must have the same shape (a scalar stands for every element). Nothing is
+// cast silently: another dtype is a TypeError that names the argument and says how to convert it.
+// A C-contiguous array is read in place (no copy); another layout is copied once.
+// Arrays out. New float64 arrays of the inputs' shape, written by the library's kernels in place,
+// or (where a function takes `out=`) the caller's own arrays, so that repeated calls allocate
+// nothing.
+// Errors. uphill::InputError becomes uphill.InputError (a ValueError) with the attributes
+// quantity, rule and row: row is the element's index (flat, C order) for array arguments, the
+// file's row where the library names one, else None.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstddef>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "io/units.hpp"
+#include "model/input_error.hpp"
+
+namespace uphill::python {
+
+namespace py = pybind11;
+
+// An InputError about one element of an array argument (or one row of a file).
+class RowInputError : public InputError {
+ public:
+  RowInputError(const InputError& error, std::size_t row) : InputError(error), row_(row) {}
+  std::size_t row() const { return row_; }
+
+ private:
+  std::size_t row_;
+};
+
+// Registers uphill.InputError and the translation of InputError / RowInputError.
+void RegisterErrors(py::module_& m);
+
+// A float64 argument: a scalar, or an array read in place when C-contiguous.
+class Float64Argument {
+ public:
+  // Throws TypeError (py::type_error) for anything but a real number or a float64 array/list.
+  Float64Argument(const py::handle& value, std::string name);
+  const std::string& name() const { return name_; }
+  bool is_scalar() const { return !array_.has_value(); }
+  std::size_t size() const { return size_; }
+  const std::vector<py::ssize_t>& shape() const { return shape_; }
+  const double* data() const { return data_; }
+  // Element i (the scalar for every i).
+  double operator[](std::size_t i) const { return data_[is_scalar() ? 0 : i]; }
+
+ private:
+  std::string name_;
+  std::optional<py::array> array_;  // keeps the (possibly copied) array alive
+  double scalar_ = 0.0;
+  const double* data_ = nullptr;
+  std::size_t size_ = 1;
+  std::vector<py::ssize_t> shape_;
+};
+
+// The common shape of the array arguments (an empty shape when all are scalars). InputError
+// (quantity: the later argument's name) when two arrays differ in shape.
+std::vector<py::ssize_t> CommonShape(const std::vector<const Float64Argument*>& arguments);
+std::size_t ElementCount(const std::vector<py::ssize_t>& shape);
+
+// A new float64 array of `shape` (a 0-d array for an empty shape).
+py::array_t<double> NewArray(const std::vector<py::ssize_t>& shape);
+// The caller's `out=` array for `name`, checked: float64, C-contiguous, writeable, of `shape`
+// (TypeError / InputError naming it); or a new array when `out` is None.
+py::array_t<double> OutputArray(const py::object& out, const std::string& name, const std::vector<py::ssize_t>& shape);
+double* MutableData(py::array_t<double>& array);
+
+// A quantity given as a number (SI) or as text with its unit, as on the command line ("45 mm",
+// "10 deg"): uphill's own unit parser (io/units.hpp) reads the text.
+double Quantity(const py::handle& value, Dimension dimension, const std::string& name);
+std::optional<double> OptionalQuantity(const py::object& value, Dimension dimension, const std::string& name);
+
+// nlohmann JSON (the CLI's own JSON of a result) to Python dicts, lists and numbers.
+py::object ToPython(const nlohmann::ordered_json& value);
+py::object ToPython(const nlohmann::json& value);
+
+// A NumPy array over a std::vector<T> that a Python object keeps alive (`owner`): no copy.
+template <typename T>
+py::array_t<T> ArrayView(const std::vector<T>& values, const py::handle& owner) {
+  return py::array_t<T>({static_cast<py::ssize_t>(values.size())}, {static_cast<py::ssize_t>(sizeof(T))},
+                        values.data(), owner);
+}
+
+// The binding files: each adds its part of the module.
+void BindUnits(py::module_& m);
+void BindModel(py::module_& m);
+void BindConvert(py::module_& m);
+void BindFit(py::module_& m);
+void BindMotion(py::module_& m);
+void BindFiles(py::module_& m);
+void BindVision(py::module_& m);
+
+}  // namespace uphill::python

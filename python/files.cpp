@@ -1,0 +1,325 @@
+// Units (io/units.hpp), one setting converted as `uphill convert` does (io/conversion.hpp),
+// experiment folders and their analysis (io/experiment.hpp, report/analysis.hpp), X-Y tables
+// (io/xy_table.hpp).
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <memory>
+
+#include "bindings.hpp"
+#include "io/configuration.hpp"
+#include "io/conversion.hpp"
+#include "io/experiment.hpp"
+#include "io/xy_table.hpp"
+#include "report/analysis.hpp"
+#include "report/fit_json.hpp"
+
+namespace uphill::python {
+namespace {
+
+Dimension ParseDimension(const std::string& name) {
+  static const std::map<std::string, Dimension> kNames = {
+      {"length", Dimension::kLength},       {"angle", Dimension::kAngle},
+      {"time", Dimension::kTime},           {"velocity", Dimension::kVelocity},
+      {"acceleration", Dimension::kAcceleration}, {"dimensionless", Dimension::kDimensionless}};
+  const auto it = kNames.find(name);
+  if (it == kNames.end())
+    throw InputError("dimension", "must be length, angle, time, velocity, acceleration or dimensionless (got \"" +
+                                      name + "\")");
+  return it->second;
+}
+
+// A field of a setting given as a Python value: text as on the command line ("1165 mm"), or a
+// number in SI (metres, radians), which the parser reads with the SI unit of its dimension.
+FieldSource KeywordSource(const py::kwargs& fields) {
+  auto values = std::make_shared<std::map<std::string, FieldSource::Field>>();
+  for (const auto& [key, value] : fields) {
+    const std::string name = key.cast<std::string>();
+    FieldSource::Field field;
+    if (py::isinstance<py::str>(value)) {
+      field.text = value.cast<std::string>();
+    } else if (py::isinstance<py::bool_>(value)) {
+      if (name != "along_rail") throw py::type_error(name + ": expected text or a number");
+      if (value.cast<bool>()) (*values)["L_convention"] = {"along-rail", ""};
+      continue;
+    } else if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) {
+      char text[32];
+      std::snprintf(text, sizeof text, "%.17g", value.cast<double>());
+      field.text = text;
+      const std::string base = name.rfind("u_", 0) == 0 ? name.substr(2) : name;
+      field.default_unit = base == "theta" || base == "alpha" ? "rad" : "m";
+    } else {
+      throw py::type_error(name + ": expected text with a unit (\"45 mm\") or a number in SI units");
+    }
+    (*values)[name] = field;
+  }
+  const auto& known = ConfigurationFieldNames();
+  for (const auto& [name, field] : *values)
+    if (std::find(known.begin(), known.end(), name) == known.end())
+      throw InputError(name, "is not a field of a setting (fields: body, R, a, b, h, L, H, D, theta, alpha, "
+                             "rod_diameter, u_<name>, L_convention or along_rail=True, label)");
+  FieldSource source;
+  source.lookup = [values](const std::string& name) -> std::optional<FieldSource::Field> {
+    const auto it = values->find(name);
+    if (it == values->end()) return std::nullopt;
+    return it->second;
+  };
+  source.context = [](const std::string& name) { return name; };
+  return source;
+}
+
+py::dict UncertainToPython(const Uncertain& u) {
+  py::dict d;
+  d["value"] = u.value;
+  d["u"] = u.u;
+  return d;
+}
+
+py::dict ConfigurationToPython(const Configuration& c) {
+  py::dict d;
+  d["label"] = c.label;
+  d["body"] = c.MakeBody().Name();
+  d["across"] = UncertainToPython(c.across);
+  d["along"] = UncertainToPython(c.along);
+  if (c.from_apparatus) {
+    d["L"] = UncertainToPython(c.L), d["H"] = UncertainToPython(c.H), d["D"] = UncertainToPython(c.D);
+    d["L_convention"] = c.convention == LConvention::kAlongRail ? "along-rail" : "horizontal";
+  } else {
+    d["theta"] = UncertainToPython(c.theta), d["alpha"] = UncertainToPython(c.alpha);
+  }
+  d["rod_radius"] = UncertainToPython(c.rod_radius);
+  return d;
+}
+
+// An experiment folder, read once; its analysis refers into it, so both live here together.
+struct LoadedExperiment {
+  Experiment experiment;
+};
+
+struct Analysis {
+  std::shared_ptr<LoadedExperiment> loaded;
+  ExperimentAnalysis analysis;
+};
+
+template <typename F>
+py::array_t<double> RowArray(const ExperimentAnalysis& a, F&& value) {
+  py::array_t<double> out(static_cast<py::ssize_t>(a.rows.size()));
+  double* p = MutableData(out);
+  for (std::size_t i = 0; i < a.rows.size(); ++i) p[i] = value(a.rows[i]);
+  return out;
+}
+
+}  // namespace
+
+void BindUnits(py::module_& m) {
+  m.def(
+      "parse_quantity",
+      [](const std::string& text, const std::string& dimension, const std::string& name) {
+        return ParseQuantity(text, ParseDimension(dimension), name);
+      },
+      py::arg("text"), py::arg("dimension") = "length", py::arg("name") = "value",
+      R"(The SI value of a quantity written with its unit, as on the command line: "45 mm" -> 0.045 (m),
+"10 deg" -> 0.1745... (rad), "50 ms" -> 0.05 (s), "9.81 m/s2". dimension: length, angle, time,
+velocity, acceleration or dimensionless. A number without a unit is refused (InputError), as on the
+command line: a guessed unit is a silent 25.4x error.)");
+  m.def(
+      "to_unit",
+      [](double value, const std::string& dimension, const std::string& unit) {
+        const Dimension d = ParseDimension(dimension);
+        if (UnitFactor(d, unit) == 0.0) throw InputError("unit", "must be one of " + AcceptedUnits(d));
+        return ToUnit(value, d, unit);
+      },
+      py::arg("value"), py::arg("dimension"), py::arg("unit"),
+      "A value in SI expressed in `unit` of `dimension` (e.g. to_unit(0.0254, \"length\", \"in\") == 1).");
+  m.def("accepted_units", [](const std::string& dimension) { return AcceptedUnits(ParseDimension(dimension)); },
+        py::arg("dimension"), "The unit names accepted for a dimension, e.g. \"mm, cm, m, km, um, in\".");
+}
+
+void BindFiles(py::module_& m) {
+  m.def(
+      "convert_setting",
+      [](const py::object& mu, const py::object& at_x, std::uint64_t mc_trials, std::uint64_t seed,
+         const std::string& length_unit, const py::kwargs& fields) {
+        ConversionOptions options;
+        options.mu = OptionalQuantity(mu, Dimension::kDimensionless, "mu");
+        if (!at_x.is_none())
+          for (const auto& x : at_x) options.at_x.push_back(Quantity(x, Dimension::kLength, "at_x"));
+        options.propagation.trials = mc_trials;
+        options.propagation.seed = seed;
+        options.length_unit = length_unit;
+        const Configuration configuration = ParseConfiguration(KeywordSource(fields));
+        nlohmann::ordered_json json;
+        {
+          py::gil_scoped_release release;
+          json = ToJson(Convert(configuration, options));
+        }
+        return ToPython(json);
+      },
+      py::kw_only(), py::arg("mu") = py::none(), py::arg("at_x") = py::none(), py::arg("mc_trials") = 1000000,
+      py::arg("seed") = 20261121, py::arg("length_unit") = "mm",
+      R"(One setting converted exactly as `uphill convert ... --json` does (io/conversion.hpp): returns
+that JSON as a dict (SI units: m, rad; keys as documented for the command: theta, alpha, phi, x_eq,
+z_eq, x_max, x_low, rolls_up, points, x_rest, x_rest_low, u_<key>, u_mc_<key>, verdict, ...).
+
+Fields are the command's flags without "--" (underscores for dashes): body, R, a, b, h, L, H, D,
+theta, alpha, rod_diameter, u_<name>, label, along_rail=True. Each value is text with its unit as
+on the command line ("1165 mm", "10 deg") or a number in SI (m, rad). mu (rolling resistance),
+at_x (positions, m or text), mc_trials (default 10^6, as the command) and seed (the command's
+default) as for the command.)");
+
+  py::class_<LoadedExperiment, std::shared_ptr<LoadedExperiment>>(m, "Experiment",
+                                                                  R"(An experiment folder (format uphill-experiment/1, data/README.md), read once.
+
+Rows that cannot be used keep their error (file, row, column, rule); the others are loaded.)")
+      .def_property_readonly("directory", [](const LoadedExperiment& e) { return e.experiment.directory; })
+      .def_property_readonly("title", [](const LoadedExperiment& e) { return e.experiment.title; })
+      .def_property_readonly("operator", [](const LoadedExperiment& e) { return e.experiment.operator_name; })
+      .def_property_readonly("date", [](const LoadedExperiment& e) { return e.experiment.date; })
+      .def_property_readonly("notes", [](const LoadedExperiment& e) { return e.experiment.notes; })
+      .def_property_readonly("metadata", [](const LoadedExperiment& e) { return ToPython(e.experiment.metadata); },
+                             "experiment.json as read (a dict).")
+      .def_property_readonly(
+          "rows",
+          [](const LoadedExperiment& e) {
+            py::list rows;
+            for (const ExperimentRow& r : e.experiment.rows) {
+              py::dict d;
+              d["row"] = r.row, d["trial"] = r.trial, d["series"] = r.series, d["note"] = r.note;
+              d["Y"] = r.Y.value, d["u_Y"] = r.Y.u;
+              d["configuration"] = r.configuration ? py::object(ConfigurationToPython(*r.configuration)) : py::none();
+              d["error"] = r.error.empty() ? py::object(py::none()) : py::object(py::str(r.error));
+              rows.append(d);
+            }
+            return rows;
+          },
+          "One dict per row of measurements.csv: row (spreadsheet row, header = 1), trial, series, note, Y and u_Y "
+          "(m), configuration (values and standard uncertainties in SI) or error (file, row, column, rule).")
+      .def_property_readonly(
+          "scenes",
+          [](const LoadedExperiment& e) {
+            std::vector<Scene> scenes;
+            for (const ExperimentRow* r : e.experiment.UsableRows()) scenes.push_back(r->configuration->MakeScene());
+            return scenes;
+          },
+          "An uphill.Scene per usable row, in file order.")
+      .def_property_readonly("errors", [](const LoadedExperiment& e) { return e.experiment.Errors(); },
+                             "The rows left out, one line each.");
+
+  m.def(
+      "read_experiment",
+      [](const std::string& directory) {
+        auto loaded = std::make_shared<LoadedExperiment>();
+        loaded->experiment = LoadExperiment(directory);
+        return loaded;
+      },
+      py::arg("directory"),
+      "Reads an experiment folder (experiment.json + measurements.csv). InputError names the file, key or "
+      "column for a folder that cannot be analysed at all.");
+
+  py::class_<Analysis>(m, "Analysis", R"(The analysis of an experiment, as `uphill fit EXP` prints it (report/analysis.hpp).
+
+Per usable row (NumPy arrays, file order): theta, alpha (rad), x_eq (X) with u_x_eq (first order)
+and u_x_eq_mc (Monte Carlo), x_max, y and u_y (m). fits: dict method -> FitReport ("ols", "wls",
+"york", "robust", "friction"), unavailable: dict method -> reason. friction_vs_line: dict
+(delta_chi2, delta_aic, delta_bic, akaike_weight_friction, verdict). to_json(): `uphill fit EXP --json`.)")
+      .def_property_readonly("experiment", [](const Analysis& a) { return a.loaded; })
+      .def_property_readonly("theta", [](const Analysis& a) { return RowArray(a.analysis, [](const AnalysedRow& r) { return r.theta; }); })
+      .def_property_readonly("alpha", [](const Analysis& a) { return RowArray(a.analysis, [](const AnalysedRow& r) { return r.alpha; }); })
+      .def_property_readonly("x_eq", [](const Analysis& a) { return RowArray(a.analysis, [](const AnalysedRow& r) { return r.x_eq; }); })
+      .def_property_readonly("u_x_eq", [](const Analysis& a) { return RowArray(a.analysis, [](const AnalysedRow& r) { return r.u_x_eq; }); })
+      .def_property_readonly("u_x_eq_mc",
+                             [](const Analysis& a) { return RowArray(a.analysis, [](const AnalysedRow& r) { return r.u_x_eq_mc; }); })
+      .def_property_readonly("x_max", [](const Analysis& a) { return RowArray(a.analysis, [](const AnalysedRow& r) { return r.x_max; }); })
+      .def_property_readonly("y", [](const Analysis& a) { return RowArray(a.analysis, [](const AnalysedRow& r) { return r.y; }); })
+      .def_property_readonly("u_y", [](const Analysis& a) { return RowArray(a.analysis, [](const AnalysedRow& r) { return r.u_y; }); })
+      .def_property_readonly("trials",
+                             [](const Analysis& a) {
+                               std::vector<std::string> t;
+                               for (const auto& r : a.analysis.rows) t.push_back(r.source->trial);
+                               return t;
+                             })
+      .def_property_readonly("flags",
+                             [](const Analysis& a) {
+                               std::vector<std::vector<std::string>> f;
+                               for (const auto& r : a.analysis.rows) f.push_back(r.flags);
+                               return f;
+                             })
+      .def_property_readonly("fits",
+                             [](const Analysis& a) {
+                               py::dict d;
+                               for (const auto& f : a.analysis.fits)
+                                 if (f.report) d[py::str(f.method)] = *f.report;
+                               return d;
+                             })
+      .def_property_readonly("unavailable",
+                             [](const Analysis& a) {
+                               py::dict d;
+                               for (const auto& f : a.analysis.fits)
+                                 if (!f.report) d[py::str(f.method)] = f.unavailable;
+                               return d;
+                             })
+      .def_property_readonly("friction_vs_line",
+                             [](const Analysis& a) -> py::object {
+                               if (!a.analysis.friction_vs_line) return py::none();
+                               const ModelComparison& c = *a.analysis.friction_vs_line;
+                               py::dict d;
+                               d["delta_chi2"] = c.delta_chi2, d["delta_aic"] = c.delta_aic, d["delta_bic"] = c.delta_bic;
+                               d["akaike_weight_friction"] = c.akaike_weight_second;
+                               d["verdict"] = c.verdict;
+                               return d;
+                             })
+      .def_property_readonly("row_errors", [](const Analysis& a) { return a.analysis.row_errors; })
+      .def_property_readonly("notes", [](const Analysis& a) { return a.analysis.notes; })
+      .def("to_json", [](const Analysis& a) { return ToPython(AnalysisToJson(a.analysis)); },
+           "The analysis as `uphill fit EXP --json` prints it (fit.json's content, SI units).");
+
+  m.def(
+      "analyse_experiment",
+      [](const py::object& experiment, std::uint64_t mc_trials, std::uint64_t seed, double outlier_threshold) {
+        std::shared_ptr<LoadedExperiment> loaded;
+        if (py::isinstance<LoadedExperiment>(experiment)) {
+          loaded = experiment.cast<std::shared_ptr<LoadedExperiment>>();
+        } else {
+          loaded = std::make_shared<LoadedExperiment>();
+          loaded->experiment = LoadExperiment(py::str(experiment).cast<std::string>());
+        }
+        AnalysisOptions options;
+        options.mc_trials = mc_trials;
+        options.seed = seed;
+        options.outlier_threshold = outlier_threshold;
+        auto result = std::make_unique<Analysis>();
+        result->loaded = loaded;
+        {
+          py::gil_scoped_release release;
+          result->analysis = AnalyseExperiment(loaded->experiment, options);
+        }
+        return result;
+      },
+      py::arg("experiment"), py::kw_only(), py::arg("mc_trials") = 100000, py::arg("seed") = 1,
+      py::arg("outlier_threshold") = 3.0,
+      R"(Analyses an experiment (a folder path or an uphill.Experiment) as `uphill fit EXP` does: per row
+theta, alpha, X ± u(X) (first order and Monte Carlo with mc_trials per row) against Y ± u(Y), and the
+five fits of Y against X. Returns an uphill.Analysis. InputError when no row is usable.)");
+
+  m.def(
+      "read_xy",
+      [](const std::string& path) {
+        const XyTable t = ReadXyFile(path);
+        py::dict d;
+        auto array = [](const std::vector<double>& v) { return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data()); };
+        d["x"] = array(t.x), d["y"] = array(t.y);
+        d["u_x"] = t.u_x.empty() ? py::object(py::none()) : py::object(array(t.u_x));
+        d["u_y"] = t.u_y.empty() ? py::object(py::none()) : py::object(array(t.u_y));
+        d["rows"] = t.rows;
+        d["row_errors"] = t.row_errors;
+        return d;
+      },
+      py::arg("path"),
+      R"(Reads the X-Y table of `uphill fit --xy` (header X,Y and optionally uX,uY; plain numbers in one
+unit): dict of float64 arrays x, y, u_x, u_y (None when absent), the spreadsheet row of each (rows)
+and the rows left out with their reason (row_errors).)");
+}
+
+}  // namespace uphill::python

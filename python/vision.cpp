@@ -1,0 +1,141 @@
+// Track CSVs (vision/track_table.hpp), camera and scene calibration files (vision/camera.hpp) and
+// uphill.track: the ball's centre in every frame of a video (vision/video_tracking.hpp).
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+
+#include "bindings.hpp"
+#include "vision/camera.hpp"
+#include "vision/track_table.hpp"
+#include "vision/video_tracking.hpp"
+
+namespace uphill::python {
+namespace {
+
+py::dict CameraToPython(const CameraIntrinsics& c) {
+  py::dict d;
+  d["width"] = c.width, d["height"] = c.height;
+  d["fx"] = c.fx, d["fy"] = c.fy, d["cx"] = c.cx, d["cy"] = c.cy;
+  d["distortion"] = c.distortion;
+  return d;
+}
+
+// Columns of a track: one element per frame; a frame without the ball has found = False and NaN
+// in u, v, radius_px, x, z (never interpolated), quality 0.
+struct TrackColumns {
+  py::array_t<std::int64_t> frame;
+  py::array_t<bool> found;
+  py::array_t<double> t, u, v, radius_px, x, z, quality;
+  explicit TrackColumns(std::size_t n)
+      : frame(static_cast<py::ssize_t>(n)), found(static_cast<py::ssize_t>(n)), t(static_cast<py::ssize_t>(n)),
+        u(static_cast<py::ssize_t>(n)), v(static_cast<py::ssize_t>(n)), radius_px(static_cast<py::ssize_t>(n)),
+        x(static_cast<py::ssize_t>(n)), z(static_cast<py::ssize_t>(n)), quality(static_cast<py::ssize_t>(n)) {}
+  void Set(std::size_t i, long frame_number, double time, bool is_found, double pu, double pv, double pr, double px,
+           double pz, double q) {
+    const double missing = std::nan("");
+    frame.mutable_at(i) = frame_number;
+    found.mutable_at(i) = is_found;
+    t.mutable_at(i) = time;
+    u.mutable_at(i) = is_found ? pu : missing;
+    v.mutable_at(i) = is_found ? pv : missing;
+    radius_px.mutable_at(i) = is_found ? pr : missing;
+    x.mutable_at(i) = is_found ? px : missing;
+    z.mutable_at(i) = is_found ? pz : missing;
+    quality.mutable_at(i) = is_found ? q : 0.0;
+  }
+  py::dict ToDict() const {
+    py::dict d;
+    d["frame"] = frame, d["t"] = t, d["found"] = found, d["u"] = u, d["v"] = v, d["radius_px"] = radius_px;
+    d["x"] = x, d["z"] = z, d["quality"] = quality;
+    return d;
+  }
+};
+
+constexpr const char* kTrackColumnsDoc =
+    "frame (int), t (s), found (bool), u, v (raw pixels), radius_px, x, z (m, apparatus frame), quality "
+    "(0..1); a frame without the ball keeps its element with found = False, NaN positions and quality 0 "
+    "(never interpolated)";
+
+}  // namespace
+
+void BindVision(py::module_& m) {
+  m.def(
+      "read_track",
+      [](const std::string& path) {
+        const Track track = ReadTrackFile(path);
+        TrackColumns c(track.frames.size());
+        for (std::size_t i = 0; i < track.frames.size(); ++i) {
+          const TrackFrame& f = track.frames[i];
+          c.Set(i, f.frame, f.t, f.found, f.u, f.v, f.radius_px, f.x, f.z, f.quality);
+        }
+        return c.ToDict();
+      },
+      py::arg("path"),
+      (std::string("Reads a track CSV as `uphill track` writes it (vision/track_table.hpp): dict of arrays ") +
+       kTrackColumnsDoc + ". InputError names the file, row and column of the first bad row.")
+          .c_str());
+
+  m.def(
+      "read_camera", [](const std::string& path) { return CameraToPython(ReadCameraFile(path)); }, py::arg("path"),
+      "Reads a camera file (uphill-camera/1, calibration/README.md): dict of width, height (px), fx, fy, cx, cy "
+      "(px) and the distortion coefficients (OpenCV's order).");
+  m.def(
+      "read_scene_calibration",
+      [](const std::string& path) {
+        const SceneCalibration s = ReadSceneFile(path);
+        py::dict d;
+        d["camera"] = CameraToPython(s.camera);
+        d["rotation"] = Eigen::Matrix3d(s.pose.rotation);
+        d["translation"] = Eigen::Vector3d(s.pose.translation);
+        d["camera_centre"] = Eigen::Vector3d(CameraCentre(s.pose));
+        return d;
+      },
+      py::arg("path"),
+      "Reads a scene file (uphill-scene/1): the camera's intrinsics and its pose in the apparatus frame: "
+      "rotation (3x3, apparatus -> camera), translation (m), camera_centre (m, apparatus frame).");
+
+  m.def(
+      "track",
+      [](const std::string& video, const std::string& scene_file, const Scene& scene, const py::object& init_uv,
+         const std::string& overlay) {
+        if (scene.body().kind == BodyKind::kDoubleCone)
+          throw InputError("scene", "tracking supports a sphere or a spheroid, not a double cone");
+        const SceneCalibration calibration = ReadSceneFile(scene_file);
+        TrackVideoOptions options;
+        options.calibration_name = scene_file;
+        options.overlay_path = overlay;
+        if (!init_uv.is_none()) {
+          const auto uv = init_uv.cast<std::vector<double>>();
+          if (uv.size() != 2 || !std::isfinite(uv[0]) || !std::isfinite(uv[1]))
+            throw InputError("init_uv", "must be (u, v), two finite raw pixel coordinates");
+          options.tracker.init_uv = Eigen::Vector2d(uv[0], uv[1]);
+        }
+        TrackResult result;
+        {
+          py::gil_scoped_release release;
+          result = TrackVideo(video, scene, calibration, options);
+        }
+        TrackColumns c(result.rows.size());
+        for (std::size_t i = 0; i < result.rows.size(); ++i) {
+          const TrackRow& r = result.rows[i];
+          c.Set(i, r.frame, r.t, r.ball.found, r.ball.u, r.ball.v, r.ball.radius_px, r.ball.x, r.ball.z, r.ball.quality);
+        }
+        py::dict d = c.ToDict();
+        d["fps"] = result.fps;
+        d["partial"] = result.partial;
+        d["partial_reason"] = result.partial_reason;
+        return d;
+      },
+      py::arg("video"), py::arg("scene_file"), py::arg("scene"), py::kw_only(), py::arg("init_uv") = py::none(),
+      py::arg("overlay") = "",
+      (std::string("The ball's centre in every frame of a video (vision/video_tracking.hpp), as `uphill track` "
+                   "finds it: video any file FFmpeg decodes, scene_file the scene calibration of `uphill calibrate "
+                   "scene` (it carries the camera's intrinsics), scene the uphill.Scene filmed (sphere or spheroid). "
+                   "init_uv=(u, v): a raw pixel near the centre in the first frame; overlay: a video to write with the "
+                   "fit drawn. Returns a dict of arrays ") +
+       kTrackColumnsDoc + ", plus fps, partial and partial_reason (a cut video, a ball lost for good).")
+          .c_str());
+}
+
+}  // namespace uphill::python
