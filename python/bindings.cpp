@@ -64,7 +64,6 @@ Float64Argument::Float64Argument(const py::handle& value, std::string name) : na
     throw py::type_error(name_ + ": expected a number or a float64 array, got a bool");
   if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) {
     scalar_ = value.cast<double>();
-    data_ = &scalar_;
     return;
   }
   py::array array;
@@ -82,13 +81,11 @@ Float64Argument::Float64Argument(const py::handle& value, std::string name) : na
                          " (uphill casts nothing silently: pass np.asarray(" + name_ + ", dtype=np.float64))");
   if (array.ndim() == 0) {
     scalar_ = *static_cast<const double*>(array.data());
-    data_ = &scalar_;
     return;
   }
   if (!(array.flags() & py::array::c_style)) array = py::array_t<double, py::array::c_style>::ensure(array);
   shape_.assign(array.shape(), array.shape() + array.ndim());
   size_ = static_cast<std::size_t>(array.size());
-  data_ = static_cast<const double*>(array.data());
   array_ = std::move(array);
 }
 

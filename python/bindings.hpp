@@ -25,9 +25,20 @@
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 
+// Until every layer's code is in namespace uphill (the restructure), its io/report/vision parts
+// are still in nested namespaces: make their names visible here either way.
+namespace uphill {
+namespace io {}
+namespace report {}
+namespace vision {}
+}  // namespace uphill
+
 namespace uphill::python {
 
 namespace py = pybind11;
+using namespace uphill::io;      // NOLINT: empty once the layers share namespace uphill
+using namespace uphill::report;  // NOLINT
+using namespace uphill::vision;  // NOLINT
 
 // An InputError about one element of an array argument (or one row of a file).
 class RowInputError : public InputError {
@@ -51,15 +62,14 @@ class Float64Argument {
   bool is_scalar() const { return !array_.has_value(); }
   std::size_t size() const { return size_; }
   const std::vector<py::ssize_t>& shape() const { return shape_; }
-  const double* data() const { return data_; }
+  const double* data() const { return array_ ? static_cast<const double*>(array_->data()) : &scalar_; }
   // Element i (the scalar for every i).
-  double operator[](std::size_t i) const { return data_[is_scalar() ? 0 : i]; }
+  double operator[](std::size_t i) const { return array_ ? data()[i] : scalar_; }
 
  private:
   std::string name_;
-  std::optional<py::array> array_;  // keeps the (possibly copied) array alive
+  std::optional<py::array> array_;  // the C-contiguous data (the caller's array, or a copy)
   double scalar_ = 0.0;
-  const double* data_ = nullptr;
   std::size_t size_ = 1;
   std::vector<py::ssize_t> shape_;
 };

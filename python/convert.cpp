@@ -3,13 +3,14 @@
 // message is the scalar model's own: Rails, Body and Scene are asked about it), and, when inputs
 // carry uncertainties, model/propagation.hpp per element.
 //
-// Blocks: the arrays are processed in blocks of kBlock elements, each checked and then converted
-// while it is in the cache, so the check costs a few comparisons per element and no extra pass
-// over memory (the kernel itself is memory-bound at 10^6 elements).
+// Blocks: the arrays are processed in blocks of kBlock elements, each converted and checked while
+// it is in the cache, so the check costs a few vector operations per element and no extra pass
+// over memory.
 #include <pybind11/stl.h>
 
+#include <immintrin.h>
+
 #include <algorithm>
-#include <array>
 #include <cfloat>
 #include <cmath>
 #include <functional>
@@ -23,7 +24,7 @@
 namespace uphill::python {
 namespace {
 
-constexpr std::size_t kBlock = 2048;
+constexpr std::size_t kBlock = 8192;  // 3 inputs + 3 outputs: 384 KB, within L2
 
 // The scalar model's verdict on element i (throws its InputError as RowInputError); used only
 // for an element the bulk check has found outside the domain.
@@ -51,13 +52,44 @@ std::size_t FirstInvalid(std::size_t m, Ok ok) {
 inline bool PositiveFinite(double v) { return (v > 0.0) & (v <= DBL_MAX); }
 inline bool NonNegativeFinite(double v) { return (v >= 0.0) & (v <= DBL_MAX); }
 
+// Whether a block of crossbar measurements lies in the domain (L, D > 0, H >= 0, all finite), in
+// AVX2 where the CPU has it: three minima and one NaN/inf detector (l + h + d)·0, 7 vector
+// operations per 4 elements, a few percent of the kernel's work. It can say false for valid
+// values near the largest double (l + h + d overflowing): callers then look element by element.
+__attribute__((target("avx2,fma"))) bool ApparatusBlockValidAvx2(std::size_t m, const double* L, const double* H,
+                                                                   const double* D) {
+  const __m256d zero = _mm256_setzero_pd();
+  __m256d lo_ld = _mm256_set1_pd(1.0), lo_h = lo_ld, poison = zero;
+  std::size_t j = 0;
+  for (; j + 4 <= m; j += 4) {
+    const __m256d l = _mm256_loadu_pd(L + j), h = _mm256_loadu_pd(H + j), d = _mm256_loadu_pd(D + j);
+    lo_ld = _mm256_min_pd(lo_ld, _mm256_min_pd(l, d));
+    lo_h = _mm256_min_pd(lo_h, h);
+    poison = _mm256_or_pd(poison, _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(l, h), d), zero));  // NaN if any is
+  }
+  const __m256d ok = _mm256_and_pd(
+      _mm256_and_pd(_mm256_cmp_pd(lo_ld, zero, _CMP_GT_OQ), _mm256_cmp_pd(lo_h, zero, _CMP_GE_OQ)),
+      _mm256_cmp_pd(poison, zero, _CMP_EQ_OQ));
+  bool all = _mm256_movemask_pd(ok) == 0xF;
+  for (; j < m; ++j) all &= PositiveFinite(L[j]) & NonNegativeFinite(H[j]) & PositiveFinite(D[j]);
+  return all;
+}
+
+bool ApparatusBlockValid(std::size_t m, const double* L, const double* H, const double* D) {
+  static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  if (avx2) return ApparatusBlockValidAvx2(m, L, H, D);
+  bool all = true;
+  for (std::size_t j = 0; j < m; ++j) all &= PositiveFinite(L[j]) & NonNegativeFinite(H[j]) & PositiveFinite(D[j]);
+  return all;
+}
+
 // A block of an argument: a pointer into its array, or a block filled with its scalar.
 struct BlockInput {
   const Float64Argument* argument = nullptr;
-  std::array<double, kBlock> fill{};
+  std::vector<double> fill;  // a scalar's block (on the heap: Python threads may have small stacks)
   const double* At(std::size_t start, std::size_t m) {
     if (!argument->is_scalar()) return argument->data() + start;
-    std::fill_n(fill.begin(), m, (*argument)[0]);
+    fill.assign(m, (*argument)[0]);
     return fill.data();
   }
 };
@@ -96,7 +128,7 @@ py::dict Convert(const ConvertArguments& a, const std::vector<py::ssize_t>& shap
   double *p_first = MutableData(first), *p_second = MutableData(second);
   {
     py::gil_scoped_release release;
-    std::array<double, kBlock> tan_theta, tan_half_alpha, q, across_on_rods;
+    std::vector<double> tan_theta(kBlock), tan_half_alpha(kBlock), q(kBlock), across_on_rods(kBlock);
     BlockInput in[7];
     const Float64Argument* args[7] = {a.apparatus() ? &*a.L : &*a.theta, a.apparatus() ? &*a.H : &*a.alpha,
                                       a.apparatus() ? &*a.D : &*a.alpha, &*a.across,
@@ -303,6 +335,10 @@ scalar model's own message; mismatched shapes; TypeError for a dtype other than 
           for (std::size_t start = 0; start < n; start += kBlock) {
             const std::size_t m = std::min(kBlock, n - start);
             const double *l = in[0].At(start, m), *h = in[1].At(start, m), *d = in[2].At(start, m);
+            // The kernel first (it never traps, whatever the input), then the check of the block
+            // it has just brought into the cache; outside the domain the call raises.
+            ConvertApparatusBatch(m, l, h, d, a, b, p_theta + start, p_alpha + start, p_x_eq + start);
+            if (ApparatusBlockValid(m, l, h, d)) continue;
             const std::size_t bad = FirstInvalid(
                 m, [&](std::size_t j) { return PositiveFinite(l[j]) & NonNegativeFinite(h[j]) & PositiveFinite(d[j]); });
             if (bad < m) {
@@ -310,7 +346,6 @@ scalar model's own message; mismatched shapes; TypeError for a dtype other than 
               const std::size_t i = start + bad;
               ExplainElement(i, [&] { Rails::FromApparatus(L[i], H[i], D[i], LConvention::kHorizontal); });
             }
-            ConvertApparatusBatch(m, l, h, d, a, b, p_theta + start, p_alpha + start, p_x_eq + start);
           }
         }
         return py::make_tuple(theta, alpha, x_eq);

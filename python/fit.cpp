@@ -57,6 +57,16 @@ FitReport Run(F&& fit) {
   }
 }
 
+// One double field of the per-row results as a strided, read-only view of the report's memory.
+py::array_t<double> RowField(const py::object& self, double RowResult::*field) {
+  const auto& r = self.cast<const FitReport&>();
+  const double* first = r.rows.empty() ? nullptr : &(r.rows.front().*field);
+  py::array_t<double> view({static_cast<py::ssize_t>(r.rows.size())}, {static_cast<py::ssize_t>(sizeof(RowResult))},
+                           first, self);
+  view.attr("setflags")(py::arg("write") = false);
+  return view;
+}
+
 py::object Optional(const std::optional<double>& v) { return v ? py::object(py::float_(*v)) : py::none(); }
 
 constexpr const char* kReportDoc = R"(What every fit returns (fit/fit_report.hpp).
@@ -117,11 +127,12 @@ void BindFit(py::module_& m) {
             return rows;
           },
           "Per-row results: structured array (row, fitted, residual, sigma, normalised, weight, outlier), no copy.")
-      .def_property_readonly("residuals", [](py::object self) { return self.attr("rows")["residual"]; },
-                             "Y_i − fitted_i, in Y's units (a view).")
-      .def_property_readonly("normalised_residuals", [](py::object self) { return self.attr("rows")["normalised"]; },
-                             "residual/sigma (a view).")
-      .def_property_readonly("fitted", [](py::object self) { return self.attr("rows")["fitted"]; }, "The model at each row (a view).")
+      .def_property_readonly("residuals", [](py::object self) { return RowField(self, &RowResult::residual); },
+                             "Y_i − fitted_i, in Y's units (a read-only view of rows[\"residual\"]).")
+      .def_property_readonly("normalised_residuals", [](py::object self) { return RowField(self, &RowResult::normalised); },
+                             "residual/sigma (a read-only view).")
+      .def_property_readonly("fitted", [](py::object self) { return RowField(self, &RowResult::fitted); },
+                             "The model at each row (a read-only view).")
       .def_readonly("outliers", &FitReport::outliers)
       .def_property_readonly("downweighted",
                              [](const FitReport& r) {
@@ -149,23 +160,29 @@ void BindFit(py::module_& m) {
 
   m.def(
       "fit_ols",
-      [](const py::object& x, const py::object& y, double outlier_threshold) {
-        const LineData d = MakeLineData(x, y, py::none(), py::none());
+      [](const py::object& x, const py::object& y, const py::object& u_x, const py::object& u_y,
+         double outlier_threshold) {
+        const LineData d = MakeLineData(x, y, u_x, u_y);
         return Run([&] { return FitOrdinaryLeastSquares(d, Options(outlier_threshold)); });
       },
-      py::arg("x"), py::arg("y"), py::kw_only(), py::arg("outlier_threshold") = 3.0,
+      py::arg("x"), py::arg("y"), py::arg("u_x") = py::none(), py::arg("u_y") = py::none(), py::kw_only(),
+      py::arg("outlier_threshold") = 3.0,
       R"(Ordinary least squares Y = k·X + c (the paper's fit; fit/least_squares_line.hpp), with Ceres.
-x, y: one-dimensional float64 arrays in any one unit each. Standard errors: the usual, scaled by
-sqrt(chi2/dof). Accuracy: NIST StRD Norris to 12.8-15.5 digits. Returns a FitReport.)");
+x, y: one-dimensional float64 arrays in any one unit each (u_x, u_y, if given, are ignored, and a
+note says so). Standard errors: the usual, scaled by sqrt(chi2/dof). Accuracy: NIST StRD Norris to
+12.8-15.5 digits. Returns a FitReport.)");
   m.def(
       "fit_wls",
-      [](const py::object& x, const py::object& y, const py::object& u_y, double outlier_threshold) {
-        const LineData d = MakeLineData(x, y, py::none(), u_y);
+      [](const py::object& x, const py::object& y, const py::object& u_y, const py::object& u_x,
+         double outlier_threshold) {
+        const LineData d = MakeLineData(x, y, u_x, u_y);
         return Run([&] { return FitWeightedLeastSquares(d, Options(outlier_threshold)); });
       },
-      py::arg("x"), py::arg("y"), py::arg("u_y"), py::kw_only(), py::arg("outlier_threshold") = 3.0,
+      py::arg("x"), py::arg("y"), py::arg("u_y"), py::kw_only(), py::arg("u_x") = py::none(),
+      py::arg("outlier_threshold") = 3.0,
       R"(Weighted least squares with the standard uncertainties u_y (> 0, Y's units); standard errors
-unscaled (the stated uncertainties propagated), scaled also given. Returns a FitReport.)");
+unscaled (the stated uncertainties propagated), scaled also given. u_x, if given, is ignored (a
+note says so). Returns a FitReport.)");
   m.def(
       "fit_york",
       [](const py::object& x, const py::object& y, const py::object& u_x, const py::object& u_y, double outlier_threshold) {
@@ -178,9 +195,9 @@ unscaled (the stated uncertainties propagated), scaled also given. Returns a Fit
 Standard errors unscaled (York's), scaled also given. Returns a FitReport.)");
   m.def(
       "fit_robust",
-      [](const py::object& x, const py::object& y, const py::object& u_y, const std::string& loss, double loss_scale,
-         double outlier_threshold) {
-        const LineData d = MakeLineData(x, y, py::none(), u_y);
+      [](const py::object& x, const py::object& y, const py::object& u_y, const py::object& u_x, const std::string& loss,
+         double loss_scale, double outlier_threshold) {
+        const LineData d = MakeLineData(x, y, u_x, u_y);
         RobustOptions o;
         if (loss == "huber") o.loss = RobustLoss::kHuber;
         else if (loss == "cauchy") o.loss = RobustLoss::kCauchy;
@@ -189,7 +206,8 @@ Standard errors unscaled (York's), scaled also given. Returns a FitReport.)");
         o.fit = Options(outlier_threshold);
         return Run([&] { return FitRobust(d, o); });
       },
-      py::arg("x"), py::arg("y"), py::arg("u_y") = py::none(), py::kw_only(), py::arg("loss") = "huber",
+      py::arg("x"), py::arg("y"), py::arg("u_y") = py::none(), py::kw_only(), py::arg("u_x") = py::none(),
+      py::arg("loss") = "huber",
       py::arg("loss_scale") = 0.0, py::arg("outlier_threshold") = 3.0,
       R"(A robust line (fit/robust_line.hpp): Huber's or Cauchy's loss with Ceres; sigma from u_y
 when given, else a robust scale (1.4826·MAD). loss_scale in units of sigma (0: the loss's default,

@@ -15,6 +15,9 @@ packages=(
   libopencv-calib3d-dev
   # dpkg-shlibdeps for `cpack -G DEB`; man for the test of the installed manual pages
   dpkg-dev man-db
+  # the Python module (python/): pybind11, Python's headers, NumPy; its tests (pytest) and the
+  # example's figure (docs/python-example.py, tested too)
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
   librandom123-dev povray ffmpeg
 )
 # The browser test of `uphill serve` (tests/e2e) runs on node + npm and Debian's chromium. A

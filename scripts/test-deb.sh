@@ -3,7 +3,7 @@
 # a minimal Debian 12 (bookworm) with Debian's debootstrap, installs the package there with
 # `apt install ./uphill_*.deb` (Debian's mirror resolves its dependencies) and runs the installed
 # program from another folder: --version, convert, fit, report (gnuplot), the manual pages, the
-# bash completion and the systemd user unit.
+# bash completion, the systemd user unit, and the Python module of python3-uphill.
 #
 #   sudo bash scripts/test-deb.sh            (root: debootstrap, chroot and mount need it)
 #
@@ -70,25 +70,41 @@ chroot "$root" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin DEBIAN_FRONTEN
   '
 
 echo "== the installed program, as a user in their home folder"
+cat > "$root/tmp/as-user.sh" << 'EOF'
+set -euo pipefail
+cd ~
+command -v uphill
+uphill --version
+uphill convert --body spheroid --a 15.875mm --b 25.4mm --L 1165mm --H 300mm --D 120mm --mu 0.05 > one.txt
+head -8 one.txt
+uphill convert --batch /usr/share/uphill/data/convert_batch.csv --csv --mc-trials 1000 > batch.csv
+head -3 batch.csv
+uphill fit /usr/share/uphill/data/series2-fixed-L --mc-trials 1000 > fit.txt
+head -4 fit.txt
+uphill report /usr/share/uphill/data/series2-fixed-L -o report --mc-trials 1000
+test -s report/report.html && test -s report/fit_y_vs_x.png
+uphill paper-figures -o figures > /dev/null && test -s figures/series2-fixed-L/fit_y_vs_x.svg
+man uphill-convert | grep -q -- --batch && echo "man uphill-convert: ok"
+source /usr/share/bash-completion/completions/uphill
+COMP_WORDS=(uphill c) COMP_CWORD=1
+_uphill_complete
+echo "completion of 'uphill c': ${COMPREPLY[*]}"
+if dpkg-query -W python3-uphill > /dev/null 2>&1; then
+  python3 - << 'PY'
+import numpy as np
+import uphill
+print("python3-uphill:", uphill.__version__, uphill.__file__, uphill.kernel())
+theta, alpha, x_eq = uphill.convert_apparatus(np.array([1.165]), np.array([0.3]), np.array([0.12]), "15.875 mm", "25.4 mm")
+print("X =", x_eq[0], "m")
+analysis = uphill.analyse_experiment("/usr/share/uphill/data/series2-fixed-L", mc_trials=1000)
+print("York slope of the sample experiment:", analysis.fits["york"].slope)
+PY
+fi
+EOF
+chmod 755 "$root/tmp/as-user.sh"
 chroot "$root" /usr/bin/env -i PATH=/usr/bin:/bin LANG=C.UTF-8 bash -euo pipefail -c '
   /usr/sbin/useradd --create-home --shell /bin/bash lab
-  su lab -c "
-    set -euo pipefail
-    cd ~
-    command -v uphill
-    uphill --version
-    uphill convert --body spheroid --a 15.875mm --b 25.4mm --L 1165mm --H 300mm --D 120mm --mu 0.05 > one.txt
-    head -8 one.txt
-    uphill convert --batch /usr/share/uphill/data/convert_batch.csv --csv --mc-trials 1000 > batch.csv
-    head -3 batch.csv
-    uphill fit /usr/share/uphill/data/series2-fixed-L --mc-trials 1000 > fit.txt
-    head -4 fit.txt
-    uphill report /usr/share/uphill/data/series2-fixed-L -o report --mc-trials 1000
-    test -s report/report.html && test -s report/fit_y_vs_x.png
-    uphill paper-figures -o figures > /dev/null && test -s figures/series2-fixed-L/fit_y_vs_x.svg
-    man uphill-convert | grep -q -- --batch && echo \"man uphill-convert: ok\"
-    bash -c \"source /usr/share/bash-completion/completions/uphill; COMP_WORDS=(uphill c); COMP_CWORD=1; _uphill_complete; echo completion of \\\"uphill c\\\": \\\${COMPREPLY[*]}\"
-  "
+  su lab -c "bash /tmp/as-user.sh"
 '
 
 echo "== the systemd user unit (systemd-analyze verify)"

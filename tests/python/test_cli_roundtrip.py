@@ -65,8 +65,8 @@ def test_fit_xy_equals_the_cli(tmp_path):
     table = uphill.read_xy(str(path))
     np.testing.assert_array_equal(table["x"], x)
     np.testing.assert_array_equal(table["u_y"], uy)
-    for method, fit in (("ols", lambda: uphill.fit_ols(x, y)), ("wls", lambda: uphill.fit_wls(x, y, uy)),
-                        ("york", lambda: uphill.fit_york(x, y, ux, uy)), ("robust", lambda: uphill.fit_robust(x, y, uy))):
+    for method, fit in (("ols", lambda: uphill.fit_ols(x, y, ux, uy)), ("wls", lambda: uphill.fit_wls(x, y, uy, u_x=ux)),
+                        ("york", lambda: uphill.fit_york(x, y, ux, uy)), ("robust", lambda: uphill.fit_robust(x, y, uy, u_x=ux))):
         cli = cli_json("fit", "--xy", path, "--method", method)
         py = fit().to_json()
         py.pop("solver", None), cli.pop("solver", None)  # Ceres' own timing differs run to run
