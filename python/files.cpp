@@ -312,14 +312,17 @@ five fits of Y against X. Returns an uphill.Analysis. InputError when no row is 
         d["x"] = array(t.x), d["y"] = array(t.y);
         d["u_x"] = t.u_x.empty() ? py::object(py::none()) : py::object(array(t.u_x));
         d["u_y"] = t.u_y.empty() ? py::object(py::none()) : py::object(array(t.u_y));
-        d["rows"] = t.rows;
+        std::vector<int> rows(t.x.size());
+        for (std::size_t i = 0; i < rows.size(); ++i) rows[i] = t.RowOf(i);
+        d["rows"] = rows;
+        d["left_out"] = t.left_out;
         d["row_errors"] = t.row_errors;
         return d;
       },
       py::arg("path"),
       R"(Reads the X-Y table of `uphill fit --xy` (header X,Y and optionally uX,uY; plain numbers in one
-unit): dict of float64 arrays x, y, u_x, u_y (None when absent), the spreadsheet row of each (rows)
-and the rows left out with their reason (row_errors).)");
+unit): dict of float64 arrays x, y, u_x, u_y (None when absent), the spreadsheet row of each (rows),
+and the rows left out (left_out) with their reasons (row_errors).)");
 }
 
 }  // namespace uphill::python
