@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 
+#include "app/convert_batch.hpp"
 #include "bindings.hpp"
 #include "io/configuration.hpp"
 #include "io/conversion.hpp"
@@ -168,6 +169,45 @@ theta, alpha, rod_diameter, u_<name>, label, along_rail=True. Each value is text
 on the command line ("1165 mm", "10 deg") or a number in SI (m, rad). mu (rolling resistance),
 at_x (positions, m or text), mc_trials (default 10^6, as the command) and seed (the command's
 default) as for the command.)");
+
+  m.def(
+      "convert_batch_file",
+      [](const std::string& path, const py::object& mu, const py::object& at_x, std::uint64_t mc_trials,
+         std::uint64_t seed, const py::kwargs& defaults) {
+        ConversionOptions options;
+        options.mu = OptionalQuantity(mu, Dimension::kDimensionless, "mu");
+        if (!at_x.is_none())
+          for (const auto& x : at_x) options.at_x.push_back(Quantity(x, Dimension::kLength, "at_x"));
+        options.propagation.trials = mc_trials;
+        options.propagation.seed = seed;
+        const FieldSource source = KeywordSource(defaults);
+        std::vector<nlohmann::ordered_json> rows;
+        {
+          py::gil_scoped_release release;
+          ConvertBatch(path, source, options, [](const BatchHeader&) {}, [&rows](const ConvertedRow& row) {
+            nlohmann::ordered_json j;
+            j["row"] = row.row;
+            if (row.result) {
+              const nlohmann::ordered_json result = ToJson(*row.result);  // outlives the loop
+              for (const auto& [key, value] : result.items()) j[key] = value;
+            } else {
+              j["error"] = row.error;
+            }
+            rows.push_back(std::move(j));
+          });
+        }
+        py::list out;
+        for (const auto& j : rows) out.append(ToPython(j));
+        return out;
+      },
+      py::arg("path"), py::kw_only(), py::arg("mu") = py::none(), py::arg("at_x") = py::none(),
+      py::arg("mc_trials") = 1000000, py::arg("seed") = 20261121,
+      R"(A batch CSV converted as `uphill convert --batch PATH --json` does (app/convert_batch.hpp): one
+configuration per row (format: docs/convert.md), keyword arguments as convert_setting's fields give
+the defaults for absent columns and empty cells. Returns a list with a dict per row: "row" (the
+spreadsheet row, header = 1) and the conversion's keys (SI), or "error" (file, row, column, rule)
+for a row that could not be converted; the other rows are converted as usual. InputError for the
+file as a whole (unreadable, an unknown column, no rows).)");
 
   py::class_<LoadedExperiment, std::shared_ptr<LoadedExperiment>>(m, "Experiment",
                                                                   R"(An experiment folder (format uphill-experiment/1, data/README.md), read once.
