@@ -25,20 +25,9 @@
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 
-// Until every layer's code is in namespace uphill (the restructure), its io/report/vision parts
-// are still in nested namespaces: make their names visible here either way.
-namespace uphill {
-namespace io {}
-namespace report {}
-namespace vision {}
-}  // namespace uphill
-
 namespace uphill::python {
 
 namespace py = pybind11;
-using namespace uphill::io;      // NOLINT: empty once the layers share namespace uphill
-using namespace uphill::report;  // NOLINT
-using namespace uphill::vision;  // NOLINT
 
 // An InputError about one element of an array argument (or one row of a file).
 class RowInputError : public InputError {

@@ -1,12 +1,6 @@
 // `import uphill`: the Python module over uphill's libraries (docs/python.md).
 #include "bindings.hpp"
-#if __has_include("model/vector_kernel.hpp")
 #include "model/vector_kernel.hpp"
-#define UPHILL_KERNEL_NAME() uphill::VectorKernelName()
-#else
-#include "model/batch_convert.hpp"
-#define UPHILL_KERNEL_NAME() uphill::BatchKernelName()
-#endif
 
 PYBIND11_MODULE(uphill, m) {
   namespace py = pybind11;
@@ -19,7 +13,7 @@ seconds) everywhere; where the program accepts a unit ("45 mm", "10 deg"), so do
 Arrays are float64 (nothing is cast silently); bad input raises uphill.InputError, a ValueError
 with the attributes quantity, rule and row. See docs/python.md.)";
   m.attr("__version__") = UPHILL_VERSION;
-  m.def("kernel", [] { return std::string(UPHILL_KERNEL_NAME()); },
+  m.def("kernel", [] { return std::string(uphill::VectorKernelName()); },
         "The batch kernels in use: \"avx2+fma (libmvec)\" or \"scalar (libm)\" (chosen at run time).");
   uphill::python::RegisterErrors(m);
   uphill::python::BindUnits(m);

@@ -15,6 +15,7 @@
 #include "model/batch_convert.hpp"
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
+#include "model/vector_kernel.hpp"
 
 namespace uphill::bench {
 namespace {
@@ -78,7 +79,7 @@ void RunPythonBenchmark(const PythonBenchmarkOptions& f, std::ostream& out) {
   if (!why_not.empty()) throw std::runtime_error("uphill bench python: " + why_not);
 
   out << "uphill bench python: one core, thread CPU time, best of " << f.repeats << "; batch kernel "
-      << BatchKernelName(BatchKernel::kAuto) << "\n\n";
+      << VectorKernelName() << "\n\n";
   Table table = ResultTable();
   table.Start(out);
   const std::size_t n = static_cast<std::size_t>(f.elements);
