@@ -8,10 +8,10 @@
 #include <map>
 #include <memory>
 
+#include "app/conversion.hpp"
 #include "app/convert_batch.hpp"
 #include "bindings.hpp"
 #include "io/configuration.hpp"
-#include "io/conversion.hpp"
 #include "io/experiment.hpp"
 #include "io/xy_table.hpp"
 #include "report/analysis.hpp"
