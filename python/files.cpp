@@ -112,6 +112,18 @@ py::array_t<double> RowArray(const ExperimentAnalysis& a, F&& value) {
   return out;
 }
 
+// The options `uphill convert` takes besides the setting: mu, --at-x, --mc-trials, --seed.
+ConversionOptions ConversionOptionsOf(const py::object& mu, const py::object& at_x, std::uint64_t mc_trials,
+                                      std::uint64_t seed) {
+  ConversionOptions options;
+  options.mu = OptionalQuantity(mu, Dimension::kDimensionless, "mu");
+  if (!at_x.is_none())
+    for (const auto& x : at_x) options.at_x.push_back(Quantity(x, Dimension::kLength, "at_x"));
+  options.propagation.trials = mc_trials;
+  options.propagation.seed = seed;
+  return options;
+}
+
 }  // namespace
 
 void BindUnits(py::module_& m) {
@@ -143,12 +155,7 @@ void BindFiles(py::module_& m) {
       "convert_setting",
       [](const py::object& mu, const py::object& at_x, std::uint64_t mc_trials, std::uint64_t seed,
          const std::string& length_unit, const py::kwargs& fields) {
-        ConversionOptions options;
-        options.mu = OptionalQuantity(mu, Dimension::kDimensionless, "mu");
-        if (!at_x.is_none())
-          for (const auto& x : at_x) options.at_x.push_back(Quantity(x, Dimension::kLength, "at_x"));
-        options.propagation.trials = mc_trials;
-        options.propagation.seed = seed;
+        ConversionOptions options = ConversionOptionsOf(mu, at_x, mc_trials, seed);
         options.length_unit = length_unit;
         const Configuration configuration = ParseConfiguration(KeywordSource(fields));
         nlohmann::ordered_json json;
@@ -160,7 +167,7 @@ void BindFiles(py::module_& m) {
       },
       py::kw_only(), py::arg("mu") = py::none(), py::arg("at_x") = py::none(), py::arg("mc_trials") = 1000000,
       py::arg("seed") = 20261121, py::arg("length_unit") = "mm",
-      R"(One setting converted exactly as `uphill convert ... --json` does (io/conversion.hpp): returns
+      R"(One setting converted exactly as `uphill convert ... --json` does (app/conversion.hpp): returns
 that JSON as a dict (SI units: m, rad; keys as documented for the command: theta, alpha, phi, x_eq,
 z_eq, x_max, x_low, rolls_up, points, x_rest, x_rest_low, u_<key>, u_mc_<key>, verdict, ...).
 
@@ -174,12 +181,7 @@ default) as for the command.)");
       "convert_batch_file",
       [](const std::string& path, const py::object& mu, const py::object& at_x, std::uint64_t mc_trials,
          std::uint64_t seed, const py::kwargs& defaults) {
-        ConversionOptions options;
-        options.mu = OptionalQuantity(mu, Dimension::kDimensionless, "mu");
-        if (!at_x.is_none())
-          for (const auto& x : at_x) options.at_x.push_back(Quantity(x, Dimension::kLength, "at_x"));
-        options.propagation.trials = mc_trials;
-        options.propagation.seed = seed;
+        const ConversionOptions options = ConversionOptionsOf(mu, at_x, mc_trials, seed);
         const FieldSource source = KeywordSource(defaults);
         std::vector<nlohmann::ordered_json> rows;
         {

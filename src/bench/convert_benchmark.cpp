@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <boost/random/mersenne_twister.hpp>
-#include <boost/random/uniform_real_distribution.hpp>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -18,6 +16,7 @@
 
 #include "bench/results_document.hpp"
 #include "bench/support.hpp"
+#include "bench/synthetic_data.hpp"
 #include "model/number_text.hpp"
 #include "model/batch_convert.hpp"
 #include "model/input_error.hpp"
@@ -137,16 +136,10 @@ void RunConvertBenchmark(const ConvertBenchmarkOptions& f, std::ostream& out) {
 
   // Random configurations over the apparatus' range (metres).
   const std::size_t n = static_cast<std::size_t>(f.configurations);
-  std::vector<double> L(n), H(n), D(n);
-  {
-    boost::random::mt19937_64 engine(f.seed);
-    boost::random::uniform_real_distribution<double> uL(0.5, 2.0), uH(0.05, 0.5), uD(0.02, 0.25);
-    for (std::size_t i = 0; i < n; ++i) {
-      L[i] = uL(engine);
-      H[i] = uH(engine);
-      D[i] = uD(engine);
-    }
-  }
+  const ApparatusSettings settings = RandomApparatusSettings(n, f.seed);
+  const std::vector<double>& L = settings.L;
+  const std::vector<double>& H = settings.H;
+  const std::vector<double>& D = settings.D;
   std::vector<double> theta(n), alpha(n), x_eq(n);
   auto convert = [&](VectorKernel k) {
     ConvertApparatusBatch(n, L.data(), H.data(), D.data(), kA, kB, theta.data(), alpha.data(), x_eq.data(), k);

@@ -1,8 +1,5 @@
 #include "bench/python_benchmark.hpp"
 
-#include <boost/random/mersenne_twister.hpp>
-#include <boost/random/normal_distribution.hpp>
-#include <boost/random/uniform_real_distribution.hpp>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -11,6 +8,7 @@
 
 #include "bench/results_document.hpp"
 #include "bench/support.hpp"
+#include "bench/synthetic_data.hpp"
 #include "fit/york_line.hpp"
 #include "model/batch_convert.hpp"
 #include "model/input_error.hpp"
@@ -85,12 +83,10 @@ void RunPythonBenchmark(const PythonBenchmarkOptions& f, std::ostream& out) {
   const std::size_t n = static_cast<std::size_t>(f.elements);
 
   // The conversion's inputs, as `uphill bench convert` draws them (metres).
-  std::vector<double> L(n), H(n), D(n);
-  {
-    boost::random::mt19937_64 engine(f.seed);
-    boost::random::uniform_real_distribution<double> uL(0.5, 2.0), uH(0.05, 0.5), uD(0.02, 0.25);
-    for (std::size_t i = 0; i < n; ++i) L[i] = uL(engine), H[i] = uH(engine), D[i] = uD(engine);
-  }
+  const ApparatusSettings settings = RandomApparatusSettings(n, f.seed);
+  const std::vector<double>& L = settings.L;
+  const std::vector<double>& H = settings.H;
+  const std::vector<double>& D = settings.D;
   std::vector<double> theta(n), alpha(n), x_eq(n);
   auto convert = [&] {
     ConvertApparatusBatch(n, L.data(), H.data(), D.data(), kA, kB, theta.data(), alpha.data(), x_eq.data());
@@ -100,21 +96,8 @@ void RunPythonBenchmark(const PythonBenchmarkOptions& f, std::ostream& out) {
   table.Add({"C++ kernel: ConvertApparatusBatch", Printf("%.3g", double(n)), FormatSeconds(kernel.seconds), "",
              FormatBytes(kernel.peak_bytes), "the reference of the rows below"});
 
-  // York's rows (Y = 1 + 2t + u(Y)·n, X = t + u(X)·n; u varying per row).
-  LineData line;
-  {
-    boost::random::mt19937_64 engine(f.seed + 1);
-    boost::random::uniform_real_distribution<double> unit(0.0, 1.0);
-    boost::random::normal_distribution<double> normal;
-    line.x.resize(n), line.y.resize(n), line.u_x.resize(n), line.u_y.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const double t = 10.0 * unit(engine);
-      line.u_x[i] = 0.05 + 0.15 * unit(engine);
-      line.u_y[i] = 0.1 + 0.3 * unit(engine);
-      line.x[i] = t + line.u_x[i] * normal(engine);
-      line.y[i] = 1.0 + 2.0 * t + line.u_y[i] * normal(engine);
-    }
-  }
+  // York's rows, as `uphill bench fit` draws them (Y = 1 + 2t + u(Y)·n, X = t + u(X)·n, t on [0, 10]).
+  const LineData line = StraightLine(n, f.seed + 1, 0.0, 10.0, 1.0);
   FitReport york;
   const Measurement york_kernel = Measure(f.repeats, [&] { york = FitErrorsInVariables(line); });
   table.Add({"C++ kernel: FitErrorsInVariables (York)", Printf("%.3g", double(n)), FormatSeconds(york_kernel.seconds),

@@ -26,4 +26,19 @@ LineData StraightLine(std::size_t n, std::uint64_t seed, double t0, double sprea
   return d;
 }
 
+ApparatusSettings RandomApparatusSettings(std::size_t n, std::uint64_t seed) {
+  boost::random::mt19937_64 engine(seed);
+  boost::random::uniform_real_distribution<double> uL(0.5, 2.0), uH(0.05, 0.5), uD(0.02, 0.25);
+  ApparatusSettings s;
+  s.L.resize(n);
+  s.H.resize(n);
+  s.D.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    s.L[i] = uL(engine);
+    s.H[i] = uH(engine);
+    s.D[i] = uD(engine);
+  }
+  return s;
+}
+
 }  // namespace uphill::bench
