@@ -31,11 +31,26 @@ class InputError(ValueError):
 
     def __reduce__(self):
         return (type(self), (self.quantity, self.rule, self.row))
+
+
+class InputTypeError(InputError, TypeError):
+    """An argument of the wrong type or dtype (uphill casts nothing silently): an InputError (so a
+    ValueError) with quantity, rule and row, and a TypeError, as Python reports wrong types."""
 )py";
 
 py::object& InputErrorType() {
   static py::object type;  // set once at import; lives as long as the module
   return type;
+}
+
+py::object& InputTypeErrorType() {
+  static py::object type;
+  return type;
+}
+
+void Raise(const py::object& type, const InputError& e, const py::object& row) {
+  py::object error = type(e.quantity(), e.rule(), row);
+  PyErr_SetObject(type.ptr(), error.ptr());
 }
 
 }  // namespace
@@ -45,23 +60,25 @@ void RegisterErrors(py::module_& m) {
   scope["__name__"] = "uphill";
   py::exec(kInputErrorSource, scope);
   InputErrorType() = scope["InputError"];
+  InputTypeErrorType() = scope["InputTypeError"];
   m.attr("InputError") = InputErrorType();
+  m.attr("InputTypeError") = InputTypeErrorType();
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const RowInputError& e) {
-      py::object error = InputErrorType()(e.quantity(), e.rule(), e.row());
-      PyErr_SetObject(InputErrorType().ptr(), error.ptr());
+      Raise(InputErrorType(), e, py::int_(e.row()));
+    } catch (const ArgumentTypeError& e) {
+      Raise(InputTypeErrorType(), e, py::none());
     } catch (const InputError& e) {
-      py::object error = InputErrorType()(e.quantity(), e.rule(), py::none());
-      PyErr_SetObject(InputErrorType().ptr(), error.ptr());
+      Raise(InputErrorType(), e, py::none());
     }
   });
 }
 
 Float64Argument::Float64Argument(const py::handle& value, std::string name) : name_(std::move(name)) {
   if (py::isinstance<py::bool_>(value))
-    throw py::type_error(name_ + ": expected a number or a float64 array, got a bool");
+    throw ArgumentTypeError(name_, "expected a number or a float64 array, got a bool");
   if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) {
     scalar_ = value.cast<double>();
     return;
@@ -72,13 +89,14 @@ Float64Argument::Float64Argument(const py::handle& value, std::string name) : na
   } else if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
     array = py::array::ensure(value);  // NumPy's own conversion; its dtype is checked below
   } else {
-    throw py::type_error(name_ + ": expected a number or a float64 array, got " +
-                         std::string(py::str(py::type::of(value).attr("__name__"))));
+    throw ArgumentTypeError(name_, "expected a number or a float64 array, got " +
+                                       std::string(py::str(py::type::of(value).attr("__name__"))));
   }
   if (!array || !array.dtype().is(py::dtype::of<double>()))
-    throw py::type_error(name_ + ": expected float64, got " +
-                         (array ? std::string(py::str(array.dtype())) : std::string("a list of mixed types")) +
-                         " (uphill casts nothing silently: pass np.asarray(" + name_ + ", dtype=np.float64))");
+    throw ArgumentTypeError(name_, "expected float64, got " +
+                                       (array ? std::string(py::str(array.dtype())) : std::string("a list of mixed types")) +
+                                       " (uphill casts nothing silently: pass np.asarray(" + name_ +
+                                       ", dtype=np.float64))");
   if (array.ndim() == 0) {
     scalar_ = *static_cast<const double*>(array.data());
     return;
@@ -118,12 +136,12 @@ py::array_t<double> NewArray(const std::vector<py::ssize_t>& shape) { return py:
 
 py::array_t<double> OutputArray(const py::object& out, const std::string& name, const std::vector<py::ssize_t>& shape) {
   if (out.is_none()) return NewArray(shape);
-  if (!py::isinstance<py::array>(out)) throw py::type_error(name + ": out array must be a NumPy array");
+  if (!py::isinstance<py::array>(out)) throw ArgumentTypeError(name, "out array must be a NumPy array");
   auto array = py::reinterpret_borrow<py::array>(out);
   if (!array.dtype().is(py::dtype::of<double>()))
-    throw py::type_error(name + ": out array must be float64, got " + std::string(py::str(array.dtype())));
+    throw ArgumentTypeError(name, "out array must be float64, got " + std::string(py::str(array.dtype())));
   if (!(array.flags() & py::array::c_style) || !array.writeable())
-    throw py::type_error(name + ": out array must be C-contiguous and writeable");
+    throw ArgumentTypeError(name, "out array must be C-contiguous and writeable");
   if (std::vector<py::ssize_t>(array.shape(), array.shape() + array.ndim()) != shape)
     throw InputError(name, "out array has the wrong shape (it must be the inputs' shape)");
   return py::reinterpret_borrow<py::array_t<double>>(out);
@@ -134,7 +152,7 @@ double* MutableData(py::array_t<double>& array) { return static_cast<double*>(ar
 double Quantity(const py::handle& value, Dimension dimension, const std::string& name) {
   if (py::isinstance<py::str>(value)) return ParseQuantity(value.cast<std::string>(), dimension, name);
   if (py::isinstance<py::bool_>(value) || !(py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)))
-    throw py::type_error(name + ": expected a number in SI units or a text with its unit (e.g. \"45 mm\")");
+    throw ArgumentTypeError(name, "expected a number in SI units or a text with its unit (e.g. \"45 mm\")");
   const double v = value.cast<double>();
   if (!std::isfinite(v)) throw InputError(name, "must be a finite number (got " + std::string(py::str(value)) + ")");
   return v;

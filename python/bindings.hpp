@@ -3,14 +3,17 @@
 //
 // Arrays in. A NumPy array (or a list of floats) of dtype float64, any shape; the array
 // arguments of one call must have the same shape (a scalar stands for every element). Nothing is
-// cast silently: another dtype is a TypeError that names the argument and says how to convert it.
+// cast silently: another dtype is uphill.InputTypeError (an InputError, so a ValueError, and a
+// TypeError) that names the argument and says how to convert it.
 // A C-contiguous array is read in place (no copy); another layout is copied once.
 // Arrays out. New float64 arrays of the inputs' shape, written by the library's kernels in place,
 // or (where a function takes `out=`) the caller's own arrays, so that repeated calls allocate
 // nothing.
 // Errors. uphill::InputError becomes uphill.InputError (a ValueError) with the attributes
 // quantity, rule and row: row is the element's index (flat, C order) for array arguments, the
-// file's row where the library names one, else None.
+// file's row where the library names one, else None. An argument of the wrong type or dtype is
+// uphill.InputTypeError, a subclass of both InputError and TypeError (as NumPy's AxisError is
+// both a ValueError and an IndexError): `except ValueError` and `except TypeError` both see it.
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -39,13 +42,20 @@ class RowInputError : public InputError {
   std::size_t row_;
 };
 
-// Registers uphill.InputError and the translation of InputError / RowInputError.
+// An argument of the wrong Python type or NumPy dtype (never cast): uphill.InputTypeError.
+class ArgumentTypeError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
+// Registers uphill.InputError, uphill.InputTypeError and the translation of InputError,
+// RowInputError and ArgumentTypeError.
 void RegisterErrors(py::module_& m);
 
 // A float64 argument: a scalar, or an array read in place when C-contiguous.
 class Float64Argument {
  public:
-  // Throws TypeError (py::type_error) for anything but a real number or a float64 array/list.
+  // Throws ArgumentTypeError for anything but a real number or a float64 array/list.
   Float64Argument(const py::handle& value, std::string name);
   const std::string& name() const { return name_; }
   bool is_scalar() const { return !array_.has_value(); }
@@ -71,7 +81,7 @@ std::size_t ElementCount(const std::vector<py::ssize_t>& shape);
 // A new float64 array of `shape` (a 0-d array for an empty shape).
 py::array_t<double> NewArray(const std::vector<py::ssize_t>& shape);
 // The caller's `out=` array for `name`, checked: float64, C-contiguous, writeable, of `shape`
-// (TypeError / InputError naming it); or a new array when `out` is None.
+// (ArgumentTypeError / InputError naming it); or a new array when `out` is None.
 py::array_t<double> OutputArray(const py::object& out, const std::string& name, const std::vector<py::ssize_t>& shape);
 double* MutableData(py::array_t<double>& array);
 

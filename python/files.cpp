@@ -42,7 +42,7 @@ FieldSource KeywordSource(const py::kwargs& fields) {
     if (py::isinstance<py::str>(value)) {
       field.text = value.cast<std::string>();
     } else if (py::isinstance<py::bool_>(value)) {
-      if (name != "along_rail") throw py::type_error(name + ": expected text or a number");
+      if (name != "along_rail") throw ArgumentTypeError(name, "expected text or a number");
       if (value.cast<bool>()) (*values)["L_convention"] = {"along-rail", ""};
       continue;
     } else if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) {
@@ -52,7 +52,7 @@ FieldSource KeywordSource(const py::kwargs& fields) {
       const std::string base = name.rfind("u_", 0) == 0 ? name.substr(2) : name;
       field.default_unit = base == "theta" || base == "alpha" ? "rad" : "m";
     } else {
-      throw py::type_error(name + ": expected text with a unit (\"45 mm\") or a number in SI units");
+      throw ArgumentTypeError(name, "expected text with a unit (\"45 mm\") or a number in SI units");
     }
     (*values)[name] = field;
   }

@@ -131,7 +131,7 @@ void RunPythonBenchmark(const PythonBenchmarkOptions& f, std::ostream& out) {
              identical});
   table.Add({"Python: uphill.convert_apparatus(...) new arrays", Printf("%.3g", double(n)),
              FormatSeconds(new_call.seconds), Overhead(new_call.seconds, kernel.seconds), FormatBytes(new_call.peak_bytes),
-             "the same numbers; includes faulting in 24 MB of fresh result pages"});
+             "the same numbers; includes faulting in " + FormatBytes(3 * sizeof(double) * n) + " of fresh result pages"});
   table.Add({"Python: NumPy conversion (out= arrays)", Printf("%.3g", double(n)), FormatSeconds(np_convert.seconds),
              Overhead(np_convert.seconds, kernel.seconds), FormatBytes(np_convert.peak_bytes),
              "max rel diff vs the module " +

@@ -51,10 +51,28 @@ def test_mismatched_lengths():
 
 @pytest.mark.parametrize("dtype", [np.float32, np.int64, np.int32, object, np.complex128])
 def test_other_dtypes_are_refused_not_cast(dtype):
-    with pytest.raises(TypeError, match="float64"):
-        uphill.convert_apparatus(L.astype(dtype), H, D, A, B)
-    with pytest.raises(TypeError, match="float64"):
+    # An InputError (a ValueError naming the argument and the rule) that is also a TypeError.
+    with pytest.raises(uphill.InputTypeError, match="float64") as e:
+        uphill.convert_apparatus(L, H, D.astype(dtype), A, B)
+    assert isinstance(e.value, ValueError) and isinstance(e.value, TypeError)
+    assert e.value.quantity == "D" and e.value.row is None
+    assert np.dtype(dtype).name in e.value.rule and "dtype=np.float64" in e.value.rule
+    with pytest.raises(uphill.InputTypeError, match="float64") as e:
         uphill.fit_ols(np.arange(5).astype(dtype), np.arange(5.0))
+    assert e.value.quantity == "X"
+    with pytest.raises(uphill.InputTypeError):
+        uphill.convert("sphere", L=L, H=H, D=D, R=np.full(3, 0.0127, dtype=dtype))
+
+
+def test_wrong_python_types_are_input_type_errors():
+    for call, quantity in ((lambda: uphill.convert_apparatus(L, H, D, A, [0.0254]), "b"),
+                           (lambda: uphill.convert_apparatus(L, H, {"D": 1}, A, B), "D"),
+                           (lambda: uphill.convert_apparatus(L, H, True, A, B), "D"),
+                           (lambda: uphill.Body.sphere(None), "R"),
+                           (lambda: uphill.convert_setting(body="sphere", R=[1.0], L="1165mm"), "R")):
+        with pytest.raises(uphill.InputTypeError) as e:
+            call()
+        assert e.value.quantity == quantity, str(e.value)
 
 
 def test_a_list_of_floats_is_accepted_a_list_of_ints_is_not():
@@ -99,8 +117,9 @@ def test_out_arrays_are_written_in_place_and_checked():
     theta, alpha, x_eq = np.empty(3), np.empty(3), np.empty(3)
     r = uphill.convert_apparatus(L, H, D, A, B, theta=theta, alpha=alpha, x_eq=x_eq)
     assert r[2] is x_eq and np.all(np.isfinite(x_eq))
-    with pytest.raises(TypeError):
+    with pytest.raises(uphill.InputTypeError) as e:
         uphill.convert_apparatus(L, H, D, A, B, x_eq=np.empty(3, dtype=np.float32))
+    assert e.value.quantity == "x_eq"
     with pytest.raises(uphill.InputError):
         uphill.convert_apparatus(L, H, D, A, B, x_eq=np.empty(4))
 
