@@ -1,10 +1,12 @@
 #include "model/gaussian_stream.hpp"
 
+#include <Random123/philox.h>
+
 #include <boost/random/normal_distribution.hpp>
 #include <cstring>
 
-// The AVX2 fast path needs no libmvec (integer and IEEE arithmetic only); whether it runs is
-// still the one kernel choice of vector_kernel.hpp.
+// The AVX2 kernels need no libmvec (integer and IEEE arithmetic only); whether they run is still
+// the one kernel choice of vector_kernel.hpp.
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 #define UPHILL_NORMALS_AVX2 1
@@ -26,7 +28,7 @@ struct GaussianStreamAccess {
     return s->buffer_[s->pos_++];
   }
   static double Next(GaussianStream* stream) {
-    // The same range as boost::random::mt19937_64 (0 .. 2^64 − 1): Boost sees the engine it would.
+    // A 64-bit engine (0 .. 2^64 − 1): Boost takes its fast 64-bit path.
     GaussianStreamAccess engine{stream};
     return boost::random::normal_distribution<double>()(engine);
   }
@@ -35,17 +37,99 @@ struct GaussianStreamAccess {
   static void Skip(GaussianStream* s, std::size_t k) { s->pos_ += k; }
 };
 
+namespace {
+
+// Blocks [first, first + count) of the stream (gaussian_stream.hpp), two words each, by
+// Random123's own Philox4x32-10.
+void PhiloxBlocks(std::uint64_t first, std::size_t count, const std::uint32_t key[2], std::uint32_t id,
+                  std::uint64_t* words) {
+  const r123::Philox4x32 philox;
+  const r123::Philox4x32::key_type k = {{key[0], key[1]}};
+  for (std::size_t b = 0; b < count; ++b) {
+    const std::uint64_t j = first + b;
+    const r123::Philox4x32::ctr_type c = {{static_cast<std::uint32_t>(j), static_cast<std::uint32_t>(j >> 32), id, 0}};
+    const r123::Philox4x32::ctr_type r = philox(c, k);
+    words[2 * b] = r.v[0] | (std::uint64_t{r.v[1]} << 32);
+    words[2 * b + 1] = r.v[2] | (std::uint64_t{r.v[3]} << 32);
+  }
+}
+
+#if UPHILL_NORMALS_AVX2
+#pragma GCC push_options
+#pragma GCC target("avx2")
+
+// (hi, lo) of the eight 32 × 32-bit products m·x, lane by lane.
+inline void MulHiLo(__m256i x, __m256i m, __m256i* hi, __m256i* lo) {
+  const __m256i even = _mm256_mul_epu32(x, m);                         // lanes 0, 2, 4, 6
+  const __m256i odd = _mm256_mul_epu32(_mm256_srli_epi64(x, 32), m);  // lanes 1, 3, 5, 7
+  *lo = _mm256_blend_epi32(even, _mm256_slli_epi64(odd, 32), 0xAA);
+  *hi = _mm256_blend_epi32(_mm256_srli_epi64(even, 32), odd, 0xAA);
+}
+
+// PhiloxBlocks for 8 blocks at a time: Random123's rounds (philox.h: _philox4x32round, bumpkey)
+// on vector lanes, block b in lane b. Falls back to PhiloxBlocks where j's low word would wrap.
+void PhiloxBlocksAvx2(std::uint64_t first, std::size_t count, const std::uint32_t key[2], std::uint32_t id,
+                      std::uint64_t* words) {
+  std::size_t b = 0;
+  const __m256i m0 = _mm256_set1_epi32(static_cast<int>(PHILOX_M4x32_0));
+  const __m256i m1 = _mm256_set1_epi32(static_cast<int>(PHILOX_M4x32_1));
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  for (; b + 8 <= count; b += 8) {
+    const std::uint64_t j = first + b;
+    if (static_cast<std::uint32_t>(j) > 0xFFFFFFF8u) {
+      PhiloxBlocks(j, 8, key, id, words + 2 * b);
+      continue;
+    }
+    __m256i x0 = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(static_cast<std::uint32_t>(j))), lane);
+    __m256i x1 = _mm256_set1_epi32(static_cast<int>(static_cast<std::uint32_t>(j >> 32)));
+    __m256i x2 = _mm256_set1_epi32(static_cast<int>(id));
+    __m256i x3 = _mm256_setzero_si256();
+    std::uint32_t k0 = key[0], k1 = key[1];
+    for (int round = 0; round < 10; ++round) {
+      if (round > 0) k0 += PHILOX_W32_0, k1 += PHILOX_W32_1;
+      __m256i hi0, lo0, hi1, lo1;
+      MulHiLo(x0, m0, &hi0, &lo0);
+      MulHiLo(x2, m1, &hi1, &lo1);
+      x0 = _mm256_xor_si256(_mm256_xor_si256(hi1, x1), _mm256_set1_epi32(static_cast<int>(k0)));
+      x1 = lo1;
+      x2 = _mm256_xor_si256(_mm256_xor_si256(hi0, x3), _mm256_set1_epi32(static_cast<int>(k1)));
+      x3 = lo0;
+    }
+    // Words 2b = c0 | c1 << 32 and 2b + 1 = c2 | c3 << 32, per block, in block order.
+    const __m256i a_lo = _mm256_unpacklo_epi32(x0, x1), a_hi = _mm256_unpackhi_epi32(x0, x1);  // blocks 0,1|4,5 and 2,3|6,7
+    const __m256i b_lo = _mm256_unpacklo_epi32(x2, x3), b_hi = _mm256_unpackhi_epi32(x2, x3);
+    const __m256i p0 = _mm256_unpacklo_epi64(a_lo, b_lo), q0 = _mm256_unpackhi_epi64(a_lo, b_lo);  // blocks 0|4, 1|5
+    const __m256i p1 = _mm256_unpacklo_epi64(a_hi, b_hi), q1 = _mm256_unpackhi_epi64(a_hi, b_hi);  // blocks 2|6, 3|7
+    __m256i* out = reinterpret_cast<__m256i*>(words + 2 * b);
+    _mm256_storeu_si256(out + 0, _mm256_permute2x128_si256(p0, q0, 0x20));  // blocks 0, 1
+    _mm256_storeu_si256(out + 1, _mm256_permute2x128_si256(p1, q1, 0x20));  // blocks 2, 3
+    _mm256_storeu_si256(out + 2, _mm256_permute2x128_si256(p0, q0, 0x31));  // blocks 4, 5
+    _mm256_storeu_si256(out + 3, _mm256_permute2x128_si256(p1, q1, 0x31));  // blocks 6, 7
+  }
+  PhiloxBlocks(first + b, count - b, key, id, words + 2 * b);
+}
+
+#pragma GCC pop_options
+#endif  // UPHILL_NORMALS_AVX2
+
+}  // namespace
+
 void GaussianStream::Refill() {
   const std::size_t left = end_ - pos_;
   std::memmove(buffer_, buffer_ + pos_, left * sizeof buffer_[0]);
-  // Through a local copy of the engine: its position index and the buffer are both unsigned long,
-  // so with the member engine every buffer store could alias the index and the loop would run at
-  // the speed of a store-to-load round trip. The copy (2.5 KB) costs far less than that.
-  boost::random::mt19937_64 engine = engine_;
-  for (std::size_t k = left; k < kBuffer; ++k) buffer_[k] = engine();
-  engine_ = engine;
+  const std::size_t blocks = (kBuffer - left) / 2;
+#if UPHILL_NORMALS_AVX2
+  if (avx2_) {
+    PhiloxBlocksAvx2(next_block_, blocks, key_, id_, buffer_ + left);
+  } else {
+    PhiloxBlocks(next_block_, blocks, key_, id_, buffer_ + left);
+  }
+#else
+  PhiloxBlocks(next_block_, blocks, key_, id_, buffer_ + left);
+#endif
+  next_block_ += blocks;
   pos_ = 0;
-  end_ = kBuffer;
+  end_ = left + 2 * blocks;
 }
 
 namespace {
@@ -120,7 +204,8 @@ void Avx2Normals(GaussianStream* stream, std::size_t n, double* z) {
 
 void GaussianStream::Fill(std::size_t n, double* z, VectorKernel kernel) {
 #if UPHILL_NORMALS_AVX2
-  if (UseAvx2(kernel)) return Avx2Normals(this, n, z);
+  avx2_ = UseAvx2(kernel);
+  if (avx2_) return Avx2Normals(this, n, z);
 #else
   UseAvx2(kernel);
 #endif

@@ -27,13 +27,15 @@
 // the inputs' distribution truncated to the physical domain. A non-zero count means that the
 // uncertainties are large for this configuration: say so to the user.
 //
-// Reproducibility. Each input has its own boost::random::mt19937_64 stream, seeded from
-// (options.seed, the input's identity); the Gaussian draws are exactly the values of
-// boost::random::normal_distribution<double> on that stream (a fixed ziggurat, unlike
-// std::normal_distribution, whose algorithm is implementation-defined), produced by
-// GaussianStream (gaussian_stream.hpp), which has a vectorised fast path that is bit-identical to
-// Boost. So the trials' inputs depend only on the seed and the Boost version, not on the machine,
-// and a draw of D does not change when another input gains or loses its uncertainty. The outputs
+// Reproducibility. Each input has its own counter-based stream: Random123's Philox4x32-10 with
+// key = options.seed and the input's index (InputQuantity, 0 … kNumInputs − 1) as the stream id
+// in the counter; the Gaussian draws are exactly the values of
+// boost::random::normal_distribution<double> on that stream's 64-bit words (a fixed ziggurat,
+// unlike std::normal_distribution, whose algorithm is implementation-defined), produced by
+// GaussianStream (gaussian_stream.hpp, which states the stream to the bit), whose vectorised
+// kernel is bit-identical to Random123 + Boost. Trial k of an input uses its k-th draw. So the
+// trials' inputs depend only on the seed and the Boost version, not on the machine, and a draw
+// of D does not change when another input gains or loses its uncertainty. The outputs
 // come from the batch kernel (batch_convert.hpp): the same numbers on every run, to a few ulp the
 // same on another CPU (kScalar and kAvx2 differ in the last bits; options.kernel picks one).
 //

@@ -25,14 +25,6 @@ constexpr std::uint64_t kPilot = 16 * kBlock;  // trials that place the coverage
 // are kept per window end).
 constexpr double kWindowSigmas = 4.5;
 
-// SplitMix64 (Steele, Lea, Flood 2014): decorrelated per-input seeds from one user seed.
-std::uint64_t SplitMix64(std::uint64_t z) {
-  z += 0x9E3779B97F4A7C15ull;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-
 enum Reason : unsigned char {
   kValid = 0,
   kNonPositiveLength,
@@ -119,7 +111,7 @@ class MonteCarloRun {
     streams.reserve(kNumInputs);
     for (int i = 0; i < kNumInputs; ++i)
       if (p_.present[i] && p_.u[i] > 0.0)
-        streams.push_back({i, GaussianStream(SplitMix64(o_.seed + SplitMix64(i)))});
+        streams.push_back({i, GaussianStream(o_.seed, static_cast<std::uint32_t>(i))});
 
     const bool windows = !store_all && o_.trials > 4 * kPilot;
     RejectedTrials rejected;
