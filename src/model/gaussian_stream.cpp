@@ -66,45 +66,56 @@ inline void MulHiLo(__m256i x, __m256i m, __m256i* hi, __m256i* lo) {
   *hi = _mm256_blend_epi32(_mm256_srli_epi64(even, 32), odd, 0xAA);
 }
 
-// PhiloxBlocks for 8 blocks at a time: Random123's rounds (philox.h: _philox4x32round, bumpkey)
-// on vector lanes, block b in lane b. Falls back to PhiloxBlocks where j's low word would wrap.
+// PhiloxBlocks for 32 blocks at a time: Random123's rounds (philox.h: _philox4x32round, bumpkey)
+// on vector lanes, block b in lane b % 8 of set b / 8 (four independent sets hide the multiplies'
+// latency). Falls back to PhiloxBlocks where j's low word would wrap.
 void PhiloxBlocksAvx2(std::uint64_t first, std::size_t count, const std::uint32_t key[2], std::uint32_t id,
                       std::uint64_t* words) {
+  constexpr int kSets = 4;
   std::size_t b = 0;
   const __m256i m0 = _mm256_set1_epi32(static_cast<int>(PHILOX_M4x32_0));
   const __m256i m1 = _mm256_set1_epi32(static_cast<int>(PHILOX_M4x32_1));
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  for (; b + 8 <= count; b += 8) {
+  for (; b + 8 * kSets <= count; b += 8 * kSets) {
     const std::uint64_t j = first + b;
-    if (static_cast<std::uint32_t>(j) > 0xFFFFFFF8u) {
-      PhiloxBlocks(j, 8, key, id, words + 2 * b);
+    if (static_cast<std::uint32_t>(j) > 0xFFFFFFFFu - 8 * kSets) {
+      PhiloxBlocks(j, 8 * kSets, key, id, words + 2 * b);
       continue;
     }
-    __m256i x0 = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(static_cast<std::uint32_t>(j))), lane);
-    __m256i x1 = _mm256_set1_epi32(static_cast<int>(static_cast<std::uint32_t>(j >> 32)));
-    __m256i x2 = _mm256_set1_epi32(static_cast<int>(id));
-    __m256i x3 = _mm256_setzero_si256();
+    __m256i x0[kSets], x1[kSets], x2[kSets], x3[kSets];
+    for (int s = 0; s < kSets; ++s) {
+      x0[s] = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(static_cast<std::uint32_t>(j) + 8u * s)), lane);
+      x1[s] = _mm256_set1_epi32(static_cast<int>(static_cast<std::uint32_t>(j >> 32)));
+      x2[s] = _mm256_set1_epi32(static_cast<int>(id));
+      x3[s] = _mm256_setzero_si256();
+    }
     std::uint32_t k0 = key[0], k1 = key[1];
     for (int round = 0; round < 10; ++round) {
       if (round > 0) k0 += PHILOX_W32_0, k1 += PHILOX_W32_1;
-      __m256i hi0, lo0, hi1, lo1;
-      MulHiLo(x0, m0, &hi0, &lo0);
-      MulHiLo(x2, m1, &hi1, &lo1);
-      x0 = _mm256_xor_si256(_mm256_xor_si256(hi1, x1), _mm256_set1_epi32(static_cast<int>(k0)));
-      x1 = lo1;
-      x2 = _mm256_xor_si256(_mm256_xor_si256(hi0, x3), _mm256_set1_epi32(static_cast<int>(k1)));
-      x3 = lo0;
+      const __m256i key0 = _mm256_set1_epi32(static_cast<int>(k0)), key1 = _mm256_set1_epi32(static_cast<int>(k1));
+      for (int s = 0; s < kSets; ++s) {
+        __m256i hi0, lo0, hi1, lo1;
+        MulHiLo(x0[s], m0, &hi0, &lo0);
+        MulHiLo(x2[s], m1, &hi1, &lo1);
+        x0[s] = _mm256_xor_si256(_mm256_xor_si256(hi1, x1[s]), key0);
+        x1[s] = lo1;
+        x2[s] = _mm256_xor_si256(_mm256_xor_si256(hi0, x3[s]), key1);
+        x3[s] = lo0;
+      }
     }
-    // Words 2b = c0 | c1 << 32 and 2b + 1 = c2 | c3 << 32, per block, in block order.
-    const __m256i a_lo = _mm256_unpacklo_epi32(x0, x1), a_hi = _mm256_unpackhi_epi32(x0, x1);  // blocks 0,1|4,5 and 2,3|6,7
-    const __m256i b_lo = _mm256_unpacklo_epi32(x2, x3), b_hi = _mm256_unpackhi_epi32(x2, x3);
-    const __m256i p0 = _mm256_unpacklo_epi64(a_lo, b_lo), q0 = _mm256_unpackhi_epi64(a_lo, b_lo);  // blocks 0|4, 1|5
-    const __m256i p1 = _mm256_unpacklo_epi64(a_hi, b_hi), q1 = _mm256_unpackhi_epi64(a_hi, b_hi);  // blocks 2|6, 3|7
-    __m256i* out = reinterpret_cast<__m256i*>(words + 2 * b);
-    _mm256_storeu_si256(out + 0, _mm256_permute2x128_si256(p0, q0, 0x20));  // blocks 0, 1
-    _mm256_storeu_si256(out + 1, _mm256_permute2x128_si256(p1, q1, 0x20));  // blocks 2, 3
-    _mm256_storeu_si256(out + 2, _mm256_permute2x128_si256(p0, q0, 0x31));  // blocks 4, 5
-    _mm256_storeu_si256(out + 3, _mm256_permute2x128_si256(p1, q1, 0x31));  // blocks 6, 7
+    for (int s = 0; s < kSets; ++s) {
+      // Words 2b = c0 | c1 << 32 and 2b + 1 = c2 | c3 << 32, per block, in block order.
+      const __m256i a_lo = _mm256_unpacklo_epi32(x0[s], x1[s]);  // blocks 0,1 | 4,5
+      const __m256i a_hi = _mm256_unpackhi_epi32(x0[s], x1[s]);  // blocks 2,3 | 6,7
+      const __m256i b_lo = _mm256_unpacklo_epi32(x2[s], x3[s]), b_hi = _mm256_unpackhi_epi32(x2[s], x3[s]);
+      const __m256i p0 = _mm256_unpacklo_epi64(a_lo, b_lo), q0 = _mm256_unpackhi_epi64(a_lo, b_lo);  // 0|4, 1|5
+      const __m256i p1 = _mm256_unpacklo_epi64(a_hi, b_hi), q1 = _mm256_unpackhi_epi64(a_hi, b_hi);  // 2|6, 3|7
+      __m256i* out = reinterpret_cast<__m256i*>(words + 2 * (b + 8 * s));
+      _mm256_storeu_si256(out + 0, _mm256_permute2x128_si256(p0, q0, 0x20));  // blocks 0, 1
+      _mm256_storeu_si256(out + 1, _mm256_permute2x128_si256(p1, q1, 0x20));  // blocks 2, 3
+      _mm256_storeu_si256(out + 2, _mm256_permute2x128_si256(p0, q0, 0x31));  // blocks 4, 5
+      _mm256_storeu_si256(out + 3, _mm256_permute2x128_si256(p1, q1, 0x31));  // blocks 6, 7
+    }
   }
   PhiloxBlocks(first + b, count - b, key, id, words + 2 * b);
 }
