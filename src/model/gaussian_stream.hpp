@@ -14,7 +14,7 @@
 // C++ library; a counter-based generator also needs no state to skip ahead: block j is computed
 // from j alone.
 //
-// Speed: the AVX2 kernel computes Philox for 8 blocks at once (the same 32-bit multiplies and
+// Speed: the AVX2 kernel computes Philox for 32 blocks at once (the same 32-bit multiplies and
 // xors as Random123's scalar code, on vector lanes) and evaluates the ziggurat's fast path
 // (≈ 98.8 % of values: one word gives a layer index, a sign and a 53-bit fraction r;
 // x = r·x[i] is accepted if x < x[i+1]; plain integer and IEEE arithmetic with correctly rounded
