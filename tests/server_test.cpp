@@ -18,97 +18,18 @@
 
 #include "io/experiment.hpp"
 #include "server/experiment_store.hpp"
-#include "server/http_server.hpp"
 #include "server/row_check.hpp"
-// Last: <httplib.h> includes <resolv.h>, whose `_res` macro breaks Eigen.
-#include <httplib.h>
+// Last: it includes <httplib.h>, which includes <resolv.h>, whose `_res` macro breaks Eigen.
+#include "server_test_support.hpp"
 
 namespace uphill::testing {
 namespace {
 
-namespace fs = std::filesystem;
-using nlohmann::json;
+using namespace uphill::testing;
+using uphill::testing::Row;  // the sample row, not the state's Row
 
-const char* kJson = "application/json";
-
-fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() /
-                       ("uphill-server-test-" + std::to_string(::getpid()) + "-" + name);
-  fs::remove_all(dir);
-  return dir;
-}
-
-json ExperimentMetadata() {
-  return {{"title", "Series 2 <script>alert(1)</script>"},
-          {"operator", "A. Technician"},
-          {"body", {{"type", "spheroid"}, {"a", "15.875 mm"}, {"b", "25.4 mm"}}},
-          {"apparatus", {{"H", "300 mm"}, {"L_convention", "horizontal"}}},
-          {"uncertainties", {{"L", "1 mm"}, {"H", "0.5 mm"}, {"D", "0.2 mm"}, {"Y", "0.5 mm"}}}};
-}
-
-// A plausible row of series 2 (L = 1165 mm, D varied). X is 389.8 mm at D = 150 mm, 289.7 at
-// 200, 229.1 at 250 (the fall-off 5-8 mm further): Y a little beyond X.
-json Row(const std::string& trial, double D = 150, double Y = 392) {
-  char d[32], y[32];
-  std::snprintf(d, sizeof d, "%g", D);
-  std::snprintf(y, sizeof y, "%g", Y);
-  return {{"trial", trial}, {"series", "s2"}, {"L", "1165"}, {"D", d}, {"Y", y}, {"note", "ok"}};
-}
-
-class ServerTest : public ::testing::Test {
+class ServerTest : public ServerFixture {
  protected:
-  void SetUp() override { Start(); }
-  void TearDown() override {
-    Stop();
-    fs::remove_all(dir_);
-  }
-  void Start() {
-    ServerOptions options;
-    options.directory = dir_.string();
-    options.port = 0;
-    options.report_mc_trials = 1000;
-    server_ = std::make_unique<Server>(options);
-    port_ = server_->Bind();
-    thread_ = std::thread([this] { server_->Run(); });
-    client_ = std::make_unique<httplib::Client>("127.0.0.1", port_);
-    client_->set_connection_timeout(5);
-    client_->set_read_timeout(20);
-  }
-  void Stop() {
-    client_.reset();
-    if (server_) server_->Stop();
-    if (thread_.joinable()) thread_.join();
-    server_.reset();
-  }
-  json State() {
-    auto r = client_->Get("/api/state");
-    EXPECT_TRUE(r);
-    EXPECT_EQ(r->status, 200);
-    return json::parse(r->body);
-  }
-  // Sends a change; returns {status, body}.
-  std::pair<int, json> Send(const std::string& method, const std::string& path, const json& body) {
-    httplib::Result r = method == "POST"  ? client_->Post(path.c_str(), body.dump(), kJson)
-                        : method == "PUT" ? client_->Put(path.c_str(), body.dump(), kJson)
-                                          : client_->Delete(path.c_str(), body.dump(), kJson);
-    if (!r) return {0, json()};
-    json parsed;
-    try {
-      parsed = json::parse(r->body);
-    } catch (...) {
-    }
-    return {r->status, parsed};
-  }
-  json Create() {
-    auto [status, body] = Send("PUT", "/api/experiment", {{"version", State()["version"]}, {"experiment", ExperimentMetadata()}, {"unit", "mm"}});
-    EXPECT_EQ(status, 200) << body.dump();
-    return body;
-  }
-  json Add(const json& row) {
-    auto [status, body] = Send("POST", "/api/rows", {{"version", State()["version"]}, {"row", row}});
-    EXPECT_EQ(status, 200) << body.dump();
-    return body;
-  }
   static std::vector<std::string> Codes(const json& check) {
     std::vector<std::string> codes;
     for (const json& f : check["flags"]) codes.push_back(f["code"]);
@@ -117,12 +38,6 @@ class ServerTest : public ::testing::Test {
   static bool Has(const std::vector<std::string>& codes, const std::string& code) {
     return std::find(codes.begin(), codes.end(), code) != codes.end();
   }
-
-  fs::path dir_ = TempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
-  std::unique_ptr<Server> server_;
-  std::thread thread_;
-  std::unique_ptr<httplib::Client> client_;
-  int port_ = 0;
 };
 
 TEST_F(ServerTest, ServesTheEmbeddedPageWithAStrictPolicy) {
@@ -293,10 +208,7 @@ TEST_F(ServerTest, RefusesBadRequests) {
 }
 
 TEST_F(ServerTest, ServesReportFilesByNameOnly) {
-  Create();
-  Add(Row("t1", 150, 392));
-  Add(Row("t2", 200, 292));
-  Add(Row("t3", 250, 232));
+  CreateWithThreeRows();
   fs::create_directories(dir_ / "report");
   std::ofstream(dir_ / "report" / "note.md") << "# hello\n";
   auto ok = client_->Get("/report/note.md");
@@ -314,14 +226,11 @@ TEST_F(ServerTest, ServesReportFilesByNameOnly) {
   fs::create_symlink(dir_ / "experiment.json", dir_ / "report" / "link.json");
   auto link = client_->Get("/report/link.json");
   ASSERT_TRUE(link);
-  EXPECT_EQ(link->status, 404);
+  EXPECT_EQ(link->status, 403);  // never followed (server_security_test.cpp: links at any level)
 }
 
 TEST_F(ServerTest, WritesTheFitReport) {
-  Create();
-  Add(Row("t1", 150, 392));
-  Add(Row("t2", 200, 292));
-  Add(Row("t3", 250, 232));
+  CreateWithThreeRows();
   auto [status, body] = Send("POST", "/api/report", json::object());
   ASSERT_EQ(status, 200) << body.dump();
   EXPECT_EQ(body["url"], "/report/report.html");

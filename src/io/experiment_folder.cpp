@@ -1,6 +1,7 @@
 #include "io/experiment_folder.hpp"
 
 #include <filesystem>
+#include <sstream>
 
 #include "io/json_file.hpp"
 #include "model/input_error.hpp"
@@ -38,15 +39,39 @@ const std::vector<std::string>& MeasurementQuantities() {
   return columns;
 }
 
-ExperimentFolder ReadExperimentJson(const std::string& directory) {
+namespace {
+
+ExperimentFolder FolderPaths(const std::string& directory) {
   namespace fs = std::filesystem;
-  if (!fs::is_directory(directory)) throw InputError(directory, "is not an experiment folder");
   ExperimentFolder folder;
   folder.directory = directory;
   folder.json_path = (fs::path(directory) / kExperimentJsonFile).string();
   folder.csv_path = (fs::path(directory) / kMeasurementsCsvFile).string();
+  return folder;
+}
+
+}  // namespace
+
+ExperimentFolder ReadExperimentJson(const std::string& directory) {
+  if (!std::filesystem::is_directory(directory)) throw InputError(directory, "is not an experiment folder");
+  ExperimentFolder folder = FolderPaths(directory);
   folder.metadata = ReadJsonFile(folder.json_path);
   return folder;
+}
+
+ExperimentFolder ParseExperimentJson(const std::string& directory, const std::string& json_text) {
+  ExperimentFolder folder = FolderPaths(directory);
+  try {
+    folder.metadata = nlohmann::json::parse(json_text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(folder.json_path, std::string("is not valid JSON: ") + e.what());
+  }
+  return folder;
+}
+
+CsvTable ParseMeasurements(const ExperimentFolder& folder, const std::string& csv_text) {
+  std::istringstream in(csv_text);
+  return ReadCsv(in, folder.csv_path);
 }
 
 std::optional<CsvTable> ReadMeasurements(const ExperimentFolder& folder) {

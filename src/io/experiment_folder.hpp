@@ -50,4 +50,11 @@ ExperimentFolder ReadExperimentJson(const std::string& directory);
 // naming the file when it exists but cannot be read or is malformed CSV.
 std::optional<CsvTable> ReadMeasurements(const ExperimentFolder& folder);
 
+// The same from the files' contents, for a reader that opened them itself (the server reads them
+// through ContainedDirectory, which refuses links): `json_text` is experiment.json of
+// `directory`, `csv_text` its measurements.csv. Messages name the files as the path readers do.
+// Throw InputError when experiment.json is not valid JSON or measurements.csv malformed CSV.
+ExperimentFolder ParseExperimentJson(const std::string& directory, const std::string& json_text);
+CsvTable ParseMeasurements(const ExperimentFolder& folder, const std::string& csv_text);
+
 }  // namespace uphill

@@ -2,11 +2,14 @@
 
 #include <boost/archive/iterators/base64_from_binary.hpp>
 #include <boost/archive/iterators/transform_width.hpp>
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+
+#include "model/input_error.hpp"
 
 namespace uphill {
 namespace {
@@ -20,7 +23,7 @@ figure{margin:1em 0 1.6em}figure img{width:100%;max-width:900px;border:1px solid
 
 std::string Slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot be read to embed it in the report");
+  if (!in) throw EnvironmentError(path + ": cannot be read to embed it in the report");
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
@@ -34,12 +37,48 @@ bool LooksNumeric(const std::string& s) {
   return end != s.c_str() && *end == '\0';
 }
 
-std::string MarkdownCell(const std::string& s) {
+// Text as Markdown shows it, never as markup: the report's text is plain (notes, titles, labels
+// typed by people), so nothing in it may become HTML, a link (`[x](javascript:…)`, `<javascript:…>`),
+// an image, emphasis or a heading. HTML's special characters become entities; Markdown's are
+// escaped with a backslash (CommonMark: any ASCII punctuation may be); line breaks become spaces,
+// so a typed line can never start a block of its own.
+std::string MarkdownText(const std::string& s) {
   std::string out;
   for (char c : s) {
-    if (c == '|') out += "\\|";
-    else if (c == '\n') out += "<br>";
-    else out += c;
+    switch (c) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '\\': case '`': case '*': case '_': case '[': case ']': case '|': case '#': case '~':
+        out += '\\';
+        out += c;
+        break;
+      case '\n': case '\r': out += ' '; break;
+      default: out += c;
+    }
+  }
+  // A block that starts like a list item or a setext underline stays a paragraph.
+  const std::size_t first = out.find_first_not_of(' ');
+  if (first != std::string::npos) {
+    const char c = out[first];
+    std::size_t digits = first;
+    while (digits < out.size() && std::isdigit(static_cast<unsigned char>(out[digits]))) ++digits;
+    if (c == '-' || c == '+' || c == '=') out.insert(first, 1, '\\');
+    else if (digits > first && digits < out.size() && (out[digits] == '.' || out[digits] == ')')) out.insert(digits, 1, '\\');
+  }
+  return out;
+}
+
+// A table cell: its text, one line (a line break is the cell's own <br>).
+std::string MarkdownCell(const std::string& s) {
+  std::string out;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t newline = s.find('\n', start);
+    out += MarkdownText(s.substr(start, newline == std::string::npos ? std::string::npos : newline - start));
+    if (newline == std::string::npos) break;
+    out += "<br>";
+    start = newline + 1;
   }
   return out;
 }
@@ -120,13 +159,13 @@ std::string RenderHtml(const Document& d, const std::string& directory) {
 
 std::string RenderMarkdown(const Document& d) {
   std::ostringstream o;
-  o << "# " << d.title << "\n\n";
+  o << "# " << MarkdownText(d.title) << "\n\n";
   for (const Block& b : d.blocks) {
     switch (b.kind) {
-      case Block::Kind::kHeading: o << "## " << b.text << "\n\n"; break;
-      case Block::Kind::kParagraph: o << b.text << "\n\n"; break;
+      case Block::Kind::kHeading: o << "## " << MarkdownText(b.text) << "\n\n"; break;
+      case Block::Kind::kParagraph: o << MarkdownText(b.text) << "\n\n"; break;
       case Block::Kind::kList:
-        for (const auto& item : b.items) o << "- " << item << "\n";
+        for (const auto& item : b.items) o << "- " << MarkdownText(item) << "\n";
         o << "\n";
         break;
       case Block::Kind::kTable:
@@ -143,8 +182,8 @@ std::string RenderMarkdown(const Document& d) {
         o << "\n";
         break;
       case Block::Kind::kFigure:
-        o << "![" << b.text << "](" << b.figure_stem << ".png)\n\n*" << b.text << ".* " << b.caption << " (`"
-          << b.figure_stem << ".svg`, script `" << b.figure_stem << ".gp`)\n\n";
+        o << "![" << MarkdownText(b.text) << "](" << b.figure_stem << ".png)\n\n*" << MarkdownText(b.text) << ".* "
+          << MarkdownText(b.caption) << " (`" << b.figure_stem << ".svg`, script `" << b.figure_stem << ".gp`)\n\n";
         break;
     }
   }

@@ -1,17 +1,24 @@
 #include "report/gnuplot_figure.hpp"
 
+#include <fcntl.h>
+#include <stdlib.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <stdexcept>
 
 #include "io/atomic_file.hpp"
+#include "model/input_error.hpp"
 
 namespace uphill {
 namespace {
+
+namespace fs = std::filesystem;
 
 std::string Quote(const std::string& s) {
   std::string out = "'";
@@ -19,12 +26,79 @@ std::string Quote(const std::string& s) {
   return out + "'";
 }
 
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// gnuplot does not report a full disk: it exits 0 and leaves a truncated file. So an image is
+// accepted only when it ends as its format ends: an SVG document with its closing tag, a PNG with
+// its IEND chunk (PNG specification, section 11.2.5: length 0, "IEND", CRC AE 42 60 82).
+bool CompleteSvg(const std::string& s) {
+  const auto end = s.find_last_not_of(" \t\r\n");
+  return end != std::string::npos && end >= 5 && s.compare(end - 5, 6, "</svg>") == 0;
+}
+
+bool CompletePng(const std::string& s) {
+  static const std::string signature("\x89PNG\r\n\x1a\n", 8);
+  static const std::string iend("\0\0\0\0IEND\xae\x42\x60\x82", 12);
+  return s.size() >= signature.size() + iend.size() && s.compare(0, signature.size(), signature) == 0 &&
+         s.compare(s.size() - iend.size(), iend.size(), iend) == 0;
+}
+
+// fsync of a finished file: a write error the kernel held back (a full disk with delayed
+// allocation) shows here, before the file is renamed into place.
+void SyncFile(const fs::path& path, const std::string& figure) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0 || ::fsync(fd) != 0) {
+    const int saved = errno;
+    if (fd >= 0) ::close(fd);
+    throw EnvironmentError("figure " + figure + ": " + path.filename().string() + " cannot be saved: " + std::strerror(saved));
+  }
+  ::close(fd);
+}
+
+// A private folder for gnuplot's output, removed with everything in it however RenderFigure ends.
+class RenderFolder {
+ public:
+  RenderFolder(const fs::path& dir, const std::string& name) {
+    std::string pattern = (dir / ("." + name + ".render-XXXXXX")).string();
+    if (::mkdtemp(pattern.data()) == nullptr)
+      throw EnvironmentError((dir / (name + ".svg")).string() + ": cannot create a temporary folder: " +
+                             std::strerror(errno));
+    path_ = pattern;
+  }
+  ~RenderFolder() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
 }  // namespace
 
 void RenderFigure(const GnuplotFigure& f, const std::string& directory) {
-  namespace fs = std::filesystem;
   // Absolute: the gnuplot command runs after a cd into it, and names its log by this path.
   const fs::path dir = fs::absolute(directory);
+  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd < 0) throw EnvironmentError(dir.string() + ": cannot open the folder: " + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{dir_fd};
+  // Anything but a regular file where an output goes is refused before anything is written.
+  for (const char* ext : {".dat", ".gp", ".svg", ".png"}) {
+    const fs::path target = dir / (f.name + ext);
+    const fs::file_status st = fs::symlink_status(target);
+    if (fs::exists(st) && !fs::is_regular_file(st))
+      throw EnvironmentError(target.string() + ": is " + (fs::is_directory(st) ? "a folder" : "not a regular file") +
+                             ": not replaced");
+  }
   WriteFileAtomically((dir / (f.name + ".dat")).string(), f.data);
   std::ostringstream script;
   script << "# " << f.name << ".gp: " << f.title << "\n"
@@ -44,27 +118,42 @@ void RenderFigure(const GnuplotFigure& f, const std::string& directory) {
          << "replot\n"
          << "unset output\n";
   WriteFileAtomically((dir / (f.name + ".gp")).string(), script.str());
-  const std::string svg_tmp = "." + f.name + ".svg.tmp", png_tmp = "." + f.name + ".png.tmp";
-  const std::string log = (dir / ("." + f.name + ".gnuplot.log")).string();
+
+  const RenderFolder render(dir, f.name);
+  const std::string folder = render.path().filename().string();  // our own characters only
+  const fs::path svg = render.path() / (f.name + ".svg"), png = render.path() / (f.name + ".png");
+  const fs::path log = render.path() / "gnuplot.log";
   const std::string command = "cd " + Quote(dir.string()) + " && gnuplot -e " +
-                              Quote("svg_out='" + svg_tmp + "'; png_out='" + png_tmp + "'") + " " +
-                              Quote(f.name + ".gp") + " > " + Quote(log) + " 2>&1";
+                              Quote("svg_out='" + folder + "/" + f.name + ".svg'; png_out='" + folder + "/" + f.name +
+                                    ".png'") +
+                              " " + Quote(f.name + ".gp") + " > " + Quote(log.string()) + " 2>&1";
   const int status = std::system(command.c_str());
-  std::ifstream in(log);
-  std::stringstream complaint;
-  complaint << in.rdbuf();
-  fs::remove(log);
-  const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && fs::exists(dir / svg_tmp) &&
-                  fs::exists(dir / png_tmp);
-  if (!ok) {
-    fs::remove(dir / svg_tmp);
-    fs::remove(dir / png_tmp);
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
-      throw std::runtime_error("figure " + f.name + ": gnuplot not found (install Debian's gnuplot-nox)");
-    throw std::runtime_error("figure " + f.name + ": gnuplot failed: " + complaint.str());
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
+    throw EnvironmentError("figure " + f.name + ": gnuplot not found (install Debian's gnuplot-nox)");
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    std::string complaint = Slurp(log);
+    while (!complaint.empty() && (complaint.back() == '\n' || complaint.back() == ' ')) complaint.pop_back();
+    throw EnvironmentError("figure " + f.name + ": gnuplot failed: " + complaint);
   }
-  fs::rename(dir / svg_tmp, dir / (f.name + ".svg"));
-  fs::rename(dir / png_tmp, dir / (f.name + ".png"));
+  if (!CompleteSvg(Slurp(svg)) || !CompletePng(Slurp(png)))
+    throw EnvironmentError("figure " + f.name + ": gnuplot left an incomplete image (is the disk full?) in " +
+                           dir.string() + "; the previous images, if any, are unchanged");
+  SyncFile(svg, f.name);
+  SyncFile(png, f.name);
+  const int render_fd = ::open(render.path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (render_fd < 0) throw EnvironmentError(render.path().string() + ": cannot be opened: " + std::strerror(errno));
+  try {
+    RenameIntoPlaceAt(render_fd, f.name + ".svg", dir_fd, dir.string(), f.name + ".svg");
+    RenameIntoPlaceAt(render_fd, f.name + ".png", dir_fd, dir.string(), f.name + ".png");
+  } catch (...) {
+    ::close(render_fd);
+    throw;
+  }
+  ::close(render_fd);
+}
+
+std::vector<std::string> FigureFiles(const std::string& name) {
+  return {name + ".dat", name + ".gp", name + ".svg", name + ".png"};
 }
 
 }  // namespace uphill

@@ -2,12 +2,17 @@
 // restyle it for a paper (`gnuplot NAME.gp` in the output folder rewrites NAME.svg and NAME.png).
 //
 // Files: NAME.dat (the numbers, whitespace-separated blocks, units in the comments), NAME.gp (the
-// script), NAME.svg and NAME.png. Every file is replaced atomically: the data and script by
-// WriteFileAtomically, the images by letting gnuplot write temporaries that are renamed only
-// when gnuplot succeeds, so a failed run never leaves a half-written figure.
+// script), NAME.svg and NAME.png. Every file is replaced atomically or not at all: the data and
+// script by WriteFileAtomically, the images by letting gnuplot write into a private temporary
+// folder beside them, then checking that each image is whole (gnuplot exits 0 on a full disk and
+// leaves a truncated file: an SVG must end with </svg>, a PNG with its IEND chunk), fsyncing it,
+// and renaming it into place. The temporary folder is removed however the call ends. Anything but
+// a regular file at an output's name (a folder in the way, a link, a device) is refused before
+// anything is written.
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace uphill {
 
@@ -19,8 +24,12 @@ struct GnuplotFigure {
   std::string plot;     // gnuplot commands after the preamble (set …; plot 'NAME.dat' …)
 };
 
-// Writes the four files into `directory`. Throws std::runtime_error naming the figure and
-// gnuplot's complaint when gnuplot is missing (install Debian's gnuplot-nox) or fails.
+// Writes the four files into `directory`. Throws EnvironmentError naming the figure and gnuplot's
+// complaint when gnuplot is missing (install Debian's gnuplot-nox) or fails, when an image comes
+// out incomplete, or when something is in the way.
 void RenderFigure(const GnuplotFigure& figure, const std::string& directory);
+
+// The four files RenderFigure writes for the figure `name`: NAME.dat, NAME.gp, NAME.svg, NAME.png.
+std::vector<std::string> FigureFiles(const std::string& name);
 
 }  // namespace uphill

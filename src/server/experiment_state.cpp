@@ -5,14 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 
 #include "io/csv_table.hpp"
 #include "io/experiment_folder.hpp"
 #include "io/units.hpp"
+#include "io/utf8.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill {
@@ -43,6 +42,8 @@ bool IsAngle(const std::string& key) { return key == "theta" || key == "alpha"; 
 std::string CheckText(const json& j, const std::string& field, std::size_t max_length) {
   if (!j.is_string()) throw InputError(field, "must be a string");
   const std::string s = j.get<std::string>();
+  if (InvalidUtf8At(s) != std::string_view::npos)
+    throw InputError(field, "is not valid UTF-8 text (byte " + std::to_string(InvalidUtf8At(s) + 1) + ")");
   if (s.size() > max_length)
     throw InputError(field, "is longer than " + std::to_string(max_length) + " characters");
   for (unsigned char c : s)
@@ -364,6 +365,10 @@ json ApplyOperation(ExperimentState& state, const json& op) {
 
 ExperimentState LoadStateFromFiles(const std::string& directory) {
   const ExperimentFolder folder = ReadExperimentJson(directory);
+  return StateFromFolder(folder, ReadMeasurements(folder));
+}
+
+ExperimentState StateFromFolder(const ExperimentFolder& folder, const std::optional<CsvTable>& measurements) {
   ExperimentState state;
   try {
     state.metadata = ValidateMetadata(folder.metadata);
@@ -373,7 +378,6 @@ ExperimentState LoadStateFromFiles(const std::string& directory) {
   // Keep what ValidateMetadata would drop only for being empty: the file is the authority here.
   state.metadata = Canonical(folder.metadata);
   state.exists = true;
-  const std::optional<CsvTable> measurements = ReadMeasurements(folder);
   if (!measurements) return state;
   const CsvTable& table = *measurements;
   const int y = [&] {

@@ -17,8 +17,12 @@
 #include <cstdint>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "io/csv_table.hpp"
+#include "io/experiment_folder.hpp"
 
 namespace uphill {
 
@@ -85,5 +89,9 @@ nlohmann::json ApplyOperation(ExperimentState& state, const nlohmann::json& op);
 // keep their raw text, so nothing is dropped. Throws InputError for a bad experiment.json or a
 // missing/unreadable measurements.csv header.
 ExperimentState LoadStateFromFiles(const std::string& directory);
+
+// The same from the folder's files as read by io/experiment_folder.hpp (`measurements` absent: no
+// measurements.csv yet): the store reads them itself, through a contained folder.
+ExperimentState StateFromFolder(const ExperimentFolder& folder, const std::optional<CsvTable>& measurements);
 
 }  // namespace uphill

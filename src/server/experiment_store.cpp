@@ -4,56 +4,54 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
-#include "io/atomic_file.hpp"
 #include "io/experiment_folder.hpp"
 #include "model/input_error.hpp"
+#include "server/journal.hpp"
 
 namespace uphill {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using Kind = ContainedDirectory::Kind;
 
-std::optional<std::string> ReadFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
-std::string HashOfFile(const std::string& path) {
-  const auto content = ReadFile(path);
-  return content ? ContentHash(*content) : "";
-}
-
-std::string NowUtc() {
+std::string UtcNow(const char* format) {
   const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
   std::tm tm{};
   gmtime_r(&t, &tm);
   char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  std::strftime(buf, sizeof buf, format, &tm);
   return buf;
 }
 
-[[noreturn]] void ThrowSystem(const std::string& what, const std::string& path) {
-  throw std::runtime_error(what + " " + path + ": " + std::strerror(errno));
+std::string KindName(Kind kind) {
+  switch (kind) {
+    case Kind::kDirectory: return "a folder";
+    case Kind::kLink: return "a symbolic link";
+    case Kind::kFile: return "a file";
+    default: return "not a regular file";
+  }
 }
 
-void FsyncDirectory(const std::string& directory) {
-  const int fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) ThrowSystem("open", directory);
-  const int rc = ::fsync(fd);
-  ::close(fd);
-  if (rc != 0) ThrowSystem("fsync", directory);
+void RequireWritable(const std::string& path, const std::string& shown) {
+  if (::access(path.c_str(), W_OK | X_OK) != 0)
+    throw EnvironmentError(shown + ": the folder cannot be written (" + std::strerror(errno) +
+                           "): the server saves every change there");
+}
+
+// "EXP" without trailing slashes ("EXP/" names the same folder).
+fs::path WithoutTrailingSlash(const std::string& directory) {
+  std::string s = directory;
+  while (s.size() > 1 && s.back() == '/') s.pop_back();
+  return fs::path(s);
 }
 
 }  // namespace
@@ -69,83 +67,160 @@ std::string ContentHash(const std::string& bytes) {
   return buf;
 }
 
-ExperimentStore::ExperimentStore(std::string directory) : directory_(std::move(directory)) {
-  const std::string json_path = (fs::path(directory_) / kExperimentJsonFile).string();
-  const std::string csv_path = (fs::path(directory_) / kMeasurementsCsvFile).string();
+ExperimentStore::ExperimentStore(std::string directory) {
+  if (directory.empty()) directory = ".";
+  // The folder: resolved once, checked now rather than at the first save.
+  struct stat st {};
+  if (::stat(directory.c_str(), &st) == 0) {
+    if (!S_ISDIR(st.st_mode))
+      throw EnvironmentError(directory + ": is a file, not a folder (give the experiment's folder)");
+    folder_ = std::make_unique<ContainedDirectory>(ContainedDirectory::Open(directory));
+    RequireWritable(folder_->path(), directory);
+    directory_ = folder_->path();
+  } else if (errno == ENOENT) {
+    const fs::path path = WithoutTrailingSlash(directory);
+    const std::string name = path.filename().string();
+    if (name.empty() || name == "." || name == "..") throw EnvironmentError(directory + ": does not exist");
+    const std::string parent = path.has_parent_path() ? path.parent_path().string() : ".";
+    struct stat parent_st {};
+    if (::stat(parent.c_str(), &parent_st) != 0)
+      throw EnvironmentError(directory + ": cannot be created: the folder " + parent +
+                             (errno == ENOENT ? " does not exist" : std::string(" cannot be read: ") + std::strerror(errno)));
+    if (!S_ISDIR(parent_st.st_mode))
+      throw EnvironmentError(directory + ": cannot be created: " + parent + " is not a folder");
+    parent_ = std::make_unique<ContainedDirectory>(ContainedDirectory::Open(parent));
+    RequireWritable(parent_->path(), parent);
+    directory_ = (fs::path(parent_->path()) / name).string();
+  } else if (errno == ENOTDIR) {
+    throw EnvironmentError(directory + ": a part of the path is a file, not a folder");
+  } else {
+    throw EnvironmentError(directory + ": cannot be opened: " + std::strerror(errno));
+  }
+
+  std::optional<std::string> json_text, csv_text, journal_text;
+  std::optional<JournalHead> head;
   const std::string journal_path = (fs::path(directory_) / kJournalFile).string();
-  json_hash_ = HashOfFile(json_path);
-  csv_hash_ = HashOfFile(csv_path);
+  std::string notes;  // things worth saying besides the journal's story
+  if (folder_) {
+    for (const char* name : {kExperimentJsonFile, kMeasurementsCsvFile, kJournalFile, kJournalHeadFile}) {
+      const Kind kind = folder_->KindOf(name);
+      if (kind != Kind::kAbsent && kind != Kind::kFile)
+        throw EnvironmentError((fs::path(directory_) / name).string() + ": is " + KindName(kind) +
+                               ", not a regular file: refused (the server reads and writes only regular files "
+                               "inside the experiment folder)");
+    }
+    if (const Kind report = folder_->KindOf("report"); report != Kind::kAbsent && report != Kind::kDirectory)
+      notes = "; " + (fs::path(directory_) / "report").string() + " is " + KindName(report) +
+              ": the report is neither written nor served until it is a folder";
+    json_text = folder_->ReadFile(kExperimentJsonFile, kMaxExperimentFileBytes);
+    csv_text = folder_->ReadFile(kMeasurementsCsvFile, kMaxExperimentFileBytes);
+    journal_text = folder_->ReadFile(kJournalFile, kMaxJournalBytes);
+    if (const auto text = folder_->ReadFile(kJournalHeadFile, 1 << 16)) head = ParseJournalHead(*text);
+  }
+  json_hash_ = json_text ? ContentHash(*json_text) : "";
+  csv_hash_ = csv_text ? ContentHash(*csv_text) : "";
+  const auto load_files = [&] {
+    const ExperimentFolder folder = ParseExperimentJson(directory_, *json_text);
+    std::optional<CsvTable> measurements;
+    if (csv_text) measurements = ParseMeasurements(folder, *csv_text);
+    return StateFromFolder(folder, measurements);
+  };
 
-  // The journal: complete lines only. A last line without its newline was being written when the
-  // server stopped; it was never acknowledged, so it is cut off.
-  std::vector<json> entries;
-  if (const auto text = ReadFile(journal_path)) {
-    std::size_t start = 0, good_end = 0;
-    int line = 0;
-    while (start < text->size()) {
-      const std::size_t newline = text->find('\n', start);
-      if (newline == std::string::npos) break;  // torn tail
-      ++line;
+  const JournalScan scan = ScanJournal(journal_text.value_or(""));
+  std::optional<std::string> damage = scan.damage;
+  if (!damage && head && scan.format == 2 && head->journal == scan.id && head->seq > scan.last_seq)
+    damage = "it ends at entry " + std::to_string(scan.last_seq) + " but entry " + std::to_string(head->seq) +
+             " (version " + std::to_string(head->version) + ") was acknowledged (" + kJournalHeadFile +
+             "): the journal was cut short";
+  const std::int64_t highest_version = std::max(scan.max_version, head ? head->version : std::int64_t{0});
+  need_header_ = scan.format != 2;
+  journal_id_ = scan.id;
+  seq_ = scan.last_seq;
+
+  bool replayed = false;
+  if (!damage && !scan.entries.empty()) {
+    bool consistent = !json_text;  // no files yet: the journal is all there is
+    for (std::size_t k = scan.entries.size(); k-- > 0 && !consistent;) {
+      const json& e = scan.entries[k];
+      consistent = e.value("json_hash", "") == json_hash_ &&
+                   (e.value("csv_hash", "") == csv_hash_ ||
+                    (k > 0 && scan.entries[k - 1].value("csv_hash", "") == csv_hash_));
+    }
+    if (consistent) {
       try {
-        entries.push_back(json::parse(text->begin() + start, text->begin() + newline));
-      } catch (const json::exception&) {
-        throw std::runtime_error(journal_path + ", line " + std::to_string(line) +
-                                 ": damaged (not JSON). Move the journal aside to start from the files.");
+        for (const json& e : scan.entries) {
+          const json inverse = ApplyOperation(state_, e.at("op"));
+          version_ = e.at("version").get<std::int64_t>();
+          if (e.at("op").at("type") == "snapshot" || inverse.at("type") == "snapshot") {
+            undo_.clear();
+          } else if (e.value("undo", false)) {
+            if (!undo_.empty()) undo_.pop_back();
+          } else {
+            undo_.push_back(inverse);
+            if (undo_.size() > kMaxUndo) undo_.erase(undo_.begin());
+          }
+        }
+        replayed = true;
+        need_snapshot_ = need_header_;  // a legacy journal continues as a new format-2 section
+        journal_message_ = "replayed " + std::to_string(scan.entries.size()) + " journal entries (version " +
+                           std::to_string(version_) + ")";
+      } catch (const std::exception& e) {
+        damage = std::string("an entry cannot be applied: ") + e.what();
+        state_ = ExperimentState();
+        undo_.clear();
+        version_ = 0;
       }
-      start = good_end = newline + 1;
+    } else {
+      state_ = load_files();
+      version_ = highest_version + 1;
+      need_snapshot_ = true;
+      journal_message_ = "the files were changed outside the server: they win; the journal continues with a "
+                         "snapshot of them at the next change";
     }
-    if (good_end < text->size()) {
-      if (::truncate(journal_path.c_str(), static_cast<off_t>(good_end)) != 0) ThrowSystem("truncate", journal_path);
-      recovery_note_ = "cut off an unfinished (unacknowledged) journal line; ";
+  } else if (!damage) {
+    if (json_text) {
+      state_ = load_files();
+      version_ = highest_version + 1;
+      journal_message_ = journal_text ? "opened the files (the journal holds no entries)" : "opened the files (no journal yet)";
+    } else {
+      version_ = highest_version;
+      journal_message_ = "new experiment (nothing written until it is created)";
     }
+    need_snapshot_ = true;
   }
 
-  const bool files_exist = !json_hash_.empty();
-  bool files_consistent = !files_exist;  // no files yet: the journal is all there is
-  for (std::size_t k = entries.size(); k-- > 0 && !files_consistent;) {
-    const json& e = entries[k];
-    files_consistent = e.value("json_hash", "") == json_hash_ &&
-                       (e.value("csv_hash", "") == csv_hash_ ||
-                        (k > 0 && entries[k - 1].value("csv_hash", "") == csv_hash_));
-  }
-  if (!entries.empty() && files_consistent) {
-    try {
-      if (entries.front().at("op").at("type") != "snapshot")
-        throw std::runtime_error("the first entry is not a snapshot");
-      for (const json& e : entries) {
-        const json inverse = ApplyOperation(state_, e.at("op"));
-        version_ = e.at("version").get<std::int64_t>();
-        if (e.at("op").at("type") == "snapshot" || inverse.at("type") == "snapshot") {
-          undo_.clear();
-        } else if (e.value("undo", false)) {
-          if (!undo_.empty()) undo_.pop_back();
-        } else {
-          undo_.push_back(inverse);
-          if (undo_.size() > kMaxUndo) undo_.erase(undo_.begin());
-        }
-      }
-    } catch (const std::exception& e) {
-      throw std::runtime_error(journal_path + ": cannot be replayed (" + e.what() +
-                               "). Move the journal aside to start from the files.");
+  if (damage) {
+    // Never trust it: the files are the state, and nothing is rewritten from the journal.
+    if (!json_text)
+      throw InputError(journal_path, "is damaged (" + *damage + ") and there is no " + kExperimentJsonFile +
+                                         " to fall back on: repair the journal, or move it aside to start a new "
+                                         "experiment");
+    state_ = load_files();
+    undo_.clear();
+    version_ = highest_version + 1;
+    need_snapshot_ = true;
+    journal_damaged_ = true;
+    journal_message_ = "the journal is damaged (" + *damage +
+                       "): the files were kept as they are and nothing was rewritten from the journal; the next "
+                       "change moves the journal aside and starts a new one";
+  } else {
+    if (scan.torn_tail) {
+      // A line that was being written when the server stopped: never acknowledged, cut off.
+      const int fd = folder_->OpenForAppend(kJournalFile);
+      const int rc = ::ftruncate(fd, static_cast<off_t>(scan.good_bytes));
+      const int saved = errno;
+      ::close(fd);
+      if (rc != 0) throw EnvironmentError(journal_path + ": cannot cut off an unfinished line: " + std::strerror(saved));
+      journal_message_ = "cut off an unfinished (unacknowledged) journal line (" + *scan.torn_tail + "); " + journal_message_;
     }
-    need_snapshot_ = false;
-    recovery_note_ += "replayed " + std::to_string(entries.size()) + " journal entries (version " +
-                      std::to_string(version_) + ")";
     // Bring the files up to the journal (a crash may have left them one change behind).
-    if (state_.exists &&
+    if (replayed && state_.exists &&
         (ContentHash(state_.ExperimentJson()) != json_hash_ || ContentHash(state_.MeasurementsCsv()) != csv_hash_)) {
       WriteFiles();
-      recovery_note_ += "; rewrote the files from the journal";
+      journal_message_ += "; rewrote the files from the journal (they were behind it)";
     }
-  } else if (files_exist) {
-    state_ = LoadStateFromFiles(directory_);
-    version_ = entries.empty() ? 1 : entries.back().value("version", std::int64_t{0}) + 1;
-    recovery_note_ += entries.empty() ? "opened the files (no journal yet)"
-                                      : "the files were changed outside the server: they win; the journal "
-                                        "continues with a snapshot of them at the next change";
-  } else {
-    recovery_note_ += "new experiment (nothing written until it is created)";
   }
+  recovery_note_ = journal_message_ + notes;
 }
 
 ExperimentStore::~ExperimentStore() {
@@ -159,60 +234,122 @@ StoreSnapshot ExperimentStore::Get() const {
   return SnapshotLocked();
 }
 
+const ContainedDirectory* ExperimentStore::folder() const {
+  std::lock_guard lock(mutex_);
+  return folder_.get();
+}
+
+JournalStatus ExperimentStore::journal_status() const {
+  std::lock_guard lock(mutex_);
+  return {journal_damaged_, journal_message_};
+}
+
 void ExperimentStore::CheckVersion(std::int64_t version) const {
   if (version != version_) throw VersionConflict(version, SnapshotLocked());
 }
 
-void ExperimentStore::Append(const json& entry) {
-  const std::string journal_path = (fs::path(directory_) / kJournalFile).string();
-  if (journal_fd_ < 0) {
-    fs::create_directories(directory_);
-    const bool existed = fs::exists(journal_path);
-    journal_fd_ = ::open(journal_path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
-    if (journal_fd_ < 0) ThrowSystem("open", journal_path);
-    if (!existed) FsyncDirectory(directory_);  // the new file's name must survive a crash too
+void ExperimentStore::EnsureFolder() {
+  if (folder_) return;
+  const std::string name = fs::path(directory_).filename().string();
+  folder_ = std::make_unique<ContainedDirectory>(parent_->Subdirectory(name, true));
+  parent_->Sync();  // the new folder's name survives a crash
+  parent_.reset();
+}
+
+void ExperimentStore::OpenJournalForWriting() {
+  EnsureFolder();
+  if (journal_fd_ >= 0 && !need_header_) return;
+  if (journal_damaged_) {
+    if (folder_->KindOf(kJournalFile) != Kind::kAbsent) {
+      const std::string stamp = UtcNow("%Y%m%dT%H%M%SZ");
+      std::string aside;
+      for (int n = 1;; ++n) {
+        aside = "journal.damaged-" + stamp + (n > 1 ? "-" + std::to_string(n) : "") + ".jsonl";
+        if (folder_->KindOf(aside) == Kind::kAbsent) break;
+      }
+      folder_->RenameNoReplace(kJournalFile, aside);
+      journal_message_ += "; moved the damaged journal aside to " + aside + " and started a new one";
+    }
+    journal_damaged_ = false;
+    need_header_ = true;
+    need_snapshot_ = true;
   }
-  const std::string line = entry.dump() + "\n";
+  if (journal_fd_ < 0) {
+    const bool existed = folder_->KindOf(kJournalFile) == Kind::kFile;
+    journal_fd_ = folder_->OpenForAppend(kJournalFile);
+    if (!existed) folder_->Sync();  // the new file's name must survive a crash too
+  }
+  if (need_header_) {
+    const std::string id = NewJournalId();
+    WriteRaw(JournalHeaderLine(id));
+    journal_id_ = id;
+    seq_ = 0;
+    need_header_ = false;
+    need_snapshot_ = true;
+  }
+}
+
+void ExperimentStore::WriteRaw(const std::string& line) {
+  const std::string journal_path = (fs::path(directory_) / kJournalFile).string();
   const off_t before = ::lseek(journal_fd_, 0, SEEK_END);
   std::size_t done = 0;
+  const auto fail = [&](const char* what) {
+    const int saved = errno;
+    // Cut the partial line off now; if that fails too, the next start cuts it (a torn line).
+    if (before >= 0 && ::ftruncate(journal_fd_, before) != 0) {
+    }
+    throw EnvironmentError(journal_path + ": " + what + " failed (" + std::strerror(saved) +
+                           "): the change was not saved");
+  };
   while (done < line.size()) {
     const ssize_t n = ::write(journal_fd_, line.data() + done, line.size() - done);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int saved = errno;
-      if (before >= 0 && ::ftruncate(journal_fd_, before) != 0) { /* the torn line is cut on the next start */ }
-      errno = saved;
-      ThrowSystem("write", journal_path);
-    }
+    if (n <= 0) fail("write");
     done += static_cast<std::size_t>(n);
   }
-  if (::fsync(journal_fd_) != 0) ThrowSystem("fsync", journal_path);
+  if (::fsync(journal_fd_) != 0) fail("fsync");
+}
+
+void ExperimentStore::Append(json entry) {
+  entry["seq"] = seq_ + 1;
+  WriteRaw(EncodeJournalLine(entry));
+  ++seq_;
 }
 
 void ExperimentStore::WriteFiles() {
-  fs::create_directories(directory_);
+  EnsureFolder();
   const std::string json_text = state_.ExperimentJson();
   const std::string csv_text = state_.MeasurementsCsv();
   // experiment.json first: recovery accepts a new experiment.json with the previous CSV.
   if (const std::string h = ContentHash(json_text); h != json_hash_) {
-    WriteFileAtomically((fs::path(directory_) / kExperimentJsonFile).string(), json_text);
+    folder_->WriteFileAtomically(kExperimentJsonFile, json_text);
     json_hash_ = h;
   }
   if (const std::string h = ContentHash(csv_text); h != csv_hash_) {
-    WriteFileAtomically((fs::path(directory_) / kMeasurementsCsvFile).string(), csv_text);
+    folder_->WriteFileAtomically(kMeasurementsCsvFile, csv_text);
     csv_hash_ = h;
+  }
+}
+
+void ExperimentStore::WriteHead() {
+  try {
+    folder_->WriteFileAtomically(kJournalHeadFile, EncodeJournalHead({journal_id_, seq_, version_}));
+  } catch (const EnvironmentError&) {
+    // The head only lets the next start notice a journal cut short; the change itself is saved.
   }
 }
 
 StoreSnapshot ExperimentStore::Commit(const json& op, bool undo) {
   ExperimentState next = state_;
   const json inverse = ApplyOperation(next, op);  // InputError: nothing written
+  OpenJournalForWriting();
   if (need_snapshot_) {
-    Append({{"version", version_}, {"time", NowUtc()}, {"op", {{"type", "snapshot"}, {"state", ToJson(state_)}}},
-            {"undo", false}, {"json_hash", json_hash_}, {"csv_hash", csv_hash_}});
+    Append({{"version", version_}, {"time", UtcNow("%Y-%m-%dT%H:%M:%SZ")},
+            {"op", {{"type", "snapshot"}, {"state", ToJson(state_)}}}, {"undo", false}, {"json_hash", json_hash_},
+            {"csv_hash", csv_hash_}});
     need_snapshot_ = false;
   }
-  Append({{"version", version_ + 1}, {"time", NowUtc()}, {"op", op}, {"undo", undo},
+  Append({{"version", version_ + 1}, {"time", UtcNow("%Y-%m-%dT%H:%M:%SZ")}, {"op", op}, {"undo", undo},
           {"json_hash", next.exists ? ContentHash(next.ExperimentJson()) : ""},
           {"csv_hash", next.exists ? ContentHash(next.MeasurementsCsv()) : ""}});
   state_ = std::move(next);
@@ -228,10 +365,11 @@ StoreSnapshot ExperimentStore::Commit(const json& op, bool undo) {
   try {
     WriteFiles();
   } catch (const std::exception& e) {
-    throw std::runtime_error(std::string("the change is saved in ") + kJournalFile +
-                             " but the experiment files could not be replaced (" + e.what() +
-                             "); they are rewritten at the next change or restart");
+    throw EnvironmentError(std::string("the change is saved in ") + kJournalFile +
+                           " but the experiment files could not be replaced (" + e.what() +
+                           "); they are rewritten at the next change or restart");
   }
+  WriteHead();
   return SnapshotLocked();
 }
 

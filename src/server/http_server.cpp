@@ -1,20 +1,20 @@
 #include "server/http_server.hpp"
 
-#include <sys/stat.h>
-
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
-#include <fstream>
 #include <regex>
-#include <sstream>
 
+#include "io/contained_directory.hpp"
 #include "io/experiment.hpp"
+#include "io/utf8.hpp"
 #include "model/input_error.hpp"
 #include "report/analysis.hpp"
 #include "report/fit_document.hpp"
 #include "internal/page_assets.hpp"
 #include "server/row_check.hpp"
-// Last: it includes <resolv.h>, whose `_res` macro breaks Eigen (a parameter of that name).
-#include <httplib.h>
+// Last: it includes <httplib.h>, which includes <resolv.h>, whose `_res` macro breaks Eigen.
+#include "internal/bounded_http_server.hpp"
 
 namespace uphill {
 namespace {
@@ -22,6 +22,8 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 using nlohmann::ordered_json;
+
+constexpr std::size_t kMaxReportFileBytes = 64u << 20;
 
 constexpr const char* kPagePolicy =
     "default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self'; connect-src 'self'; "
@@ -40,7 +42,9 @@ void SecurityHeaders(httplib::Response& res) {
 
 void SendJson(httplib::Response& res, int status, const ordered_json& body) {
   res.status = status;
-  res.set_content(body.dump(), "application/json; charset=utf-8");
+  // Text that is not UTF-8 never gets this far (422 naming the field); `replace` keeps an answer
+  // an answer even if some did.
+  res.set_content(body.dump(-1, ' ', false, ordered_json::error_handler_t::replace), "application/json; charset=utf-8");
 }
 
 void SendError(httplib::Response& res, int status, const std::string& message, const std::string& field = "") {
@@ -50,13 +54,55 @@ void SendError(httplib::Response& res, int status, const std::string& message, c
 }
 
 // A request body as JSON. Nesting is bounded: no request of the page is deeper than 4.
+// Marks a byte that is not UTF-8 while the field holding it is looked for: U+FDD0, a
+// noncharacter that no keyboard produces.
+constexpr std::string_view kBadByteMark = "\xEF\xB7\x90";
+
+// The path of the first key or string value that contains the mark, as the API names fields
+// ("row.note", "experiment.body.a"), or "" if none.
+std::string MarkedField(const json& j, const std::string& path) {
+  const auto marked = [](const std::string& s) { return s.find(kBadByteMark) != std::string::npos; };
+  if (j.is_string()) return marked(j.get_ref<const std::string&>()) ? path : "";
+  if (j.is_object())
+    for (const auto& [key, value] : j.items()) {
+      const std::string inner = path.empty() ? key : path + "." + key;
+      if (marked(key)) return inner;
+      if (std::string found = MarkedField(value, inner); !found.empty()) return found;
+    }
+  if (j.is_array())
+    for (std::size_t i = 0; i < j.size(); ++i)
+      if (std::string found = MarkedField(j[i], path + "[" + std::to_string(i) + "]"); !found.empty()) return found;
+  return "";
+}
+
+const json::parser_callback_t kDepthLimit = [](int depth, json::parse_event_t, json&) {
+  if (depth > 16) throw InputError("request", "JSON nested too deeply");
+  return true;
+};
+
+// Text that is not UTF-8 (a Latin-1 paste, a broken client) is refused naming the field that
+// holds it, which JSON's own parser cannot do: the bad bytes are marked, the marked document is
+// parsed, and the field with the mark is named.
+[[noreturn]] void RefuseNotUtf8(const std::string& body) {
+  std::string marked;
+  std::string_view rest = body;
+  for (std::size_t bad; (bad = InvalidUtf8At(rest)) != std::string_view::npos;) {
+    marked.append(rest.substr(0, bad)).append(kBadByteMark);
+    rest.remove_prefix(bad + 1);
+  }
+  marked.append(rest);
+  const json j = json::parse(marked, nullptr, false);
+  std::string field = j.is_discarded() ? "" : MarkedField(j, "");
+  if (field.empty()) field = "request";
+  // The key itself may be the bad text: name it with the mark shown as U+FFFD.
+  for (std::size_t at; (at = field.find(kBadByteMark)) != std::string::npos;) field.replace(at, kBadByteMark.size(), "\xEF\xBF\xBD");
+  throw InputError(field.substr(0, 96), "is not valid UTF-8 text (the page sends UTF-8: retype or paste it again)");
+}
+
 json ParseBody(const httplib::Request& req) {
   if (req.body.empty()) return json::object();
-  const json::parser_callback_t depth_limit = [](int depth, json::parse_event_t, json&) {
-    if (depth > 16) throw InputError("request", "JSON nested too deeply");
-    return true;
-  };
-  return json::parse(req.body, depth_limit);
+  if (InvalidUtf8At(req.body) != std::string_view::npos) RefuseNotUtf8(req.body);
+  return json::parse(req.body, kDepthLimit);
 }
 
 std::int64_t VersionOf(const json& body) {
@@ -70,6 +116,20 @@ bool ValidReportName(const std::string& name) {
   return std::regex_match(name, ok) && name.find("..") == std::string::npos;
 }
 
+// "application/json", optionally with "; charset=utf-8": the only body the API reads. Anything
+// else, "application/jsonx" or "text/plain" included, is refused (a cross-site form cannot send
+// this type without a CORS preflight, which this server never grants).
+bool IsJsonContentType(const std::string& value) {
+  std::string v;
+  for (char c : value)
+    if (c != ' ' && c != '\t') v += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return v == "application/json" || v == "application/json;charset=utf-8";
+}
+
+// Headers whose meaning is lost when they are sent twice (which Host decides the origin check,
+// which length the body has): a request with two of them is refused.
+constexpr const char* kSingleHeaders[] = {"Host", "Origin", "Content-Type", "Content-Length", "Transfer-Encoding"};
+
 std::string ContentType(const std::string& name) {
   const std::string ext = fs::path(name).extension().string();
   if (ext == ".html") return "text/html; charset=utf-8";
@@ -79,24 +139,52 @@ std::string ContentType(const std::string& name) {
   return "text/plain; charset=utf-8";  // .md, .gp, .dat, anything else: shown, never run
 }
 
+internal::ConnectionLimits Limits(const ServerOptions& options) {
+  internal::ConnectionLimits limits;
+  limits.request_budget_bytes = options.max_request_bytes + 32 * 1024;  // the body and its headers
+  limits.request_deadline = options.request_deadline;
+  limits.idle_timeout = options.idle_timeout;
+  limits.max_connections = options.max_connections;
+  return limits;
+}
+
+// Refuses a request before its body is read, and closes the connection (the unread body must not
+// be taken for the next request).
+httplib::Server::HandlerResponse Refuse(httplib::Response& res, int status, const std::string& message) {
+  SendError(res, status, message);
+  SecurityHeaders(res);
+  res.set_header("Connection", "close");
+  internal::BoundedHttpServer::CloseAfterResponse();
+  return httplib::Server::HandlerResponse::Handled;
+}
+
 }  // namespace
 
 struct Server::Impl {
   ServerOptions options;
   ExperimentStore store;
-  httplib::Server http;
+  internal::BoundedHttpServer http;
   int port = 0;
   std::mutex report_mutex;
 
-  explicit Impl(ServerOptions o) : options(std::move(o)), store(options.directory) {}
+  explicit Impl(ServerOptions o) : options(std::move(o)), store(options.directory), http(Limits(options)) {}
 
-  std::string ReportDirectory() const { return (fs::path(options.directory) / "report").string(); }
+  // Whether EXP/report/report.html is there (a regular file, reached without links).
+  bool ReportExists() const {
+    const ContainedDirectory* folder = store.folder();
+    if (!folder) return false;
+    try {
+      return folder->KindOf("report/report.html") == ContainedDirectory::Kind::kFile;
+    } catch (const std::exception&) {
+      return false;
+    }
+  }
 
   ordered_json StateJson(const StoreSnapshot& s) const {
     ordered_json j;
     j["version"] = s.version;
     j["can_undo"] = s.can_undo;
-    j["directory"] = fs::absolute(options.directory).string();
+    j["directory"] = store.directory();
     j["exists"] = s.state.exists;
     j["experiment"] = s.state.metadata.is_object() ? s.state.metadata : ordered_json::object();
     j["unit"] = s.state.unit;
@@ -111,8 +199,10 @@ struct Server::Impl {
       j["rows"].push_back(row);
     }
     j["fit"] = checked["fit"];
-    const bool report = fs::exists(fs::path(ReportDirectory()) / "report.html");
+    const bool report = ReportExists();
     j["report"] = {{"exists", report}, {"url", report ? json("/report/report.html") : json(nullptr)}};
+    const JournalStatus journal = store.journal_status();
+    j["journal"] = {{"status", journal.damaged ? "damaged" : "ok"}, {"message", journal.message}};
     return j;
   }
 
@@ -130,8 +220,10 @@ struct Server::Impl {
       SendError(res, 400, std::string("malformed JSON: ") + e.what());
     } catch (const std::invalid_argument& e) {
       SendError(res, 400, e.what());
+    } catch (const EnvironmentError& e) {
+      SendError(res, 500, e.what());  // the server's disk or folder, not the request
     } catch (const std::exception& e) {
-      SendError(res, 500, e.what());
+      SendError(res, 500, std::string("internal error: ") + e.what());
     }
   }
 
@@ -147,36 +239,48 @@ struct Server::Impl {
 
   void Routes() {
     http.set_payload_max_length(options.max_request_bytes);
-    http.set_read_timeout(10, 0);
-    http.set_write_timeout(10, 0);
-    http.set_keep_alive_timeout(5);
 
+    // Every request, before its body is read: the headers that decide how it is read and whom it
+    // comes from must be there once, the body must have a length, and it must come from here.
     http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-      if (!AllowedHost(req)) {
-        SendError(res, 403, "Host header must be this server's loopback address");
-        SecurityHeaders(res);
-        return httplib::Server::HandlerResponse::Handled;
-      }
+      for (const char* name : kSingleHeaders)
+        if (req.get_header_value_count(name) > 1)
+          return Refuse(res, 400, std::string("the ") + name + " header is given more than once: refused");
+      if (req.has_header("Transfer-Encoding"))
+        return Refuse(res, 411, "send the body with a Content-Length (Transfer-Encoding is refused)");
+      if (!AllowedHost(req)) return Refuse(res, 403, "Host header must be this server's loopback address");
       if (req.method != "GET" && req.method != "HEAD") {
         const std::string origin = req.get_header_value("Origin");
-        if (!origin.empty() && origin != "http://" + req.get_header_value("Host")) {
-          SendError(res, 403, "cross-origin change refused");
-          SecurityHeaders(res);
-          return httplib::Server::HandlerResponse::Handled;
-        }
-        if (req.get_header_value("Content-Type").rfind("application/json", 0) != 0) {
-          SendError(res, 415, "changes must be sent as application/json");
-          SecurityHeaders(res);
-          return httplib::Server::HandlerResponse::Handled;
-        }
+        if (!origin.empty() && origin != "http://" + req.get_header_value("Host"))
+          return Refuse(res, 403, "cross-origin change refused");
+        if (!IsJsonContentType(req.get_header_value("Content-Type")))
+          return Refuse(res, 415, "changes must be sent as application/json");
       }
       return httplib::Server::HandlerResponse::Unhandled;
     });
     http.set_post_routing_handler([](const httplib::Request&, httplib::Response& res) { SecurityHeaders(res); });
-    http.set_error_handler([](const httplib::Request&, httplib::Response& res) {
+    http.set_error_handler([this](const httplib::Request&, httplib::Response& res) {
+      if (internal::BoundedHttpServer::RequestOverBudget()) {
+        res.status = 413;
+        res.body.clear();
+      } else if (internal::BoundedHttpServer::RequestTimedOut()) {
+        res.status = 408;
+        res.body.clear();
+      }
       if (res.body.empty()) {
-        const std::string message = res.status == 413 ? "request too large" : res.status == 404 ? "not found" : "error";
+        const std::string message =
+            res.status == 413 ? "request too large (at most " + std::to_string(options.max_request_bytes / 1024) + " KiB)"
+            : res.status == 408 ? "request not received in time"
+            : res.status == 404 ? "not found"
+            : res.status == 400 ? "malformed request"
+                                : "error";
         SendError(res, res.status, message);
+      }
+      // A request that was refused before its body was read, or could not be read: the rest of
+      // the connection cannot be trusted to start a new request.
+      if (res.status == 400 || res.status == 408 || res.status == 411 || res.status == 413 || res.status == 414) {
+        res.set_header("Connection", "close");
+        internal::BoundedHttpServer::CloseAfterResponse();
       }
       SecurityHeaders(res);
     });
@@ -258,24 +362,14 @@ struct Server::Impl {
         SendError(res, 422, e.what(), e.quantity());
       } catch (const json::exception& e) {
         SendError(res, 400, std::string("malformed JSON: ") + e.what());
+      } catch (const std::invalid_argument& e) {
+        SendError(res, 400, e.what());
       }
     });
     http.Post("/api/report", [this](const httplib::Request&, httplib::Response& res) {
       std::lock_guard lock(report_mutex);  // one report at a time; the store stays free meanwhile
       try {
-        const Experiment experiment = LoadExperiment(options.directory);
-        AnalysisOptions analysis_options;
-        analysis_options.mc_trials = options.report_mc_trials;
-        const ExperimentAnalysis analysis = AnalyseExperiment(experiment, analysis_options);
-        WriteFitReport(analysis, ReportDirectory());
-        ordered_json files = ordered_json::array();
-        std::vector<std::string> names;
-        for (const auto& entry : fs::directory_iterator(ReportDirectory()))
-          if (entry.is_regular_file() && ValidReportName(entry.path().filename().string()))
-            names.push_back(entry.path().filename().string());
-        std::sort(names.begin(), names.end());
-        for (const auto& n : names) files.push_back(n);
-        SendJson(res, 200, {{"url", "/report/report.html"}, {"files", files}});
+        WriteReport(res);
       } catch (const InputError& e) {
         SendError(res, 422, e.what(), e.quantity());
       } catch (const std::exception& e) {
@@ -288,18 +382,71 @@ struct Server::Impl {
         SendError(res, 403, "refused: report files are served by plain name only");
         return;
       }
-      const std::string path = (fs::path(ReportDirectory()) / name).string();
-      struct stat st {};
-      if (::lstat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {  // no symlinks out of the folder
-        SendError(res, 404, "no such report file: " + name);
+      const ContainedDirectory* folder = store.folder();
+      try {
+        const std::string relative = "report/" + name;
+        const auto kind = folder ? folder->KindOf(relative) : ContainedDirectory::Kind::kAbsent;
+        if (kind == ContainedDirectory::Kind::kAbsent) {
+          SendError(res, 404, "no such report file: " + name);
+          return;
+        }
+        if (kind != ContainedDirectory::Kind::kFile) {
+          SendError(res, 403, "refused: " + name + " is not a regular file of the report folder");
+          return;
+        }
+        const auto content = folder->ReadFile(relative, kMaxReportFileBytes);
+        if (!content) {
+          SendError(res, 404, "no such report file: " + name);
+          return;
+        }
+        res.set_header("Content-Security-Policy", kReportPolicy);
+        res.set_content(*content, ContentType(name));
+      } catch (const EnvironmentError& e) {
+        // A link at report/ or at the file: nothing outside the experiment folder is served.
+        SendError(res, 403, std::string("refused: ") + e.what());
+      }
+    });
+  }
+
+  // The fit report of the files as they are, written into a private staging folder inside the
+  // experiment and then moved, file by file, into EXP/report/ (a real folder, never a link).
+  void WriteReport(httplib::Response& res) {
+    const ContainedDirectory* folder = store.folder();
+    if (!folder) throw InputError("experiment", "does not exist yet: create it first");
+    using Kind = ContainedDirectory::Kind;
+    for (const char* name : {"experiment.json", "measurements.csv"})
+      if (const Kind kind = folder->KindOf(name); kind != Kind::kFile && kind != Kind::kAbsent) {
+        SendError(res, 403, std::string("refused: ") + name + " is not a regular file of the experiment folder");
         return;
       }
-      std::ifstream in(path, std::ios::binary);
-      std::stringstream content;
-      content << in.rdbuf();
-      res.set_header("Content-Security-Policy", kReportPolicy);
-      res.set_content(content.str(), ContentType(name));
-    });
+    if (const Kind kind = folder->KindOf("report"); kind != Kind::kAbsent && kind != Kind::kDirectory) {
+      SendError(res, 403, "refused: " + (fs::path(store.directory()) / "report").string() +
+                              " is not a folder (a symbolic link or a file): the report is written only inside "
+                              "the experiment folder");
+      return;
+    }
+    const Experiment experiment = LoadExperiment(store.directory());
+    AnalysisOptions analysis_options;
+    analysis_options.mc_trials = options.report_mc_trials;
+    const ExperimentAnalysis analysis = AnalyseExperiment(experiment, analysis_options);
+    ContainedDirectory staging = folder->MakeStagingDirectory(".report-staging-");
+    std::vector<std::string> names;
+    try {
+      WriteFitReport(analysis, staging.path());
+      const ContainedDirectory target = folder->Subdirectory("report", true);
+      for (const std::string& name : staging.RegularFiles()) {
+        if (!ValidReportName(name)) continue;
+        staging.MoveFile(name, target, name);
+        names.push_back(name);
+      }
+    } catch (...) {
+      ContainedDirectory::RemoveStaging(*folder, std::move(staging));
+      throw;
+    }
+    ContainedDirectory::RemoveStaging(*folder, std::move(staging));
+    ordered_json files = ordered_json::array();
+    for (const auto& n : names) files.push_back(n);
+    SendJson(res, 200, {{"url", "/report/report.html"}, {"files", files}});
   }
 };
 
@@ -310,13 +457,15 @@ Server::~Server() { Stop(); }
 int Server::Bind() {
   if (impl_->options.port == 0) {
     impl_->port = impl_->http.bind_to_any_port(impl_->options.host);
-    if (impl_->port <= 0) throw std::runtime_error("cannot listen on " + impl_->options.host);
+    if (impl_->port <= 0) throw EnvironmentError("--host " + impl_->options.host + ": cannot listen on this address");
   } else {
     if (!impl_->http.bind_to_port(impl_->options.host, impl_->options.port))
-      throw std::runtime_error("cannot listen on " + impl_->options.host + ":" + std::to_string(impl_->options.port) +
-                               " (in use? try --port 0 for any free port)");
+      throw EnvironmentError("--port " + std::to_string(impl_->options.port) + ": cannot listen on " +
+                             impl_->options.host + ":" + std::to_string(impl_->options.port) +
+                             " (the port is in use, or the address is not this computer's; --port 0 picks a free one)");
     impl_->port = impl_->options.port;
   }
+  impl_->http.WidenBacklog();
   return impl_->port;
 }
 

@@ -13,18 +13,27 @@
 //   GET    /report/<name>                 a file of EXP/report/, read-only
 // The state: {version, can_undo, directory, exists, experiment, unit, columns, rows:[{id, trial,
 // series, L, H, D, Y, u_*, note, check:{theta_deg, alpha_deg, x, u_x, x_max, crossbar, y,
-// residual, flags:[{code, field, message, severity}]}}], fit:{...}, report:{exists, url}}.
-// Errors: {error, field?}: 400 malformed JSON or missing version, 403 a request from another
-// origin or host, or a refused report name, 404, 409 a stale version ({error, state}: the
-// current state), 413 a request over max_request_bytes, 422 content that breaks a rule, 500.
+// residual, flags:[{code, field, message, severity}]}}], fit:{...}, report:{exists, url},
+// journal:{status: "ok"|"damaged", message}}.
+// Errors: {error, field?}: 400 malformed JSON, a missing version, a header given twice or a
+// request that cannot be parsed; 403 a request from another origin or host, a refused report
+// name, or a link or non-regular file where the report lives; 404; 408 a request that did not
+// arrive within the deadline; 409 a stale version ({error, state}: the current state); 411 a body
+// without Content-Length (chunked); 413 a request over max_request_bytes; 415 a body that is not
+// exactly application/json; 422 content that breaks a rule (text that is not UTF-8 included),
+// naming the field; 500 the server's own folder or disk failed.
 //
-// Security: by default bound to 127.0.0.1; the Host header must name the loopback address (no
-// DNS rebinding); changes need Content-Type application/json and, if the browser sends Origin,
-// this server's own origin (no cross-site requests); every response carries a strict
-// Content-Security-Policy (scripts and styles only from this server, no inline code), and the page
-// inserts user text with textContent only.
+// Security (docs/serve.md, "What the server promises", says what is promised and what is not): by default bound to
+// 127.0.0.1; the Host header must name the loopback address (no DNS rebinding); changes need
+// Content-Type application/json and, if the browser sends Origin, this server's own origin (no
+// cross-site requests); every response carries a strict Content-Security-Policy (scripts and
+// styles only from this server, no inline code), and the page inserts user text with textContent
+// only. Files are read and written only inside the experiment folder, never through a link
+// (io/contained_directory.hpp); every request is bounded in bytes and time and idle connections
+// hold no one up (internal/bounded_http_server.hpp).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -37,19 +46,26 @@ struct ServerOptions {
   std::string directory;               // the experiment folder (created with the experiment)
   std::string host = "127.0.0.1";
   int port = 8080;                     // 0: any free port (Bind returns it)
-  std::size_t max_request_bytes = 64 * 1024;
+  std::size_t max_request_bytes = 64 * 1024;  // a request's body; its headers get 32 KiB more
   std::uint64_t report_mc_trials = 10000;  // per row, for u(X) by Monte Carlo in the report
+  // A request must arrive whole within request_deadline; a connection idle for idle_timeout is
+  // closed; at most max_connections are served at once (one thread each).
+  std::chrono::milliseconds request_deadline{10000};
+  std::chrono::milliseconds idle_timeout{5000};
+  std::size_t max_connections = 128;
 };
 
 class Server {
  public:
-  // Opens the experiment (ExperimentStore: may throw).
+  // Opens the experiment (ExperimentStore: checks the folder and may throw EnvironmentError or
+  // InputError before anything listens).
   explicit Server(ServerOptions options);
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
 
-  // Binds and listens; returns the port. Throws std::runtime_error if the address is taken.
+  // Binds and listens; returns the port. Throws EnvironmentError naming the port when it is taken
+  // (never shared: no SO_REUSEPORT) or the address is not this computer's.
   int Bind();
   // Serves until Stop() (from another thread). Call after Bind.
   void Run();

@@ -124,7 +124,7 @@ FieldSource MakeSource(const ExperimentState& state, const Row& row, const std::
     if (body.contains(name)) return FieldSource::Field{text(body.at(name)), ""};
     if (apparatus.contains(name)) return FieldSource::Field{text(apparatus.at(name)), ""};
     if (name.rfind("u_", 0) == 0 && defaults.contains(name.substr(2)))
-      return FieldSource::Field{text(defaults.at(name.substr(2))), ""};
+      return FieldSource::Field{text(defaults.at(name.substr(2))), "", true};
     return std::nullopt;
   };
   source.context = [=](const std::string& name) -> std::string {

@@ -1,4 +1,5 @@
 // uphill: analysis toolkit for the "rolling uphill" rail apparatus. See README.md.
+#include <filesystem>
 #include <iostream>
 
 #include "commands.hpp"
@@ -32,15 +33,30 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // One line, like every other refusal (CLI11's own adds "Run with --help …").
+    std::string message = e.what();
+    if (argc > 1 && argv[1][0] != '-' && dynamic_cast<const CLI::RequiredError*>(&e) != nullptr &&
+        app.get_subcommands().empty()) {
+      std::string names;
+      for (const CLI::App* sub : app.get_subcommands({}))
+        if (!sub->get_name().empty()) names += (names.empty() ? "" : ", ") + sub->get_name();
+      message = std::string(argv[1]) + ": no such command (the commands: " + names + ")";
+    }
+    std::cerr << "uphill: " << message << " (uphill --help lists the flags)\n";
+    return 2;
   } catch (const uphill::InputError& e) {
     std::cerr << "uphill: " << e.what() << "\n";
     return 2;
-  } catch (const std::runtime_error& e) {
-    // Environment problems (a file that cannot be written, gnuplot missing): not a bug.
+  } catch (const uphill::EnvironmentError& e) {
+    // The computer refused (a file that cannot be written, gnuplot missing, a port in use): the
+    // user's to fix, not a bug.
     std::cerr << "uphill: " << e.what() << "\n";
-    return 1;
+    return 2;
+  } catch (const std::filesystem::filesystem_error& e) {
+    std::cerr << "uphill: " << (e.path1().empty() ? std::string() : e.path1().string() + ": ") << e.code().message()
+              << "\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "uphill: internal error: " << e.what() << "\n";
     return 1;

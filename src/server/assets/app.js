@@ -126,6 +126,15 @@ function applyState(state, fillForm) {
   renderPlot();
   renderFit();
   renderReport();
+  renderJournal();
+}
+
+// A journal the server could not trust: it kept the files and says what it found.
+function renderJournal() {
+  const warning = $('journal-warning');
+  const damaged = S.journal && S.journal.status === 'damaged';
+  warning.hidden = !damaged;
+  warning.textContent = damaged ? 'Journal: ' + S.journal.message : '';
 }
 
 function summary() {

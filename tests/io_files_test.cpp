@@ -1,0 +1,108 @@
+// Writing files safely (src/io/atomic_file.hpp, contained_directory.hpp): only regular files are
+// ever replaced, a failed write leaves the target as it was, and a contained folder never follows
+// a link at any level nor lets "..", "." or an absolute path out. Truth: the file system's own
+// answer (lstat, the bytes) before and after each call.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "io/atomic_file.hpp"
+#include "io/contained_directory.hpp"
+#include "model/input_error.hpp"
+#include "file_test_support.hpp"
+
+namespace uphill {
+namespace {
+
+namespace fs = std::filesystem;
+
+using uphill::testing::FreshFolder;
+const auto Slurp = uphill::testing::ReadBytes;
+
+TEST(AtomicFile, ReplacesARegularFileAndLeavesNoTemporary) {
+  const fs::path dir = FreshFolder("replace");
+  std::ofstream(dir / "a.txt") << "old";
+  WriteFileAtomically((dir / "a.txt").string(), "new content\n");
+  EXPECT_EQ(Slurp(dir / "a.txt"), "new content\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+  fs::remove_all(dir);
+}
+
+TEST(AtomicFile, NeverReplacesAFolderALinkAPipeOrADevice) {
+  const fs::path dir = FreshFolder("obstacles");
+  fs::create_directories(dir / "folder");
+  std::ofstream(dir / "target") << "keep";
+  fs::create_symlink(dir / "target", dir / "link");
+  ASSERT_EQ(::mkfifo((dir / "pipe").c_str(), 0644), 0);
+  for (const char* name : {"folder", "link", "pipe"}) {
+    try {
+      WriteFileAtomically((dir / name).string(), "x");
+      ADD_FAILURE() << name << " was replaced";
+    } catch (const EnvironmentError& e) {
+      EXPECT_NE(std::string(e.what()).find("not replaced"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(fs::is_directory(fs::symlink_status(dir / "folder")));
+  EXPECT_TRUE(fs::is_symlink(dir / "link"));
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(dir / "pipe")));
+  EXPECT_EQ(Slurp(dir / "target"), "keep");
+  // A device node (the issue's /dev/full, which made a regular file of itself as root).
+  EXPECT_THROW(WriteFileAtomically("/dev/full", "x"), EnvironmentError);
+  EXPECT_TRUE(fs::is_character_file("/dev/full"));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 4);  // no temporaries
+  fs::remove_all(dir);
+}
+
+TEST(AtomicFile, AMissingFolderIsNamed) {
+  try {
+    WriteFileAtomically("/nonexistent-uphill/x/out.json", "x");
+    ADD_FAILURE();
+  } catch (const EnvironmentError& e) {
+    EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ContainedDirectory, ReadsAndWritesInsideAndRefusesLinksAtAnyLevel) {
+  const fs::path root = FreshFolder("contained");
+  const fs::path outside = FreshFolder("contained-outside");
+  std::ofstream(outside / "secret") << "secret";
+  fs::create_directories(root / "sub");
+  std::ofstream(root / "sub" / "file") << "inside";
+  fs::create_directory_symlink(outside, root / "linked-folder");
+  fs::create_symlink(outside / "secret", root / "sub" / "linked-file");
+  const ContainedDirectory dir = ContainedDirectory::Open(root.string());
+  EXPECT_EQ(dir.ReadFile("sub/file", 100).value_or(""), "inside");
+  EXPECT_FALSE(dir.ReadFile("sub/absent", 100).has_value());
+  EXPECT_EQ(dir.KindOf("linked-folder"), ContainedDirectory::Kind::kLink);
+  EXPECT_THROW(dir.ReadFile("linked-folder/secret", 100), EnvironmentError);
+  EXPECT_THROW(dir.ReadFile("sub/linked-file", 100), EnvironmentError);
+  EXPECT_THROW(dir.KindOf("linked-folder/secret"), EnvironmentError);
+  EXPECT_THROW(dir.WriteFileAtomically("linked-folder/new", "x"), EnvironmentError);
+  EXPECT_THROW(dir.WriteFileAtomically("sub/linked-file", "x"), EnvironmentError);
+  EXPECT_THROW(dir.Subdirectory("linked-folder", true), EnvironmentError);
+  EXPECT_THROW(dir.OpenForAppend("sub/linked-file"), EnvironmentError);
+  for (const char* bad : {"../contained-outside/secret", "/etc/passwd", "sub/../sub/file", "./sub/file", "sub//file", ""})
+    EXPECT_THROW(dir.ReadFile(bad, 100), InputError) << bad;
+  EXPECT_EQ(Slurp(outside / "secret"), "secret");
+  EXPECT_EQ(std::distance(fs::directory_iterator(outside), fs::directory_iterator()), 1);
+  EXPECT_THROW(dir.ReadFile("sub/file", 3), EnvironmentError);  // over the size limit
+  // Writing inside: atomic, and a staging folder comes and goes.
+  dir.WriteFileAtomically("sub/new", "made");
+  EXPECT_EQ(Slurp(root / "sub" / "new"), "made");
+  ContainedDirectory staging = dir.MakeStagingDirectory(".stage-");
+  staging.WriteFileAtomically("f", "staged");
+  const ContainedDirectory target = dir.Subdirectory("made/deeper", true);
+  staging.MoveFile("f", target, "f");
+  ContainedDirectory::RemoveStaging(dir, std::move(staging));
+  EXPECT_EQ(Slurp(root / "made" / "deeper" / "f"), "staged");
+  for (const auto& e : fs::directory_iterator(root)) EXPECT_NE(e.path().filename().string().rfind(".stage-", 0), 0u);
+  fs::remove_all(root);
+  fs::remove_all(outside);
+}
+
+}  // namespace
+}  // namespace uphill
