@@ -198,7 +198,7 @@ TEST(XyTable, NamesEveryBadRowAtOnceAndMapsReadRowsToSpreadsheetRows) {
   EXPECT_EQ(t.RowOf(2), 6);
   EXPECT_EQ(t.RowOf(3), 8);
   EXPECT_EQ(t.Locate("u(Y)[2]"), "d.csv, row 6, column uY");
-  EXPECT_EQ(t.Locate("X"), "X");
+  EXPECT_EQ(t.Locate("X"), "d.csv: X");  // a rule about the whole column still names the file
   // Without a callback the messages are kept.
   std::istringstream again("X,Y\n1,x\n");
   EXPECT_EQ(ReadXy(again, "e.csv").row_errors, (std::vector<std::string>{"e.csv, row 2, column Y: 'x' is not a number"}));

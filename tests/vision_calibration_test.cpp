@@ -107,6 +107,19 @@ TEST_F(CameraCalibrationTest, RecoversTheIntrinsicsOfTheRenderingCamera) {
   EXPECT_EQ(summary.inputs.size(), 12u);
 }
 
+// Issue 11: the same image given 12 times counted as 12 views. A view that is pixel for pixel an
+// earlier one (the same file twice, or a copy) is refused, naming both.
+TEST_F(CameraCalibrationTest, TheSameImageTwiceIsRefused) {
+  std::vector<NamedImage> images = Named();
+  images.push_back({"copy_of_view3.png", images[3].image.clone()});
+  const std::string message = InputErrorOf([&] { CalibrateCamera(images, kTarget); });
+  EXPECT_NE(message.find("copy_of_view3.png: is the same image as view3.png"), std::string::npos) << message;
+  std::vector<NamedImage> twelve(12, images[0]);
+  for (size_t i = 0; i < twelve.size(); ++i) twelve[i].name = "shot" + std::to_string(i) + ".png";
+  EXPECT_NE(InputErrorOf([&] { CalibrateCamera(twelve, kTarget); }).find("shot1.png: is the same image as shot0.png"),
+            std::string::npos);
+}
+
 TEST_F(CameraCalibrationTest, ImagesWithoutABoardAreRejectedAndNamed) {
   std::vector<NamedImage> images = Named();
   images.resize(10);
@@ -119,10 +132,12 @@ TEST_F(CameraCalibrationTest, ImagesWithoutABoardAreRejectedAndNamed) {
   EXPECT_NE(result.views.back().rejected_because.find("not found"), std::string::npos);
   EXPECT_NE(result.Summary(kTarget).inputs.back().find("empty_table.png: rejected"), std::string::npos);
 
-  // No board anywhere: a clear error naming the files.
-  const cv::Mat small_blank = blank(cv::Rect(0, 0, 320, 240));
+  // No board anywhere: a clear error naming the files (three different pictures of nothing).
   const std::string message = InputErrorOf([&] {
-    CalibrateCamera({{"a.png", small_blank}, {"b.png", small_blank}, {"c.png", small_blank}}, kTarget);
+    CalibrateCamera({{"a.png", blank(cv::Rect(0, 0, 320, 240))},
+                     {"b.png", blank(cv::Rect(320, 0, 320, 240))},
+                     {"c.png", blank(cv::Rect(640, 0, 320, 240))}},
+                    kTarget);
   });
   EXPECT_NE(message.find("found in only 0 of 3"), std::string::npos) << message;
   EXPECT_NE(message.find("a.png, b.png, c.png"), std::string::npos) << message;
@@ -224,7 +239,37 @@ TEST(SceneCalibration, AMisreadPointShowsInTheVerdict) {
   EXPECT_EQ(r.verdict, "poor");
   std::string reasons;
   for (const auto& s : r.reasons) reasons += s + "\n";
-  EXPECT_NE(reasons.find("row 8: residual"), std::string::npos) << reasons;
+  EXPECT_NE(reasons.find("row 8: "), std::string::npos) << reasons;
+  EXPECT_EQ(reasons.find("row 7: "), std::string::npos) << reasons;
+  EXPECT_EQ(reasons.find("row 9: "), std::string::npos) << reasons;
+}
+
+// Issue 11: a wrong row 3 was blamed on row 2, because the misfit pulls the full fit toward
+// itself. Whichever row is mistyped (a pixel or a coordinate), that row, and only it, is named:
+// in the verdict, or in the refusal when the mistake puts another point behind the camera.
+TEST(SceneCalibration, TheMistypedRowIsTheOneNamed) {
+  const CameraIntrinsics camera = TrueCamera();
+  for (size_t wrong = 0; wrong < ApparatusPoints().size(); ++wrong)
+    for (int kind = 0; kind < 2; ++kind) {
+      std::vector<ScenePoint> points = Observe(camera, LabPose(), ApparatusPoints(), 0.2, 7);
+      if (kind == 0) points[wrong].pixel += Eigen::Vector2d(-40, 30);  // a misread pixel
+      else points[wrong].position.x() += points[wrong].position.x() > 0.5 ? -0.4 : 0.4;  // a mistyped x
+      const std::string named = "row " + std::to_string(wrong + 2);
+      std::string said;
+      try {
+        const SceneCalibrationResult r = CalibrateScene(camera, points);
+        EXPECT_EQ(r.verdict, "poor") << named;
+        for (const auto& reason : r.reasons) said += reason + "\n";
+      } catch (const InputError& e) {
+        said = e.what();
+      }
+      EXPECT_NE(said.find(named + ":"), std::string::npos) << "kind " << kind << ": " << said;
+      for (size_t other = 0; other < points.size(); ++other)
+        if (other != wrong) {
+          EXPECT_EQ(said.find("row " + std::to_string(other + 2) + ":"), std::string::npos)
+              << "kind " << kind << ", mistake in " << named << ": " << said;
+        }
+    }
 }
 
 TEST(SceneCalibration, DegenerateOrInconsistentPointsAreRefused) {

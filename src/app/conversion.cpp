@@ -65,6 +65,23 @@ std::vector<std::string> Verdict(const ConversionResult& r, const ConversionOpti
     out.push_back("With mu = " + Printf("%g", *options.mu) + " it stays at rest from " + from + " to " +
                   Length(r.rest->high, unit) + " (Y, the farthest rest position).");
   }
+  if (r.propagation && r.propagation->rejected.total() > 0) {
+    const RejectedTrials& k = r.propagation->rejected;
+    std::string reasons;
+    const auto reason = [&](std::uint64_t n, const char* what) {
+      if (n > 0) reasons += (reasons.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+    };
+    reason(k.non_positive_length, "a length <= 0");
+    reason(k.negative_height, "a height H < 0");
+    reason(k.angle_out_of_range, "an angle out of range");
+    reason(k.impossible_apparatus, "an impossible along-rail L");
+    reason(k.cone_cannot_rest, "a double cone that cannot rest");
+    out.push_back("Monte Carlo: " + std::to_string(k.total()) + " of " + std::to_string(r.propagation->trials) +
+                  " trials (" + Printf("%.3g", 100.0 * static_cast<double>(k.total()) / static_cast<double>(r.propagation->trials)) +
+                  " %) were left out because a draw was impossible (" + reasons +
+                  "): the uncertainties are large for this setting, and the Monte Carlo values describe the "
+                  "inputs' distribution cut to what is possible.");
+  }
   return out;
 }
 
@@ -82,6 +99,36 @@ void AddUncertaintyKeys(const PropagationResult& p, nlohmann::ordered_json* j) {
   (*j)["mc_rejected_trials"] = p.rejected.total();
 }
 
+}  // namespace
+
+namespace {
+// The last guard before any output: every number of the result is finite. The inputs' ranges
+// (RequireModelLength, the model's own rules) keep the known cases finite; a combination they
+// miss is refused, naming what overflowed, rather than printed as inf or NaN.
+void RequireFiniteResult(const ConversionResult& r) {
+  const Scene& s = r.scene;
+  std::vector<std::pair<const char*, double>> values = {
+      {"theta", s.rails().theta}, {"alpha", s.rails().alpha}, {"x_max", s.x_max()}, {"x_low", s.x_low()}};
+  if (s.x_eq()) values.push_back({"X", *s.x_eq()});
+  for (const PathPoint& p : r.points) {
+    values.push_back({"z at --at-x", p.z});
+    values.push_back({"dz/dx at --at-x", p.dzdx});
+    values.push_back({"R* at --at-x", p.r_star});
+  }
+  if (r.rest) {
+    values.push_back({"x_rest", r.rest->high});
+    values.push_back({"x_rest(-mu)", r.rest->low});
+  }
+  if (r.propagation)
+    for (const PropagatedValue* q : r.propagation->Outputs()) {
+      values.push_back({q->name, q->u_first_order});
+      values.push_back({q->name, q->u_monte_carlo});
+    }
+  for (const auto& [name, v] : values)
+    if (!std::isfinite(v))
+      throw InputError("the setting", std::string(name) + " (or its uncertainty) is not a finite number for these "
+                                                            "values: a length, angle or uncertainty is too extreme");
+}
 }  // namespace
 
 ConversionResult Convert(const Configuration& configuration, const ConversionOptions& options) {
@@ -104,6 +151,7 @@ ConversionResult Convert(const Configuration& configuration, const ConversionOpt
     r.propagation = Propagate(configuration.MakeUncertainRails(), configuration.MakeUncertainBody(),
                               configuration.rod_radius, options.propagation);
   if (options.verdict) r.verdict = Verdict(r, options);
+  RequireFiniteResult(r);
   return r;
 }
 

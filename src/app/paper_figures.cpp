@@ -7,6 +7,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/experiment.hpp"
+#include "io/output_paths.hpp"
 #include "model/scene.hpp"
 #include "motion/motion.hpp"
 #include "report/analysis.hpp"
@@ -175,7 +176,7 @@ void ExperimentFigures(const std::string& data_dir, const std::string& dir, Docu
     options.mc_trials = 10000;
     const ExperimentAnalysis analysis = AnalyseExperiment(experiment, options);
     const fs::path sub = fs::path(dir) / s.folder;
-    fs::create_directories(sub);
+    OutputPaths::CreateFolders(sub.string());
     for (const GnuplotFigure& f : AnalysisFigures(analysis)) {
       if (f.name == "fit_residuals") continue;
       RenderFigure(f, sub.string());
@@ -189,7 +190,9 @@ void ExperimentFigures(const std::string& data_dir, const std::string& dir, Docu
 
 std::vector<std::string> WritePaperFigures(const std::string& dir, const std::string& data_dir) {
   std::vector<std::string> written;
-  fs::create_directories(dir);
+  OutputPaths outputs;  // checked before any work
+  outputs.CheckFolder(dir, "-o", {"index.html"});
+  OutputPaths::CreateFolders(dir);
   std::vector<GnuplotFigure> figures{PotentialFigure(), XFigure(true), XFigure(false)};
   for (auto& f : SphereFigures()) figures.push_back(std::move(f));
   Document gallery;

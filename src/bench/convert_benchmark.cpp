@@ -194,7 +194,7 @@ void RunConvertBenchmark(const ConvertBenchmarkOptions& f, std::ostream& out) {
   if (!Capture(python + " " + ShellQuote(script) + " convert " + ShellQuote((dir / "in.f64").string()) + " " +
                    ShellQuote((dir / "out.f64").string()) + reps,
                &text))
-    throw std::runtime_error("the NumPy script failed: " + script);
+    throw EnvironmentError("the NumPy script failed: " + script);
   const nlohmann::json np_convert = nlohmann::json::parse(text);
   for (const auto& [name, version] : np_convert.at("versions").items())
     section.versions.emplace_back(name, version.get<std::string>());
@@ -212,7 +212,7 @@ void RunConvertBenchmark(const ConvertBenchmarkOptions& f, std::ostream& out) {
   if (!Capture(python + " " + ShellQuote(script) + " mc --trials " + std::to_string(f.trials) + " --seed " +
                    std::to_string(f.seed) + " --case " + ShellQuote(lab_case.dump()) + reps,
                &text))
-    throw std::runtime_error("the NumPy script failed: " + script);
+    throw EnvironmentError("the NumPy script failed: " + script);
   const nlohmann::json np_mc = nlohmann::json::parse(text);
   double worst_np = 0.0;
   for (const PropagatedValue* y : mc.Outputs())

@@ -105,7 +105,7 @@ std::optional<nlohmann::json> RunPeers(const FitBenchmarkOptions& f, const std::
                               ShellQuote((dir / "in.f64").string()) + " --repeats " + std::to_string(f.repeats) +
                               (f.no_odr ? " --no-odr" : "") + (f.no_rlm ? " --no-rlm" : "");
   std::string out;
-  if (!Capture(command, &out)) throw std::runtime_error("the peer script failed: " + script);
+  if (!Capture(command, &out)) throw EnvironmentError("the peer script failed: " + script);
   return nlohmann::json::parse(out);
 }
 

@@ -13,6 +13,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "model/input_error.hpp"
+
 namespace uphill::bench {
 
 namespace fs = std::filesystem;
@@ -141,7 +143,7 @@ std::string PeerUnavailable(const std::string& disabled_by, const std::string& p
 
 TemporaryDirectory::TemporaryDirectory() {
   char name[] = "/tmp/uphill-bench-XXXXXX";
-  if (!mkdtemp(name)) throw std::runtime_error("cannot create a temporary directory");
+  if (!mkdtemp(name)) throw EnvironmentError("cannot create a temporary directory");
   path_ = name;
 }
 
@@ -154,7 +156,7 @@ void WriteFloat64(const fs::path& path, const std::vector<const std::vector<doub
   std::ofstream out(path, std::ios::binary);
   for (const auto* row : rows)
     out.write(reinterpret_cast<const char*>(row->data()), static_cast<std::streamsize>(row->size() * sizeof(double)));
-  if (!out) throw std::runtime_error("cannot write " + path.string());
+  if (!out) throw EnvironmentError("cannot write " + path.string());
 }
 
 std::vector<std::vector<double>> ReadFloat64(const fs::path& path, std::size_t rows, std::size_t n) {
@@ -165,7 +167,7 @@ std::vector<std::vector<double>> ReadFloat64(const fs::path& path, std::size_t r
   std::ifstream in(path, std::ios::binary);
   std::vector<std::vector<double>> out(rows, std::vector<double>(n));
   for (auto& row : out) in.read(reinterpret_cast<char*>(row.data()), static_cast<std::streamsize>(n * sizeof(double)));
-  if (!in) throw std::runtime_error("cannot read " + path.string());
+  if (!in) throw EnvironmentError("cannot read " + path.string());
   return out;
 }
 

@@ -34,6 +34,7 @@ class Reader {
   std::optional<Uncertain> Get(const std::string& name, Dimension dimension) const {
     const auto field = source_.lookup(name);
     if (!field) return std::nullopt;
+    used_.push_back(name);
     Uncertain m;
     m.value = Parse(name, *field, dimension);
     if (const auto uf = source_.lookup("u_" + name)) {
@@ -55,16 +56,32 @@ class Reader {
 
   std::string Context(const std::string& name) const { return source_.context(name); }
 
+  // An uncertainty given for this configuration of a quantity it does not use (u_L with the
+  // angles, u_b for a sphere) would be silently ignored: refused, naming it.
+  void RefuseUnusedUncertainties(const std::string& what_is_used) const {
+    for (const FieldSpec& f : kUncertainFields) {
+      if (std::find(used_.begin(), used_.end(), f.name) != used_.end()) continue;
+      const auto u = source_.lookup(std::string("u_") + f.name);
+      if (u && !u->is_default)
+        throw InputError(source_.context(std::string("u_") + f.name),
+                         std::string("is the uncertainty of ") + f.name + ", which this setting does not use (" +
+                             what_is_used + ")");
+    }
+  }
+
  private:
   double Parse(const std::string& name, const FieldSource::Field& field, Dimension dimension) const {
     try {
-      return ParseQuantity(field.text, dimension, name, field.default_unit);
+      const double value = ParseQuantity(field.text, dimension, name, field.default_unit);
+      if (dimension == Dimension::kLength) RequireModelLength(name, value);
+      return value;
     } catch (const InputError& e) {
       throw InputError(source_.context(name), e.rule());
     }
   }
 
   const FieldSource& source_;
+  mutable std::vector<std::string> used_;  // the quantities read
 };
 
 }  // namespace
@@ -172,6 +189,9 @@ Configuration ParseConfiguration(const FieldSource& source) {
   if (auto rod = in.Get("rod_diameter", Dimension::kLength)) {
     c.rod_radius = Uncertain{rod->value / 2, rod->u / 2};
   }
+  in.RefuseUnusedUncertainties(std::string(c.from_apparatus ? "the rails are given as L, H, D" : "the rails are given as theta, alpha") +
+                               "; the body as " + (c.body_kind == BodyKind::kSphere ? "R" : c.body_kind == BodyKind::kSpheroid ? "a, b" : "R, h") +
+                               (c.rod_radius.value > 0 || in.Has("rod_diameter") ? "; rods" : "; line rails"));
   // Validate the geometry now, naming the field the model complains about.
   try {
     c.MakeScene();

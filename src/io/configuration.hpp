@@ -59,6 +59,11 @@ struct FieldSource {
   struct Field {
     std::string text;
     std::string default_unit;
+    // A default from elsewhere (flags under a batch CSV, an experiment's default uncertainties):
+    // an uncertainty given this way may go unused (a u_L default for a row given by angles).
+    // Given for this configuration itself, an uncertainty of a quantity it does not use is an
+    // error: it would be silently ignored.
+    bool is_default = false;
   };
   std::function<std::optional<Field>(const std::string& name)> lookup;
   std::function<std::string(const std::string& name)> context;

@@ -39,7 +39,10 @@ FieldSource ConfigurationTable::Source(int row, const Cells& cells, const FieldS
       if (cell.find_first_not_of(" \t") != std::string_view::npos)
         return FieldSource::Field{std::string(cell), units_[static_cast<std::size_t>(it->second)]};
     }
-    return defaults ? defaults->lookup(name) : std::nullopt;
+    if (!defaults) return std::nullopt;
+    auto field = defaults->lookup(name);
+    if (field) field->is_default = true;
+    return field;
   };
   source.context = [this, row, defaults](const std::string& name) {
     if (auto it = field_column_.find(name); it != field_column_.end())

@@ -159,7 +159,7 @@ Experiment LoadExperiment(const std::string& directory) {
         if (apparatus.contains(name))
           return FieldSource::Field{Text(apparatus.at(name), json_path + ": apparatus." + name), ""};
         if (name.rfind("u_", 0) == 0 && defaults.contains(name.substr(2)))
-          return FieldSource::Field{Text(defaults.at(name.substr(2)), json_path + ": uncertainties"), ""};
+          return FieldSource::Field{Text(defaults.at(name.substr(2)), json_path + ": uncertainties"), "", true};
         return std::nullopt;
       };
       source.context = [&](const std::string& name) -> std::string {
@@ -176,9 +176,19 @@ Experiment LoadExperiment(const std::string& directory) {
       row.Y.value = ParseQuantity(y ? y->text : "", Dimension::kLength, source.context("Y"),
                                   y ? y->default_unit : "");
       if (!(row.Y.value > 0.0)) throw InputError(source.context("Y"), "must be > 0 (a position beyond O)");
+      try {
+        RequireModelLength("Y", row.Y.value);
+      } catch (const InputError& e) {
+        throw InputError(source.context("Y"), e.rule());
+      }
       if (const auto uy = source.lookup("u_Y")) {
         row.Y.u = ParseQuantity(uy->text, Dimension::kLength, source.context("u_Y"), uy->default_unit);
         if (row.Y.u < 0.0) throw InputError(source.context("u_Y"), "must be >= 0");
+        try {
+          RequireModelLength("u_Y", row.Y.u);
+        } catch (const InputError& e) {
+          throw InputError(source.context("u_Y"), e.rule());
+        }
       }
     } catch (const InputError& err) {
       row.error = err.what();

@@ -112,14 +112,15 @@ int XyTable::RowOf(std::size_t i) const {
 std::string XyTable::Locate(const std::string& quantity) const {
   // The fit layer names a value "X[i]", "Y[i]", "u(X)[i]" or "u(Y)[i]" (i counts read rows).
   const auto open = quantity.find('[');
-  if (open == std::string::npos || quantity.back() != ']') return quantity;
+  // A rule about the data as a whole ("rows", "u(Y)", "X"): the file, then the quantity.
+  if (open == std::string::npos || quantity.back() != ']') return source + ": " + quantity;
   const std::string name = quantity.substr(0, open);
   const std::string column = name == "u(X)" ? "uX" : name == "u(Y)" ? "uY" : name;
   std::size_t i = 0;
   try {
     i = std::stoul(quantity.substr(open + 1));
   } catch (const std::exception&) {
-    return quantity;
+    return source + ": " + quantity;
   }
   return source + ", row " + std::to_string(RowOf(i)) + ", column " + column;
 }

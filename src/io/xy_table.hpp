@@ -32,7 +32,8 @@ struct XyTable {
 
   // Spreadsheet row of read row i (the header is row 1).
   int RowOf(std::size_t i) const;
-  // "file, row 4, column uX" for the fit layer's name of a value, "u(X)[2]"; other names as given.
+  // "file, row 4, column uX" for the fit layer's name of a value, "u(X)[2]"; "file: rows" for a
+  // rule about the data as a whole ("rows", "u(Y)").
   std::string Locate(const std::string& quantity) const;
 };
 

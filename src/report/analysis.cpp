@@ -48,6 +48,10 @@ AnalysedRow AnalyseRow(const ExperimentRow& row, const AnalysisOptions& options)
   r.u_x_eq = propagated.x_eq->u_first_order;
   r.u_x_eq_mc = options.mc_trials > 0 ? propagated.x_eq->u_monte_carlo : 0.0;
   r.u_disagrees = propagated.x_eq->disagrees;
+  // No inf or NaN reaches the report: a setting the model cannot answer for is this row's error.
+  for (const double v : {r.x_eq, r.u_x_eq, r.u_x_eq_mc, r.x_max, r.theta, r.alpha})
+    if (!std::isfinite(v))
+      throw InputError("the setting", "the model's X or its uncertainty is not a finite number for these values");
   if (const auto crossbar = c.CrossbarDistance(); crossbar && r.x_eq > *crossbar)
     r.flags.push_back("X beyond the crossbar (" + Mm(*crossbar) + ")");
   // Measured values scatter: flag only departures beyond two combined standard uncertainties.
@@ -78,9 +82,16 @@ ExperimentAnalysis AnalyseExperiment(const Experiment& experiment, const Analysi
                              ": " + e.what());
     }
   }
-  if (a.rows.empty())
-    throw InputError(experiment.directory, "no usable rows to analyse (" +
-                                               std::to_string(a.row_errors.size()) + " rows with errors)");
+  if (a.rows.empty()) {
+    // Say what is broken, not only how often: the first row's error names the file, row, column
+    // and rule (often one cause for all, e.g. a dimension in experiment.json without its unit).
+    if (a.row_errors.empty()) throw InputError(experiment.directory, "has no rows in measurements.csv to analyse");
+    const std::size_t n = a.row_errors.size();
+    throw InputError(experiment.directory, "no usable rows to analyse: " +
+                                               (n == 1 ? std::string("its one row has an error: ")
+                                                       : "all " + std::to_string(n) + " rows have errors; the first: ") +
+                                               a.row_errors.front());
+  }
   LineData line;
   FrictionData friction;
   bool all_u_y = true, all_u_x = true;

@@ -69,7 +69,7 @@ std::string ModelCurves(const ExperimentAnalysis& a, const std::string& data_fil
 
 GnuplotFigure YAgainstX(const ExperimentAnalysis& a) {
   GnuplotFigure f;
-  f.name = "fit_y_vs_x";
+  f.name = AnalysisFigureNames()[0];
   f.title = "Measured Y against theoretical X";
   f.caption = "Each point is one trial: X from the converter with its first-order standard uncertainty, "
               "Y as measured with u(Y). The dashed line is y = x (no friction); the straight lines are "
@@ -95,7 +95,7 @@ GnuplotFigure YAgainstX(const ExperimentAnalysis& a) {
 // plot it is a few millimetres on a scale of hundreds and cannot be seen.
 GnuplotFigure OffsetAgainstX(const ExperimentAnalysis& a) {
   GnuplotFigure f;
-  f.name = "fit_offset";
+  f.name = AnalysisFigureNames()[1];
   f.title = "Offset Y - X against X";
   f.caption = "The measured offset of the farthest rest position from the theoretical equilibrium, with "
               "sqrt(u(X)^2 + u(Y)^2) error bars. Zero is the frictionless model; the straight-line fits "
@@ -121,7 +121,7 @@ GnuplotFigure OffsetAgainstX(const ExperimentAnalysis& a) {
 
 GnuplotFigure Residuals(const ExperimentAnalysis& a) {
   GnuplotFigure f;
-  f.name = "fit_residuals";
+  f.name = AnalysisFigureNames()[2];
   f.title = "Residuals against X";
   f.caption = "Y minus the fitted value for the OLS straight line (with u(Y) error bars) and for the "
               "friction model. Structure here (a trend or a curve) means the model misses something.";
@@ -158,5 +158,7 @@ GnuplotFigure Residuals(const ExperimentAnalysis& a) {
 std::vector<GnuplotFigure> AnalysisFigures(const ExperimentAnalysis& analysis) {
   return {YAgainstX(analysis), OffsetAgainstX(analysis), Residuals(analysis)};
 }
+
+std::vector<std::string> AnalysisFigureNames() { return {"fit_y_vs_x", "fit_offset", "fit_residuals"}; }
 
 }  // namespace uphill

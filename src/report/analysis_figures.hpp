@@ -16,5 +16,7 @@
 namespace uphill {
 
 std::vector<GnuplotFigure> AnalysisFigures(const ExperimentAnalysis& analysis);
+// The names of those figures (whatever the analysis holds), for checking outputs before the work.
+std::vector<std::string> AnalysisFigureNames();
 
 }  // namespace uphill

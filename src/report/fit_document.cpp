@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "io/atomic_file.hpp"
+#include "model/input_error.hpp"
 #include "report/analysis_figures.hpp"
 #include "report/fit_json.hpp"
 #include "report/gnuplot_figure.hpp"
@@ -204,9 +205,18 @@ std::string RenderText(const Document& d) {
   return o.str();
 }
 
+std::vector<std::string> FitReportFiles() {
+  std::vector<std::string> files = {"report.html", "report.md", "fit.json"};
+  for (const std::string& name : AnalysisFigureNames())
+    for (std::string& file : FigureFiles(name)) files.push_back(std::move(file));
+  return files;
+}
+
 void WriteFitReport(const ExperimentAnalysis& a, const std::string& directory) {
   namespace fs = std::filesystem;
-  fs::create_directories(directory);
+  std::error_code ec;
+  fs::create_directories(directory, ec);
+  if (ec) throw EnvironmentError(directory + ": cannot create the folder: " + ec.message());
   for (const GnuplotFigure& f : AnalysisFigures(a)) RenderFigure(f, directory);
   const Document d = FitDocument(a, true);
   WriteFileAtomically((fs::path(directory) / "fit.json").string(), AnalysisToJson(a).dump(2) + "\n");

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "report/analysis.hpp"
 #include "report/document.hpp"
@@ -15,8 +16,10 @@ Document FitDocument(const ExperimentAnalysis& analysis, bool with_figures);
 // Plain-text rendering of a Document for a terminal (aligned tables), used by `uphill fit`.
 std::string RenderText(const Document& document);
 
-// Creates `directory` if needed; every file is written atomically. Throws std::runtime_error
-// (figures: gnuplot missing or failing; files: the path and the failing call).
+// Creates `directory` if needed; every file is written atomically or not at all. Throws
+// EnvironmentError (figures: gnuplot missing or failing; files: the path and the failing call).
 void WriteFitReport(const ExperimentAnalysis& analysis, const std::string& directory);
+// The names of the files WriteFitReport writes into its folder.
+std::vector<std::string> FitReportFiles();
 
 }  // namespace uphill

@@ -4,12 +4,14 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "model/input_error.hpp"
+#include "vision/library_logs.hpp"
 
 namespace uphill {
 namespace {
@@ -54,6 +56,27 @@ double Flatness(const std::vector<Eigen::Matrix<double, N, 1>>& points) {
   for (size_t i = 0; i < points.size(); ++i) centred.row(static_cast<Eigen::Index>(i)) = (points[i] - mean).transpose();
   const Eigen::VectorXd s = Eigen::JacobiSVD<Eigen::MatrixXd>(centred).singularValues();
   return s(0) > 0 ? s(1) / s(0) : 0;
+}
+
+// The pose fitted to `points` without the one at `skip` (skip ≥ size: all of them): SQPnP, then
+// Levenberg-Marquardt. nullopt when no pose fits.
+std::optional<CameraPose> FitPose(const CameraIntrinsics& camera, const std::vector<ScenePoint>& points, size_t skip) {
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (i == skip) continue;
+    object.emplace_back(points[i].position.x(), points[i].position.y(), points[i].position.z());
+    image.emplace_back(points[i].pixel.x(), points[i].pixel.y());
+  }
+  cv::Mat dist = camera.distortion.empty() ? cv::Mat() : cv::Mat(camera.distortion, true);
+  cv::Mat rvec, tvec;
+  if (!cv::solvePnP(object, image, CameraMatrix(camera), dist, rvec, tvec, false, cv::SOLVEPNP_SQPNP)) return std::nullopt;
+  cv::solvePnPRefineLM(object, image, CameraMatrix(camera), dist, rvec, tvec,
+                       cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 100, 1e-12));
+  CameraPose pose;
+  pose.rotation = RotationOf(rvec);
+  pose.translation = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+  return pose;
 }
 
 }  // namespace
@@ -128,6 +151,13 @@ CameraCalibration CalibrateCamera(const std::vector<NamedImage>& images, const C
                                       " pixels, but " + images.front().name + " is " + std::to_string(size.width) +
                                       "×" + std::to_string(size.height) + ": all views must come from one camera setting");
   }
+  // The same picture twice (a file given twice, or copied) would count as two views and make the
+  // fit look better constrained than it is.
+  for (size_t i = 1; i < images.size(); ++i)
+    for (size_t k = 0; k < i; ++k)
+      if (images[i].image.channels() == images[k].image.channels() && cv::norm(images[i].image, images[k].image, cv::NORM_INF) == 0)
+        throw InputError(images[i].name, "is the same image as " + images[k].name +
+                                             ": each view must be a new photograph (move or tilt the board between shots)");
 
   CameraCalibration result;
   std::vector<std::vector<cv::Point3f>> object_points;
@@ -225,6 +255,7 @@ CameraCalibration CalibrateCamera(const std::vector<NamedImage>& images, const C
 CameraCalibration CalibrateCameraFromFiles(const std::vector<std::string>& paths, const ChessboardTarget& target,
                                            const CameraCalibrationOptions& options) {
   std::vector<NamedImage> images;
+  QuietVideoLibraryLogs();
   for (const auto& path : paths) {
     cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
     if (image.empty()) throw InputError(path, "cannot be read as an image (missing, or not PNG/JPEG/…)");
@@ -284,26 +315,44 @@ SceneCalibrationResult CalibrateScene(const CameraIntrinsics& camera, const std:
     throw InputError("points", "their pixels all lie on one line: the camera sees them edge-on; "
                                "film from higher up or add points off that plane");
 
-  std::vector<cv::Point3d> object;
-  std::vector<cv::Point2d> image;
-  for (const auto& p : points) {
-    object.emplace_back(p.position.x(), p.position.y(), p.position.z());
-    image.emplace_back(p.pixel.x(), p.pixel.y());
-  }
-  cv::Mat dist = camera.distortion.empty() ? cv::Mat() : cv::Mat(camera.distortion, true);
-  cv::Mat rvec, tvec;
-  if (!cv::solvePnP(object, image, CameraMatrix(camera), dist, rvec, tvec, false, cv::SOLVEPNP_SQPNP))
-    throw InputError("points", "no camera pose fits them (check that each pixel belongs to its point)");
-  cv::solvePnPRefineLM(object, image, CameraMatrix(camera), dist, rvec, tvec,
-                       cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 100, 1e-12));
-
+  const std::optional<CameraPose> pose = FitPose(camera, points, points.size());
+  if (!pose) throw InputError("points", "no camera pose fits them (check that each pixel belongs to its point)");
   SceneCalibrationResult result;
   result.scene.camera = camera;
-  result.scene.pose.rotation = RotationOf(rvec);
-  result.scene.pose.translation = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
-  for (const auto& p : points)
-    if ((result.scene.pose.rotation * p.position + result.scene.pose.translation).z() <= 0)
-      throw InputError(p.label, "lies behind the camera in the best-fitting pose: the points and pixels disagree");
+  result.scene.pose = *pose;
+  // Leave-one-out: each point predicted by the pose the other points give. A misread point pulls
+  // the full fit toward itself, so its own residual can be smaller than a good neighbour's; the
+  // pose without it does not, and the point's distance from that prediction names it.
+  std::vector<double> deleted(points.size(), 0.0);
+  std::vector<bool> in_front_without(points.size(), false);
+  if (points.size() >= 5)
+    for (size_t i = 0; i < points.size(); ++i) {
+      const std::optional<CameraPose> without = FitPose(camera, points, i);
+      if (!without) continue;
+      bool all_in_front = true;
+      for (size_t k = 0; k < points.size(); ++k)
+        if (k != i && (without->rotation * points[k].position + without->translation).z() <= 0) all_in_front = false;
+      in_front_without[i] = all_in_front;
+      deleted[i] = (ProjectApparatusPoints(camera, *without, {points[i].position})[0] - points[i].pixel).norm();
+    }
+  const auto culprit = [&]() -> std::optional<size_t> {
+    if (points.size() < 5) return std::nullopt;
+    std::vector<double> sorted = deleted;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    const size_t worst = static_cast<size_t>(std::max_element(deleted.begin(), deleted.end()) - deleted.begin());
+    if (deleted[worst] > 5 * median && deleted[worst] > 2) return worst;
+    return std::nullopt;
+  }();
+  for (size_t i = 0; i < points.size(); ++i)
+    if ((result.scene.pose.rotation * points[i].position + result.scene.pose.translation).z() <= 0) {
+      if (culprit && in_front_without[*culprit])
+        throw InputError(points[*culprit].label,
+                         "does not fit the other points (" + Fixed(deleted[*culprit], 1) +
+                             " px from where they place it), and with it " + points[i].label +
+                             " would lie behind the camera: check this point's pixel and position");
+      throw InputError(points[i].label, "lies behind the camera in the best-fitting pose: the points and pixels disagree");
+    }
   const std::vector<Eigen::Vector2d> reprojected = ProjectApparatusPoints(camera, result.scene.pose, positions);
   double sum = 0;
   for (size_t i = 0; i < points.size(); ++i) {
@@ -322,15 +371,9 @@ SceneCalibrationResult CalibrateScene(const CameraIntrinsics& camera, const std:
                   " px is above 2 px: a point misread or mismeasured, or the camera file is not this camera's");
   if (flatness < 0.05)
     why.push_back("the points lie nearly on one line: the rotation about it is poorly determined");
-  // A misread point pulls the fit toward itself and raises every residual, the RMS too; the
-  // median stays with the good points.
-  std::vector<double> errors;
-  for (const auto& r : result.residuals) errors.push_back(r.error_px);
-  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-  const double median = errors[errors.size() / 2];
-  for (const auto& r : result.residuals)
-    if (r.error_px > 5 * median && r.error_px > 2)
-      why.push_back(r.label + ": residual " + Fixed(r.error_px, 1) + " px, far above the others (check this point)");
+  if (culprit)
+    why.push_back(points[*culprit].label + ": " + Fixed(deleted[*culprit], 1) +
+                  " px from where the other points place it, far more than any other point (check this point)");
   result.verdict = why.empty() ? "good" : "poor";
   return result;
 }

@@ -4,10 +4,15 @@
 #include <sstream>
 
 #include "io/atomic_file.hpp"
+#include "model/input_error.hpp"
 #include "model/number_text.hpp"
 
 namespace uphill {
 namespace {
+
+constexpr const char* kAnalysisFile = "track_analysis.json";
+constexpr const char* kPositionFigure = "track_x_vs_t";
+constexpr const char* kResidualFigure = "track_residuals";
 
 nlohmann::json Optional(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
 
@@ -152,7 +157,7 @@ nlohmann::json TrackAnalysisJson(const TrackAnalysis& a) {
 std::vector<GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& a) {
   std::vector<GnuplotFigure> figures;
   GnuplotFigure x;
-  x.name = "track_x_vs_t";
+  x.name = kPositionFigure;
   x.title = "Measured x(t) against the fitted model";
   x.caption = "Each point is one video frame where the ball was found (x of its centre in the apparatus frame); "
               "the line is the model motion fitted to them (x0, t0 and " +
@@ -172,7 +177,7 @@ std::vector<GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& a) {
   figures.push_back(x);
   if (a.fit.available) {
     GnuplotFigure r;
-    r.name = "track_residuals";
+    r.name = kResidualFigure;
     r.title = "Residuals of the model fit";
     r.caption = "Measured minus fitted x for every frame of the fit window, with the stated u_x as error bars. "
                 "Structure (a trend, a wave) means the model misses something.";
@@ -192,9 +197,18 @@ std::vector<GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& a) {
   return figures;
 }
 
+std::vector<std::string> TrackAnalysisFiles() {
+  std::vector<std::string> files = {kAnalysisFile};
+  for (const char* name : {kPositionFigure, kResidualFigure})
+    for (std::string& file : FigureFiles(name)) files.push_back(std::move(file));
+  return files;
+}
+
 void WriteTrackAnalysis(const TrackAnalysis& analysis, const std::string& directory) {
-  std::filesystem::create_directories(directory);
-  WriteFileAtomically((std::filesystem::path(directory) / "track_analysis.json").string(),
+  std::error_code ec;
+  std::filesystem::create_directories(directory, ec);
+  if (ec) throw EnvironmentError(directory + ": cannot create the folder: " + ec.message());
+  WriteFileAtomically((std::filesystem::path(directory) / kAnalysisFile).string(),
                           TrackAnalysisJson(analysis).dump(2) + "\n");
   for (const auto& figure : TrackAnalysisFigures(analysis)) RenderFigure(figure, directory);
 }

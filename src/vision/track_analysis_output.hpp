@@ -21,7 +21,9 @@ std::string TrackAnalysisTable(const TrackAnalysis& analysis);
 nlohmann::json TrackAnalysisJson(const TrackAnalysis& analysis);
 std::vector<GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& analysis);
 // Writes DIR/track_analysis.json and the figures (.dat, .gp, .svg, .png). Throws
-// std::runtime_error when a file cannot be written or gnuplot fails.
+// EnvironmentError when a file cannot be written or gnuplot fails.
 void WriteTrackAnalysis(const TrackAnalysis& analysis, const std::string& directory);
+// The names of every file WriteTrackAnalysis may write into its folder.
+std::vector<std::string> TrackAnalysisFiles();
 
 }  // namespace uphill

@@ -1,9 +1,13 @@
 #include "vision/video_tracking.hpp"
 
+#include <fcntl.h>
+#include <sys/random.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
@@ -12,7 +16,9 @@
 #include <sstream>
 
 #include "io/atomic_file.hpp"
+#include "io/output_paths.hpp"
 #include "model/input_error.hpp"
+#include "vision/library_logs.hpp"
 
 namespace uphill {
 namespace {
@@ -24,6 +30,54 @@ double ThreadCpuSeconds() {
 }
 
 std::string Size(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+// A file written by a library that takes a path (OpenCV's VideoWriter): it writes under a
+// temporary name in the target's folder (same extension: it picks the container), and the file
+// is renamed into place only by Commit, so a failed or interrupted run never leaves a half-written
+// file at the target's name nor touches what is there. The temporary is removed otherwise.
+class PendingFile {
+ public:
+  explicit PendingFile(const std::string& target) : target_(target) {
+    const std::filesystem::path path(target);
+    folder_ = path.has_parent_path() ? path.parent_path().string() : ".";
+    OutputPaths::CreateFolders(folder_);
+    unsigned long long r = 0;
+    if (::getrandom(&r, sizeof r, 0) != static_cast<ssize_t>(sizeof r)) r = static_cast<unsigned long long>(::getpid());
+    char suffix[24];
+    std::snprintf(suffix, sizeof suffix, ".tmp-%016llx", r);
+    name_ = "." + path.stem().string() + suffix + path.extension().string();
+    temporary_ = (std::filesystem::path(folder_) / name_).string();
+  }
+  PendingFile(const PendingFile&) = delete;
+  PendingFile& operator=(const PendingFile&) = delete;
+  ~PendingFile() {
+    if (!committed_) ::unlink(temporary_.c_str());
+  }
+  const std::string& temporary() const { return temporary_; }
+  // fsync, then rename over the target (never over anything but a regular file).
+  void Commit() {
+    const int fd = ::open(temporary_.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0 || ::fsync(fd) != 0) {
+      if (fd >= 0) ::close(fd);
+      throw EnvironmentError(target_ + ": cannot be saved: " + std::strerror(errno));
+    }
+    ::close(fd);
+    const int dir = ::open(folder_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dir < 0) throw EnvironmentError(folder_ + ": cannot open the folder: " + std::strerror(errno));
+    try {
+      RenameIntoPlaceAt(dir, name_, dir, folder_, std::filesystem::path(target_).filename().string());
+    } catch (...) {
+      ::close(dir);
+      throw;
+    }
+    ::close(dir);
+    committed_ = true;
+  }
+
+ private:
+  std::string target_, folder_, name_, temporary_;
+  bool committed_ = false;
+};
 
 // The scene's centre path and the fitted outline and centre, drawn on a copy of the frame.
 void DrawOverlay(cv::Mat& frame, const BallTracker& tracker, const std::vector<cv::Point>& path, const BallObservation& b) {
@@ -48,6 +102,7 @@ void DrawOverlay(cv::Mat& frame, const BallTracker& tracker, const std::vector<c
 TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const SceneCalibration& calibration,
                        const TrackVideoOptions& options) {
   if (!std::filesystem::is_regular_file(video_path)) throw InputError(video_path, "no such video file");
+  QuietVideoLibraryLogs();
   cv::VideoCapture capture;
   try {
     capture.open(video_path, cv::CAP_FFMPEG);
@@ -66,12 +121,21 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
                                                    " px frames (calibrate the camera at the video's resolution)");
   BallTracker tracker(scene, calibration, options.tracker);
 
+  std::optional<PendingFile> overlay_file;  // destroyed after the writer: it closes first
   std::optional<cv::VideoWriter> overlay;
   std::vector<cv::Point> path;
   if (!options.overlay_path.empty()) {
-    overlay.emplace(options.overlay_path, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('a', 'v', 'c', '1'),
-                    result.fps > 0 ? result.fps : 30.0, cv::Size(width, height));
-    if (!overlay->isOpened()) throw std::runtime_error(options.overlay_path + ": cannot open the overlay video for writing");
+    overlay_file.emplace(options.overlay_path);
+    try {
+      overlay.emplace(overlay_file->temporary(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('a', 'v', 'c', '1'),
+                      result.fps > 0 ? result.fps : 30.0, cv::Size(width, height));
+    } catch (const cv::Exception&) {
+      overlay.reset();
+    }
+    if (!overlay || !overlay->isOpened())
+      throw EnvironmentError(options.overlay_path +
+                             ": cannot write a video there (FFmpeg has no H.264 encoder for this container, or the "
+                             "folder cannot be written; use a .mp4 name in a writable folder)");
     std::vector<Eigen::Vector3d> points;
     for (int i = 0; i <= 200; ++i) {
       const double x = scene.x_low() + (scene.x_max() - scene.x_low()) * i / 200.0;
@@ -128,6 +192,10 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
     result.partial_reason = "the ball was lost after frame " + std::to_string(last_found) + " and not found again in the last " +
                             std::to_string(read - last_found - 1) + " frames";
   }
+  if (overlay) {
+    overlay->release();
+    overlay_file->Commit();
+  }
   return result;
 }
 
@@ -157,10 +225,7 @@ void WriteTrack(const std::string& csv_path, const TrackResult& result, const Tr
                                  {"extrapolated_timestamps", result.extrapolated_times},
                                  {"partial", result.partial}};
   if (result.partial) side["partial_reason"] = result.partial_reason;
-  const std::filesystem::path folder = std::filesystem::path(csv_path).parent_path();
-  std::error_code ec;
-  if (!folder.empty()) std::filesystem::create_directories(folder, ec);
-  if (ec) throw std::runtime_error(folder.string() + ": cannot create the folder: " + ec.message());
+  OutputPaths::CreateFolders(std::filesystem::path(csv_path).parent_path().string());
   WriteFileAtomically(csv_path, csv.str());
   WriteFileAtomically(csv_path + ".json", side.dump(2) + "\n");
 }

@@ -41,12 +41,16 @@ struct TrackResult {
 struct TrackVideoOptions {
   TrackerOptions tracker;
   std::string calibration_name = "the scene file";  // for messages
-  std::string overlay_path;                          // optional: the video with the fit drawn (.mp4)
+  // Optional: the video with the fit drawn (.mp4). Written under a temporary name beside it and
+  // renamed into place when the track is complete: never half-written, its folder created.
+  std::string overlay_path;
   // Called after each frame with (frames done, declared total or 0).
   std::function<void(int, long)> progress;
 };
 
-// Opens with the FFmpeg backend. The caller sets one-core decoding if it wants it
+// Opens with the FFmpeg backend (its own log lines silenced: library_logs.hpp). Throws
+// InputError for a video that cannot be read or holds no ball, EnvironmentError when the overlay
+// cannot be written. The caller sets one-core decoding if it wants it
 // (OPENCV_FFMPEG_CAPTURE_OPTIONS="threads;1" before the call, cv::setNumThreads(1)).
 TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const SceneCalibration& calibration,
                        const TrackVideoOptions& options = {});
@@ -57,7 +61,8 @@ struct TrackSources {
 };
 
 // Writes the CSV (header `frame,t,u,v,radius_px,x,z,quality`; x z in mm) and the sidecar, each
-// atomically. Throws std::runtime_error when a file cannot be written.
+// atomically, creating the CSV's folder if needed. Throws EnvironmentError when a file cannot be
+// written.
 void WriteTrack(const std::string& csv_path, const TrackResult& result, const TrackSources& sources);
 
 }  // namespace uphill

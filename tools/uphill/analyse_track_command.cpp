@@ -10,6 +10,7 @@
 #if UPHILL_VISION_PROGRAM
 #include <iostream>
 
+#include "io/output_paths.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "vision/track_analysis.hpp"
@@ -40,6 +41,11 @@ void Run(const AnalyseTrackFlags& f) {
     o.fit = TrackFitParameter::kMu;
   } else {
     throw InputError("--fit", "must be g (an effective g) or mu (rolling resistance), got '" + f.fit + "'");
+  }
+  if (!f.output.empty()) {  // checked before any work
+    OutputPaths outputs;
+    outputs.AddInput(f.track, "the track file");
+    outputs.CheckFolder(f.output, "-o", TrackAnalysisFiles());
   }
   const Track track = ReadTrackFile(f.track);
   const TrackAnalysis analysis = AnalyseTrack(track, scene, o);

@@ -5,11 +5,13 @@
 //   calibrate target --cols 9 --rows 6 --square 20mm -o board.svg|board.png
 // The numbers are printed with their units; the files' formats are in calibration/README.md. The
 // points file and the target: src/app/calibration_inputs.hpp.
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "commands.hpp"
+#include "flag_checks.hpp"
 #include "vision_program.hpp"
 #if UPHILL_VISION_PROGRAM
 #include <Eigen/Geometry>
@@ -23,9 +25,11 @@
 
 #include "app/calibration_inputs.hpp"
 #include "io/atomic_file.hpp"
+#include "io/output_paths.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "vision/calibration.hpp"
+#include "vision/library_logs.hpp"
 #endif
 
 namespace uphill::cli {
@@ -87,13 +91,32 @@ void PrintVerdict(const std::string& verdict, const std::vector<std::string>& re
 
 // ---- camera ----
 
+// -o checked before any work: never one of the inputs, never anything but a regular file.
+void CheckOutput(const CalibrateFlags& f) {
+  OutputPaths outputs;
+  for (const std::string& image : f.images) outputs.AddInput(image, "the image");
+  outputs.AddInput(f.camera, "the camera file");
+  outputs.AddInput(f.points, "the points file");
+  outputs.AddInput(f.frame, "the frame");
+  outputs.AddInput(f.board_image, "the board image");
+  outputs.CheckFile(f.output, "-o");
+}
+
+// Just before writing: the output's missing folders.
+void MakeOutputFolder(const CalibrateFlags& f) {
+  OutputPaths::CreateFolders(std::filesystem::path(f.output).parent_path().string());
+}
+
 void RunCamera(const CalibrateFlags& f) {
   const ChessboardTarget target = Target(f.target);
   if (f.images.empty()) throw InputError("IMAGES", "give the chessboard views (10 to 20 image files)");
+  CheckOutput(f);
   CameraCalibrationOptions options;
   options.fit_k3 = f.fit_k3;
   const CameraCalibration c = CalibrateCameraFromFiles(f.images, target, options);
   const CameraIntrinsics& k = c.camera;
+  MakeOutputFolder(f);
+  WriteCameraFile(f.output, k, c.Summary(target));  // first: the printout then describes a saved file
   std::cout << "camera calibration: " << c.views_used << " of " << c.views.size() << " views used, chessboard "
             << target.cols << "×" << target.rows << " inner corners, " << Num(target.square * 1000) << " mm squares\n";
   Row("image size", std::to_string(k.width) + " × " + std::to_string(k.height) + " px");
@@ -115,7 +138,6 @@ void RunCamera(const CalibrateFlags& f) {
       std::cout << "    " << v.name << ": rejected, " << v.rejected_because << "\n";
   }
   PrintVerdict(c.verdict, c.reasons);
-  WriteCameraFile(f.output, k, c.Summary(target));
   std::cout << "wrote " << f.output << "\n";
 }
 
@@ -141,12 +163,14 @@ Eigen::Vector3d Point(const std::string& text, const std::string& flag) {
 }
 
 cv::Mat ReadImage(const std::string& path, const std::string& flag) {
+  QuietVideoLibraryLogs();
   const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
   if (image.empty()) throw InputError(flag + " " + path, "cannot be read as an image");
   return image;
 }
 
 void RunScene(const CalibrateFlags& f) {
+  CheckOutput(f);
   const CameraIntrinsics camera = ReadCameraFile(f.camera);
   SceneCalibrationResult r;
   if (!f.board_image.empty()) {
@@ -174,6 +198,8 @@ void RunScene(const CalibrateFlags& f) {
       throw;
     }
   }
+  MakeOutputFolder(f);
+  WriteSceneFile(f.output, r.scene, r.Summary());  // first: the printout then describes a saved file
   const CameraPose& pose = r.scene.pose;
   const Eigen::Vector3d centre = CameraCentre(pose);
   const Eigen::Vector3d axis = pose.rotation.row(2).transpose();
@@ -191,7 +217,6 @@ void RunScene(const CalibrateFlags& f) {
   std::cout << "  residuals:\n";
   for (const auto& p : r.residuals) std::cout << "    " << p.label << ": " << Fixed(p.error_px, 3) << " px\n";
   PrintVerdict(r.verdict, r.reasons);
-  WriteSceneFile(f.output, r.scene, r.Summary());
   std::cout << "wrote " << f.output << "\n";
 }
 
@@ -200,15 +225,19 @@ void RunScene(const CalibrateFlags& f) {
 void RunTarget(const CalibrateFlags& f) {
   const ChessboardTarget t = Target(f.target);
   const std::string extension = std::filesystem::path(f.output).extension().string();
+  if (extension != ".svg" && extension != ".png")
+    throw InputError("-o", "must end in .svg or .png (got '" + f.output + "')");
+  CheckOutput(f);
   if (extension == ".svg") {
+    MakeOutputFolder(f);
     WriteFileAtomically(f.output, ChessboardTargetSvg(t));
     std::cout << "wrote " << f.output << ": print at 100 % (no \"fit to page\"), then measure a square: it must be "
               << Num(t.square * 1000) << " mm (give the measured value to --square)\n";
     return;
   }
-  if (extension != ".png") throw InputError("-o", "must end in .svg or .png (got '" + f.output + "')");
   const double dpi = ParseQuantity(f.dpi, Dimension::kDimensionless, "--dpi");
   const TargetPng png = ChessboardTargetPng(t, dpi);
+  MakeOutputFolder(f);
   WriteFileAtomically(f.output, png.bytes);
   std::cout << "wrote " << f.output << ": " << png.width << " × " << png.height << " px, " << png.pixels_per_square
             << " px per square; print at " << Num(dpi) << " dpi so that a square measures " << Num(t.square * 1000)
@@ -249,13 +278,26 @@ void AddCalibrateCommand(CLI::App& app) {
   scene->add_option("--board-y-axis", flags->board_y_axis, "with --board-image: apparatus axis down the board's columns")
       ->capture_default_str();
   scene->add_option("-o,--output", flags->output, "scene file to write (JSON)")->required();
-  scene->callback([flags] { RunScene(*flags); });
+  scene->callback([flags, scene] {
+    // The chessboard's flags belong to --board-image; --frame to --points.
+    const bool board = !flags->board_image.empty();
+    for (const char* flag : {"--cols", "--rows", "--square", "--board-origin", "--board-x-axis", "--board-y-axis"})
+      RefuseIgnored(scene, flag, !board, "applies only with --board-image (a chessboard lying in the scene)");
+    RefuseIgnored(scene, "--frame", board, "applies only with --points (the board image itself is checked)");
+    RefuseEmpty(scene, "--points", flags->points, "a CSV of points");
+    RefuseEmpty(scene, "--board-image", flags->board_image, "an image file");
+    RunScene(*flags);
+  });
 
   CLI::App* target = calibrate->add_subcommand("target", "Write a chessboard target to print (SVG or PNG)");
   AddTargetFlags(target, &flags->target, true);
   target->add_option("--dpi", flags->dpi, "PNG only: printer resolution (dots per inch)")->capture_default_str();
   target->add_option("-o,--output", flags->output, "file to write: .svg (exact size in mm) or .png")->required();
-  target->callback([flags] { RunTarget(*flags); });
+  target->callback([flags, target] {
+    RefuseIgnored(target, "--dpi", std::filesystem::path(flags->output).extension() == ".svg",
+                  "applies to a .png target only (an SVG has its size in mm)");
+    RunTarget(*flags);
+  });
 }
 
 }  // namespace uphill::cli

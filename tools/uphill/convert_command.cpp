@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "app/convert_batch.hpp"
+#include "flag_checks.hpp"
 #include "convert_output.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
@@ -23,19 +24,32 @@ struct ConvertFlags {
   bool csv = false;
   bool json = false;
   std::string length_unit = "mm";
-  std::uint64_t mc_trials = 1000000;
+  std::int64_t mc_trials = 1000000;  // signed: "-1" is refused as -1, not wrapped
   std::uint64_t seed = 20261121;
+  const CLI::App* command = nullptr;  // to ask which flags were given
 };
 
+// 10^8 trials take seconds per configuration; more only wastes time (the statistical error of
+// u falls as 1/sqrt(2N): already 0.007 % at 10^8).
+constexpr std::int64_t kMaxTrials = 100000000;
+
 ConversionOptions Options(const ConvertFlags& f) {
+  const CLI::App* c = f.command;
+  if (f.json && f.csv) throw InputError("--csv/--json", "give at most one of them");
+  RefuseIgnored(c, "--length-unit", f.json, "applies to the table and CSV only (JSON is in SI units)");
+  RefuseEmpty(c, "--at-x", f.at_x, "positions with unit, e.g. 10mm,20mm");
+  RefuseEmpty(c, "--mu", f.mu, "a rolling-resistance coefficient, e.g. 0.01");
+  RefuseEmpty(c, "--batch", f.batch, "a CSV file, or - for stdin");
   ConversionOptions o;
   if (UnitFactor(Dimension::kLength, f.length_unit) == 0.0)
     throw InputError("--length-unit", "must be one of " + AcceptedUnits(Dimension::kLength));
   o.length_unit = f.length_unit;
   if (!f.at_x.empty()) o.at_x = ParseQuantityList(f.at_x, Dimension::kLength, "--at-x");
   if (!f.mu.empty()) o.mu = ParseQuantity(f.mu, Dimension::kDimensionless, "--mu");
-  if (f.mc_trials < 100) throw InputError("--mc-trials", "must be at least 100");
-  o.propagation.trials = f.mc_trials;
+  if (f.mc_trials < 100 || f.mc_trials > kMaxTrials)
+    throw InputError("--mc-trials", "must be between 100 and " + std::to_string(kMaxTrials) + " (got " +
+                                        std::to_string(f.mc_trials) + ")");
+  o.propagation.trials = static_cast<std::uint64_t>(f.mc_trials);
   o.propagation.seed = f.seed;
   return o;
 }
@@ -66,7 +80,11 @@ void Run(const ConvertFlags& f) {
   options.verdict = format == OutputFormat::kJson || f.batch.empty();  // only JSON and one setting's table show it
   if (f.batch.empty()) {
     ConvertedRow row;
-    row.result = Convert(ParseConfiguration(FlagSource(f.scene)), options);
+    const Configuration configuration = ParseConfiguration(FlagSource(f.scene));
+    const std::string why = "has no effect: no input has an uncertainty (give one as --u-<name>, e.g. --u-D 0.2mm)";
+    RefuseIgnored(f.command, "--mc-trials", !configuration.HasUncertainty(), why);
+    RefuseIgnored(f.command, "--seed", !configuration.HasUncertainty(), why);
+    row.result = Convert(configuration, options);
     ConversionPrinter printer(std::cout, format, false, f.length_unit, ColumnsOf(*row.result));
     printer.Row(row);
     printer.Finish();
@@ -109,6 +127,7 @@ void AddConvertCommand(CLI::App& app) {
   cmd->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials for the uncertainties")
       ->capture_default_str();
   cmd->add_option("--seed", flags->seed, "Monte Carlo seed (same seed, same numbers)")->capture_default_str();
+  flags->command = cmd;
   cmd->callback([flags] { Run(*flags); });
 }
 

@@ -2,12 +2,15 @@
 //   uphill fit EXP [--json]                       an experiment folder (data/README.md)
 //   uphill fit --xy FILE.csv [--method M] [--json]  arbitrary X-Y data, header X,Y[,uX,uY]
 // `uphill report EXP -o DIR`: the full report (HTML, Markdown, fit.json, figures).
+#include <filesystem>
 #include <iostream>
 
 #include "commands.hpp"
+#include "flag_checks.hpp"
 #include "fit/least_squares_line.hpp"
 #include "fit/robust_line.hpp"
 #include "fit/york_line.hpp"
+#include "io/output_paths.hpp"
 #include "io/xy_table.hpp"
 #include "model/input_error.hpp"
 #include "report/fit_document.hpp"
@@ -22,7 +25,8 @@ struct FitFlags {
   std::string method = "ols";
   bool json = false;
   bool no_rows = false;
-  std::uint64_t mc_trials = 100000;
+  std::int64_t mc_trials = 100000;  // signed: "-1" is refused as -1, not wrapped
+  const CLI::App* command = nullptr;  // to ask which flags were given
   std::string output;
 };
 
@@ -89,7 +93,12 @@ void RunXy(const FitFlags& f) {
 ExperimentAnalysis Analyse(const FitFlags& f, Experiment* keep) {
   *keep = LoadExperiment(f.experiment);
   AnalysisOptions options;
-  options.mc_trials = f.mc_trials;
+  // Per row; 10^7 take about half a second a row. Fewer than 100 give no usable u(X): 0 gave
+  // u_MC = 0 on every row.
+  if (f.mc_trials < 100 || f.mc_trials > 10000000)
+    throw InputError("--mc-trials", "must be between 100 and 10000000 trials per row (got " +
+                                        std::to_string(f.mc_trials) + ")");
+  options.mc_trials = static_cast<std::uint64_t>(f.mc_trials);
   ExperimentAnalysis a = AnalyseExperiment(*keep, options);
   for (const auto& e : a.row_errors) {
     std::cerr << "uphill: " << e << " (row left out)\n";
@@ -119,9 +128,14 @@ void AddFitCommand(CLI::App& app) {
   fit->add_flag("--json", flags->json, "JSON output (see README: stable keys)");
   fit->add_flag("--no-rows", flags->no_rows, "with --xy --json: leave the per-row entries out (\"rows\": [])");
   fit->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials per row for u(X)")->capture_default_str();
-  fit->callback([flags] {
+  fit->callback([flags, fit] {
+    flags->command = fit;
+    RefuseEmpty(fit, "--xy", flags->xy, "a CSV file, or - for stdin");
     if (flags->xy.empty() == flags->experiment.empty())
       throw InputError("fit", "give either an experiment folder or --xy FILE.csv");
+    RefuseIgnored(fit, "--method", flags->xy.empty(), "applies to --xy data only (an experiment gets every fit)");
+    RefuseIgnored(fit, "--mc-trials", !flags->xy.empty(), "applies to an experiment folder only (--xy data has no X to propagate)");
+    RefuseIgnored(fit, "--no-rows", flags->xy.empty() || !flags->json, "applies to --xy with --json only");
     if (!flags->xy.empty()) RunXy(*flags);
     else RunExperiment(*flags);
   });
@@ -131,6 +145,10 @@ void AddFitCommand(CLI::App& app) {
   report->add_option("-o,--output", flags->output, "output folder (created if needed)")->required();
   report->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials per row for u(X)")->capture_default_str();
   report->callback([flags] {
+    OutputPaths outputs;  // checked before any work: never over the experiment's own files
+    outputs.AddInput((std::filesystem::path(flags->experiment) / "experiment.json").string(), "the experiment's");
+    outputs.AddInput((std::filesystem::path(flags->experiment) / "measurements.csv").string(), "the experiment's");
+    outputs.CheckFolder(flags->output, "-o", FitReportFiles());
     Experiment experiment;
     const ExperimentAnalysis a = Analyse(*flags, &experiment);
     WriteFitReport(a, flags->output);

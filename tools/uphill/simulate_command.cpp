@@ -10,6 +10,7 @@
 
 #include "app/simulation.hpp"
 #include "commands.hpp"
+#include "flag_checks.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "scene_flags.hpp"
@@ -24,6 +25,7 @@ struct SimulateFlags {
   std::string method = "auto";
   bool csv = false, json = false;
   std::string length_unit = "mm";
+  const CLI::App* command = nullptr;  // to ask which flags were given
 };
 
 std::string Num(double v) {
@@ -70,6 +72,14 @@ void Run(const SimulateFlags& f) {
   if (UnitFactor(Dimension::kLength, f.length_unit) == 0.0)
     throw InputError("--length-unit", "must be one of " + AcceptedUnits(Dimension::kLength));
   if (f.json && f.csv) throw InputError("--csv/--json", "give at most one of them");
+  const CLI::App* c = f.command;
+  RefuseIgnored(c, "--length-unit", f.json || f.csv, "applies to the table only (CSV and JSON are in SI units)");
+  RefuseEmpty(c, "--x0", f.x0, "the release position with unit, e.g. 120mm");
+  RefuseEmpty(c, "--at-times", f.at_times, "sample times with unit, e.g. 0.1s,150ms");
+  RefuseEmpty(c, "--at-x", f.at_x, "sample positions with unit, e.g. 10mm,20mm");
+  RefuseEmpty(c, "--dt", f.dt, "a time step with unit, e.g. 10ms");
+  RefuseIgnored(c, "--t-end", !Given(c, "--dt"), "applies only with --dt (the samples of --at-times or --at-x are all given)");
+  RefuseEmpty(c, "--t-end", f.t_end, "a time with unit, e.g. 2s");
   const Scene scene = ParseConfiguration(FlagSource(f.scene)).MakeScene();
   if (f.x0.empty()) throw InputError("--x0", "is required (release position, with unit, e.g. --x0 120mm)");
   SimulationRequest request;
@@ -114,6 +124,7 @@ void AddSimulateCommand(CLI::App& app) {
   cmd->add_flag("--json", flags->json, "JSON output (SI; keys in README)");
   cmd->add_option("--length-unit", flags->length_unit, "length unit of the table: mm, cm, m, in")
       ->capture_default_str();
+  flags->command = cmd;
   cmd->callback([flags] { Run(*flags); });
 }
 

@@ -20,6 +20,7 @@
 
 #include "app/tracking_inputs.hpp"
 #include "io/configuration.hpp"
+#include "io/output_paths.hpp"
 #include "model/input_error.hpp"
 #include "vision/camera.hpp"
 #include "vision/track_analysis.hpp"
@@ -54,6 +55,12 @@ Eigen::Vector2d ParsePixel(const std::string& text) {
   }
 }
 
+// Where --analyse writes: the folder of the track CSV.
+std::string AnalysisFolder(const TrackFlags& f) {
+  const std::string folder = std::filesystem::path(f.out).parent_path().string();
+  return folder.empty() ? "." : folder;
+}
+
 void Run(const TrackFlags& f) {
   if (f.camera.empty()) throw InputError("--camera", "is required (the camera file of `uphill calibrate camera`)");
   if (f.scene_file.empty()) throw InputError("--scene", "is required (the scene file of `uphill calibrate scene`)");
@@ -62,6 +69,15 @@ void Run(const TrackFlags& f) {
   const Scene scene = configuration.MakeScene();
   if (scene.body().kind == BodyKind::kDoubleCone)
     throw InputError("--body", "tracking supports a sphere or a spheroid, not a double cone");
+  // Every output checked before any work: never an input, never anything but a regular file.
+  OutputPaths outputs;
+  outputs.AddInput(f.video, "the input video");
+  outputs.AddInput(f.camera, "the camera file");
+  outputs.AddInput(f.scene_file, "the scene file");
+  outputs.CheckFile(f.out, "-o");
+  outputs.CheckFile(f.out + ".json", "-o (its sidecar)");
+  if (!f.overlay.empty()) outputs.CheckFile(f.overlay, "--overlay");
+  if (f.analyse) outputs.CheckFolder(AnalysisFolder(f), "-o (with --analyse)", TrackAnalysisFiles());
   const SceneCalibration calibration = ReadTrackingCalibration(f.camera, f.scene_file);
 
   TrackVideoOptions options;
@@ -105,9 +121,8 @@ void Run(const TrackFlags& f) {
     // The same analysis as `uphill analyse-track OUT [scene flags] -o <OUT's folder>`, default options.
     const TrackAnalysis analysis = AnalyseTrack(ReadTrackFile(f.out), scene);
     std::cout << "\n" << TrackAnalysisTable(analysis);
-    const std::string folder = std::filesystem::path(f.out).parent_path().string();
-    WriteTrackAnalysis(analysis, folder.empty() ? "." : folder);
-    std::cout << "wrote " << (folder.empty() ? "." : folder) << "/track_analysis.json and its figures\n";
+    WriteTrackAnalysis(analysis, AnalysisFolder(f));
+    std::cout << "wrote " << AnalysisFolder(f) << "/track_analysis.json and its figures\n";
   }
 }
 

@@ -101,6 +101,13 @@ StandardisedView ViewFromScans(const LineData& data, const ColumnScan& x, const 
   v.sy = ScaleOf(y.min, y.max, v.y0);
   v.inv_sx = 1.0 / v.sx;
   v.inv_sy = 1.0 / v.sy;
+  // The covariance comes back from the standardised problem multiplied by sx² and sy²: a spread
+  // below 1e-100 would underflow it to 0 (standard errors of inf or NaN).
+  for (const auto& [scale, name] : {std::pair{v.sx, "X"}, std::pair{v.sy, "Y"}})
+    if (scale < kSmallestUncertainty)
+      throw InputError(name, std::string("its values spread over less than 1e-100 (") + ExactText(scale) +
+                                 "): the fit's variances would underflow to 0; give the data in a smaller unit "
+                                 "(larger numbers)");
   if (uy) {
     // u² and 1/u² are monotone in u: the extremes decide. Name the first offending row.
     const auto representable = [](double u) {
@@ -370,6 +377,11 @@ void FinishReport(FitReport& report, const std::vector<std::string>& names,
   const int p = static_cast<int>(values.size());
   report.dof = static_cast<int>(report.n) - p;
   report.exact = report.dof == 0;
+  // The last guard before any output: no inf or NaN leaves a fit. The inputs' bounds
+  // (line_data.hpp) keep every case the tests know finite; a combination they miss is refused.
+  if (!std::isfinite(report.chi2) || !values.allFinite() || !report.covariance.allFinite())
+    throw InputError("rows", "the fit overflows binary64 for these values (chi2 = " + ExactText(report.chi2) +
+                                 "): check for a value typed in the wrong unit, or rescale the data");
   if (report.dof > 0) {
     const double factor = report.chi2 / report.dof;
     report.reduced_chi2 = factor;

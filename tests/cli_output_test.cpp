@@ -1,0 +1,103 @@
+// What the program writes, end to end (issue 11): every output file is whole or absent, even on a
+// full disk or with something in the way; an output never replaces an input or anything that is
+// not a regular file; and the user's environment gets exit status 2 with one line, never 1.
+// Truth: the formats' own ends (an SVG's closing tag, a PNG's IEND chunk, JSON that parses, HTML
+// that closes), the bytes of the inputs before and after, and the exit-code table of README.md.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "cli_test_support.hpp"
+#include "file_test_support.hpp"
+
+namespace uphill {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using testing::RunUphill;
+
+const std::string kSource = UPHILL_SOURCE_DIR;
+const std::string kProgram = UPHILL_PROGRAM;
+
+const auto Slurp = testing::ReadBytes;
+
+// A path for an output folder that does not exist yet.
+fs::path Fresh(const std::string& name) {
+  const fs::path dir = testing::FreshFolder(name);
+  fs::remove(dir);
+  return dir;
+}
+
+// Whether a file the report writes is complete, judged by its format's own end.
+bool Complete(const fs::path& path) {
+  const std::string s = Slurp(path);
+  const std::string ext = path.extension().string();
+  const auto ends_with = [&](const std::string& tail) {
+    const auto end = s.find_last_not_of(" \t\r\n");
+    return end != std::string::npos && end + 1 >= tail.size() && s.compare(end + 1 - tail.size(), tail.size(), tail) == 0;
+  };
+  if (ext == ".svg") return ends_with("</svg>");
+  if (ext == ".png") return s.size() > 20 && s.compare(s.size() - 12, 12, std::string("\0\0\0\0IEND\xae\x42\x60\x82", 12)) == 0;
+  if (ext == ".json") return json::accept(s);
+  if (ext == ".html") return ends_with("</html>");
+  if (ext == ".md" || ext == ".dat" || ext == ".gp") return !s.empty() && s.back() == '\n';
+  return false;
+}
+
+// `uphill report` with the size of any file it may write limited (RLIMIT_FSIZE through the
+// shell's `ulimit -f`, in its blocks), as a full disk would: writes beyond it fail with EFBIG,
+// gnuplot's too (SIGXFSZ ignored, as a full disk sends no signal).
+int ReportWithFileSizeLimit(const fs::path& out, int blocks) {
+  const std::string command = "sh -c 'ulimit -f " + std::to_string(blocks) + "; trap \"\" XFSZ; exec " + kProgram +
+                              " report " + kSource + "/data/series1-fixed-D -o " + out.string() +
+                              " --mc-trials 1000' > /dev/null 2> " + out.string() + ".err";
+  const int raw = std::system(command.c_str());
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+}
+
+TEST(OutputCli, AFullDiskLeavesEveryReportFileWholeOrAbsent) {
+  // Limits from "not even one image fits" to "all but report.html fit" (the report's files are
+  // 1 KiB to ~150 KiB; the sizes of the shell's blocks do not matter, only that the run fails).
+  for (int kib : {8, 30, 80, 120}) {
+    const fs::path out = Fresh("full-" + std::to_string(kib));
+    const int status = ReportWithFileSizeLimit(out, kib);
+    const std::string err = Slurp(out.string() + ".err");
+    EXPECT_EQ(status, 2) << kib << ": " << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    for (const auto& entry : fs::directory_iterator(out)) {
+      const std::string name = entry.path().filename().string();
+      EXPECT_NE(name[0], '.') << kib << " KiB: a temporary was left behind: " << name;
+      EXPECT_TRUE(Complete(entry.path())) << kib << " KiB: " << name << " is half-written";
+    }
+    fs::remove_all(out);
+    fs::remove(out.string() + ".err");
+  }
+}
+
+TEST(OutputCli, AFolderInTheWayOfAFigureIsNamedAndLeavesNoTemporaries) {
+  const fs::path out = Fresh("in-the-way");
+  fs::create_directories(out / "fit_offset.svg");
+  const auto r = RunUphill("report " + kSource + "/data/series1-fixed-D -o " + out.string() + " --mc-trials 1000");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("fit_offset.svg"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("folder"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_directory(out / "fit_offset.svg"));
+  for (const auto& entry : fs::directory_iterator(out)) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_NE(name[0], '.') << "a temporary was left behind: " << name;
+    if (name != "fit_offset.svg") {
+      EXPECT_TRUE(Complete(entry.path())) << name;
+    }
+  }
+  fs::remove_all(out);
+}
+
+}  // namespace
+}  // namespace uphill
