@@ -136,8 +136,8 @@ TEST(ConvertCli, BatchRefusesUnknownColumnsAndEmptyFiles) {
   const auto unknown = RunUphill("convert --batch -", "body,R_mm,L_mm,H_mm,D_mmm\nsphere,1,2,3,4\n");
   EXPECT_EQ(unknown.status, 2);
   EXPECT_EQ(unknown.err,
-            "uphill: <stdin>, row 1, column D_mmm: unknown column (see README.md, 'Batch CSV of "
-            "convert', for the accepted names)\n");
+            "uphill: <stdin>, row 1, column D_mmm: unknown column (see docs/convert.md, 'Batch "
+            "CSV', for the accepted names)\n");
   const auto empty = RunUphill("convert --batch -", "");
   EXPECT_EQ(empty.status, 2);
   EXPECT_EQ(empty.err, "uphill: <stdin>: is empty (expected a header row)\n");

@@ -2,7 +2,7 @@
 // full disk or with something in the way; an output never replaces an input or anything that is
 // not a regular file; and the user's environment gets exit status 2 with one line, never 1.
 // Truth: the formats' own ends (an SVG's closing tag, a PNG's IEND chunk, JSON that parses, HTML
-// that closes), the bytes of the inputs before and after, and the exit-code table of README.md.
+// that closes), the bytes of the inputs before and after, and the exit-code table of docs/exit-codes.md.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -12,6 +12,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
 
 #include "cli_test_support.hpp"
 #include "file_test_support.hpp"
@@ -97,6 +98,68 @@ TEST(OutputCli, AFolderInTheWayOfAFigureIsNamedAndLeavesNoTemporaries) {
     }
   }
   fs::remove_all(out);
+}
+
+// Issue 11: `uphill track` overwrote its input video when -o or --overlay named it (a relative
+// path, "./", a symbolic link), and as root replaced the device /dev/full with a regular file;
+// --overlay into a missing folder failed (exit 1) where -o creates its folder. Truth: the input's
+// bytes before and after, lstat of /dev/full, and docs/exit-codes.md (status 2, one line naming
+// the flag). The clip: tools/make_video (12 frames).
+class TrackOutputCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    clip_ = new fs::path(testing::FreshFolder("track-output-clip"));
+    const std::string command = std::string(UPHILL_MAKE_VIDEO) + " " + clip_->string() +
+                                " --width 480 --height 270 --frames 12 --boards 0 > /dev/null 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0);
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*clip_);
+    delete clip_;
+  }
+  // `uphill track` on the clip in `work` (make_video's apparatus), `outputs` appended.
+  static testing::CommandResult Track(const fs::path& work, const std::string& outputs) {
+    return RunUphill("track " + (work / "clip.mp4").string() + " --camera " + (work / "cam.json").string() +
+                     " --scene " + (work / "scene.json").string() +
+                     " --body sphere --R 25.4mm --L 1000mm --H 100mm --D 150mm --rod-diameter 8mm --quiet " + outputs);
+  }
+  static fs::path Work(const std::string& name) {
+    const fs::path work = testing::FreshFolder(name);
+    for (const char* f : {"clip.mp4", "cam.json", "scene.json"}) fs::copy_file(*clip_ / f, work / f);
+    return work;
+  }
+  static fs::path* clip_;
+};
+fs::path* TrackOutputCli::clip_ = nullptr;
+
+TEST_F(TrackOutputCli, NeverWritesOverItsInputsOrADevice) {
+  const fs::path work = Work("track-inputs");
+  fs::create_symlink(work / "clip.mp4", work / "link.mp4");
+  const std::string video = Slurp(work / "clip.mp4");
+  const std::string w = work.string();
+  for (const std::string& outputs : std::vector<std::string>{
+           "-o " + w + "/clip.mp4", "-o " + w + "/t.csv --overlay " + w + "/./clip.mp4",
+           "-o " + w + "/t.csv --overlay " + w + "/link.mp4", "-o " + w + "/cam.json", "-o /dev/full",
+           "-o " + w + "/t.csv --overlay /dev/full"}) {
+    const auto r = Track(work, outputs);
+    EXPECT_EQ(r.status, 2) << outputs << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    const std::string flag = outputs.find("--overlay") != std::string::npos ? "--overlay" : "-o";
+    EXPECT_EQ(r.err.rfind("uphill: " + flag + " ", 0), 0u) << r.err;
+    EXPECT_EQ(Slurp(work / "clip.mp4"), video) << outputs << ": the input video was changed";
+  }
+  EXPECT_TRUE(fs::is_character_file(fs::symlink_status("/dev/full")));
+  EXPECT_FALSE(fs::exists(work / "t.csv"));  // refused before any work
+  fs::remove_all(work);
+}
+
+TEST_F(TrackOutputCli, OverlayAndTrackGoIntoFoldersThatDoNotExistYet) {
+  const fs::path work = Work("track-new-folders");
+  const auto r = Track(work, "-o " + (work / "out/t.csv").string() + " --overlay " + (work / "shots/o.mp4").string());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_GT(fs::file_size(work / "out/t.csv"), 0u);
+  EXPECT_GT(fs::file_size(work / "shots/o.mp4"), 0u);
+  fs::remove_all(work);
 }
 
 }  // namespace

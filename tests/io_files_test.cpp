@@ -1,6 +1,7 @@
-// Writing files safely (src/io/atomic_file.hpp, contained_directory.hpp): only regular files are
-// ever replaced, a failed write leaves the target as it was, and a contained folder never follows
-// a link at any level nor lets "..", "." or an absolute path out. Truth: the file system's own
+// Writing files safely (src/io/atomic_file.hpp, contained_directory.hpp, output_paths.hpp): only
+// regular files are ever replaced, a failed write leaves the target as it was, a contained folder
+// never follows a link at any level nor lets "..", "." or an absolute path out, and an output is
+// never an input however it is spelled. Truth: the file system's own
 // answer (lstat, the bytes) before and after each call.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -9,9 +10,11 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "io/atomic_file.hpp"
 #include "io/contained_directory.hpp"
+#include "io/output_paths.hpp"
 #include "model/input_error.hpp"
 #include "file_test_support.hpp"
 
@@ -102,6 +105,57 @@ TEST(ContainedDirectory, ReadsAndWritesInsideAndRefusesLinksAtAnyLevel) {
   for (const auto& e : fs::directory_iterator(root)) EXPECT_NE(e.path().filename().string().rfind(".stage-", 0), 0u);
   fs::remove_all(root);
   fs::remove_all(outside);
+}
+
+// Issue 11: `track --overlay` naming the input video (relative, "./", through a link) overwrote
+// the recording. The truth is the file system's identity of the files (device and inode): every
+// spelling of the input is refused, naming the flag and the input; other files are allowed.
+TEST(OutputPaths, AnOutputIsNeverAnInputHoweverItIsSpelled) {
+  const fs::path dir = FreshFolder("output-paths");
+  fs::create_directories(dir / "sub");
+  std::ofstream(dir / "clip.mp4") << "recording";
+  fs::create_symlink(dir / "clip.mp4", dir / "link.mp4");
+  fs::create_directory_symlink(dir, dir / "sub" / "up");
+  fs::create_hard_link(dir / "clip.mp4", dir / "hard.mp4");
+  const std::string base = dir.string();
+  OutputPaths outputs;
+  outputs.AddInput(base + "/clip.mp4", "the input video");
+  for (const std::string& spelling : std::vector<std::string>{base + "/clip.mp4", base + "/./clip.mp4", base + "/sub/../clip.mp4",
+                                      base + "/link.mp4", base + "/sub/up/clip.mp4", base + "/hard.mp4"}) {
+    try {
+      outputs.CheckFile(spelling, "--overlay");
+      ADD_FAILURE() << spelling << " was allowed";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind("--overlay " + spelling + ": is the input video", 0), 0u) << what;
+    }
+  }
+  EXPECT_NO_THROW(outputs.CheckFile(base + "/overlay.mp4", "--overlay"));
+  // Two outputs of one command that are the same file would overwrite each other.
+  EXPECT_THROW(outputs.CheckFile(base + "/./overlay.mp4", "-o"), InputError);
+  EXPECT_EQ(Slurp(dir / "clip.mp4"), "recording");
+  fs::remove_all(dir);
+}
+
+// Issue 11: as root, `-o /dev/full` replaced the device node with a regular file. Only a regular
+// file is ever replaced; a file where a folder is needed is named. Truth: lstat before and after.
+TEST(OutputPaths, OnlyRegularFilesAndFoldersThatCanBeMade) {
+  const fs::path dir = FreshFolder("output-kinds");
+  std::ofstream(dir / "afile") << "x";
+  fs::create_directories(dir / "folder");
+  OutputPaths outputs;
+  EXPECT_THROW(outputs.CheckFile("/dev/full", "-o"), InputError);
+  EXPECT_TRUE(fs::is_character_file(fs::symlink_status("/dev/full")));
+  EXPECT_THROW(outputs.CheckFile((dir / "folder").string(), "-o"), InputError);
+  EXPECT_THROW(outputs.CheckFile((dir / "afile" / "x.csv").string(), "-o"), InputError);
+  EXPECT_THROW(outputs.CheckFolder((dir / "afile").string(), "-o", {"report.md"}), InputError);
+  // A missing folder is fine (it is made when the output is written), and made by CreateFolders.
+  EXPECT_NO_THROW(outputs.CheckFile((dir / "new" / "deeper" / "x.csv").string(), "-o"));
+  EXPECT_FALSE(fs::exists(dir / "new"));
+  OutputPaths::CreateFolders((dir / "new" / "deeper").string());
+  EXPECT_TRUE(fs::is_directory(dir / "new" / "deeper"));
+  EXPECT_THROW(OutputPaths::CreateFolders((dir / "afile" / "below").string()), EnvironmentError);
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -153,6 +153,30 @@ TEST_F(ServerTest, EditsDeletesAndUndoes) {
   EXPECT_EQ(LoadExperiment(dir_.string()).rows.size(), 2u);
 }
 
+// Issue 11: making D a constant of the apparatus silently dropped the measured D column from
+// measurements.csv (the fit then used the constant for every row). Truth: the rows as entered,
+// read back from the files by the analysis' own reader (LoadExperiment).
+TEST_F(ServerTest, MakingAMeasuredQuantityAConstantIsRefused) {
+  Create();
+  Add(Row("t1", 150, 392));
+  const json s = Add(Row("t2", 200, 292));
+  json constant_d = ExperimentMetadata();
+  constant_d["apparatus"]["D"] = "175 mm";
+  auto [status, body] = Send("PUT", "/api/experiment", {{"version", s["version"]}, {"experiment", constant_d}, {"unit", "mm"}});
+  EXPECT_EQ(status, 422) << body.dump();
+  EXPECT_EQ(body["field"], "apparatus.D") << body.dump();
+  EXPECT_NE(body["error"].get<std::string>().find("2 row(s) have a measured D"), std::string::npos) << body.dump();
+  json angles = ExperimentMetadata();
+  angles["apparatus"] = {{"theta", "1 deg"}, {"alpha", "60 deg"}};
+  EXPECT_EQ(Send("PUT", "/api/experiment", {{"version", s["version"]}, {"experiment", angles}, {"unit", "mm"}}).first, 422);
+  EXPECT_EQ(State()["columns"], json({"L", "D", "Y"}));
+  const Experiment e = LoadExperiment(dir_.string());
+  ASSERT_EQ(e.rows.size(), 2u);
+  EXPECT_TRUE(e.rows[1].error.empty()) << e.rows[1].error;
+  ASSERT_TRUE(e.rows[1].configuration.has_value());
+  EXPECT_NEAR(e.rows[1].configuration->D.value, 0.200, 1e-12);
+}
+
 TEST_F(ServerTest, StaleVersionIsAConflictWithTheCurrentState) {
   Create();
   const json s = Add(Row("t1", 150, 392));

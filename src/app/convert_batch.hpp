@@ -1,5 +1,5 @@
 // ConvertBatch: `uphill convert --batch`: every row of a CSV file (or stdin, or a stream) one
-// configuration (README, "Batch CSV of convert"), the command's flags supplying defaults for
+// configuration (docs/convert.md, "Batch CSV"), the command's flags supplying defaults for
 // absent columns and empty cells.
 //
 // The file is read record by record (CsvRecords, io/csv_records.hpp: bounded memory, no copy of

@@ -36,7 +36,7 @@ constexpr double kAm = 0.015875, kBm = 0.0254;
 class TextFile {
  public:
   explicit TextFile(const fs::path& path) : file_(std::fopen(path.c_str(), "wb")), path_(path) {
-    if (!file_) throw std::runtime_error("cannot write " + path.string());
+    if (!file_) throw EnvironmentError("cannot write " + path.string());
     buffer_.reserve(kBlock + 256);
   }
   ~TextFile() { Close(); }
@@ -56,7 +56,7 @@ class TextFile {
   void Close() {
     if (!file_) return;
     Flush();
-    if (std::fclose(file_) != 0) throw std::runtime_error("cannot write " + path_.string());
+    if (std::fclose(file_) != 0) throw EnvironmentError("cannot write " + path_.string());
     file_ = nullptr;
   }
 
@@ -64,7 +64,7 @@ class TextFile {
   static constexpr std::size_t kBlock = std::size_t{1} << 20;
   void Flush() {
     if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
-      throw std::runtime_error("cannot write " + path_.string());
+      throw EnvironmentError("cannot write " + path_.string());
     written_ += buffer_.size();
     buffer_.clear();
   }

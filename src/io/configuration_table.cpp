@@ -24,7 +24,7 @@ ConfigurationTable::ConfigurationTable(const std::vector<std::string>& header, c
     if (base == "note") continue;
     if (std::find(known.begin(), known.end(), base) == known.end())
       throw InputError(Context(source_, 1, header_[i]),
-                       "unknown column (see README.md, 'Batch CSV of convert', for the accepted names)");
+                       "unknown column (see docs/convert.md, 'Batch CSV', for the accepted names)");
     if (!field_column_.emplace(base, static_cast<int>(i)).second)
       throw InputError(Context(source_, 1, header_[i]), "gives '" + base + "' a second time");
   }

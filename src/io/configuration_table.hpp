@@ -1,5 +1,5 @@
 // ConfigurationTable: a CSV table whose rows are configurations (the batch input of
-// `uphill convert`, README "Batch CSV of convert"): columns named by ConfigurationFieldNames(),
+// `uphill convert`, docs/convert.md "Batch CSV"): columns named by ConfigurationFieldNames(),
 // each optionally with a unit suffix (`L_mm`), plus `note` (ignored).
 #pragma once
 

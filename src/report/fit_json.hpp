@@ -1,4 +1,4 @@
-// JSON of fits and analyses (SI units: metres, radians). Documented in README.md, "fit.json".
+// JSON of fits and analyses (SI units: metres, radians). Documented in docs/fit.md, "fit.json".
 //
 // FitToJson(report) is the stable machine interface of `uphill fit --xy … --json`: for a straight
 // line the top-level keys `slope`, `intercept`, `u_slope`, `u_intercept` (the method's primary

@@ -314,6 +314,32 @@ ordered_json ValidateMetadata(const json& j) {
   return out;
 }
 
+namespace {
+
+// A quantity the new experiment.json makes a constant of the apparatus (or unused: the rails
+// given as angles) would drop its column, and every value measured in it, from measurements.csv.
+// Measured data is never dropped: refused while any row has a value in that column.
+void RefuseDroppingMeasuredColumns(const ExperimentState& state, const ordered_json& metadata) {
+  ExperimentState next;
+  next.metadata = metadata;
+  const std::vector<std::string> kept = next.Columns();
+  for (const std::string& q : RowQuantities()) {
+    const std::string base = q.rfind("u_", 0) == 0 ? q.substr(2) : q;
+    if (std::find(kept.begin(), kept.end(), base) != kept.end()) continue;
+    const auto measured = std::count_if(state.rows.begin(), state.rows.end(),
+                                        [&](const Row& r) { return !r.Value(q).empty(); });
+    if (measured == 0) continue;
+    const bool constant = metadata.contains("apparatus") && metadata.at("apparatus").contains(base);
+    throw InputError(constant ? "apparatus." + base : "apparatus",
+                     (constant ? std::string("would make ") + base + " a constant"
+                               : std::string("gives the rails as angles, which leaves no column for ") + base) +
+                         ", but " + std::to_string(measured) + " row(s) have a measured " + q +
+                         ": clear those cells first (measured data is never dropped)");
+  }
+}
+
+}  // namespace
+
 json ApplyOperation(ExperimentState& state, const json& op) {
   const std::string type = op.at("type").get<std::string>();
   if (type == "snapshot") {
@@ -328,7 +354,9 @@ json ApplyOperation(ExperimentState& state, const json& op) {
       throw InputError("unit", "cannot change once rows exist (their numbers were typed in " + state.unit + ")");
     json inverse = state.exists ? json{{"type", "meta"}, {"experiment", state.metadata}, {"unit", state.unit}}
                                 : json{{"type", "snapshot"}, {"state", ToJson(state)}};
-    state.metadata = Canonical(op.at("experiment"));
+    ordered_json metadata = Canonical(op.at("experiment"));
+    RefuseDroppingMeasuredColumns(state, metadata);
+    state.metadata = std::move(metadata);
     state.unit = unit;
     state.exists = true;
     return inverse;

@@ -1,7 +1,7 @@
 // Server: the HTTP side of `uphill serve` (cpp-httplib). Serves the page (page_assets.hpp, all
 // embedded: it works offline) and a JSON API over one ExperimentStore.
 //
-// API (JSON bodies; lengths as plain-number text in the experiment's unit, see README.md):
+// API (JSON bodies; lengths as plain-number text in the experiment's unit, see docs/serve.md, "The JSON API"):
 //   GET    /api/state                     the state (below)
 //   PUT    /api/experiment                {version, experiment, unit}: create or change
 //   POST   /api/rows                      {version, row, index?}: add a row

@@ -11,6 +11,7 @@
 
 #include "internal/child_process.hpp"
 #include "internal/content_key.hpp"
+#include "model/input_error.hpp"
 
 namespace uphill {
 
@@ -83,8 +84,8 @@ PovrayRun RunPovray(const std::string& scene_text, cv::Size size, int frames, co
   run.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   run.cpu_seconds = status.cpu_seconds;
   if (!status.started)
-    throw std::runtime_error("cannot run '" + options.program +
-                             "': POV-Ray is needed for this footage (Debian package povray; scripts/install-deps.sh)");
+    throw EnvironmentError("cannot run '" + options.program +
+                           "': POV-Ray is needed for this footage (Debian package povray; scripts/install-deps.sh)");
   if (!status.ok())
     throw std::runtime_error("POV-Ray failed on " + (dir / "shot.pov").string() + " (exit " +
                              std::to_string(status.exit_code) + ", signal " + std::to_string(status.signal) +

@@ -8,8 +8,8 @@
 // deterministic, so that a small window re-rendered later matches the full picture), and one
 // animation frame per picture (+KFI1 +KFF n; the scene switches on frame_number).
 //
-// Errors: std::runtime_error when povray is missing (naming the package), fails (with the last
-// lines of its log, which stays in work_dir/shot.log), or writes no picture.
+// Errors: EnvironmentError when povray is missing (naming the package); std::runtime_error when
+// it fails (with the last lines of its log, which stays in work_dir/shot.log) or writes no picture.
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "internal/child_process.hpp"
+#include "model/input_error.hpp"
 
 namespace uphill {
 
@@ -69,8 +70,8 @@ VideoEncoder::VideoEncoder(const std::string& path, cv::Size size, const VideoEn
   argv.push_back(m.temporary);
   m.child = std::make_unique<internal::ChildInput>(argv, m.log);
   if (!m.child->started())
-    throw std::runtime_error("cannot run '" + s.program +
-                             "': the footage is encoded with ffmpeg (Debian package ffmpeg; scripts/install-deps.sh)");
+    throw EnvironmentError("cannot run '" + s.program +
+                           "': the footage is encoded with ffmpeg (Debian package ffmpeg; scripts/install-deps.sh)");
 }
 
 VideoEncoder::~VideoEncoder() {

@@ -39,7 +39,7 @@ struct VideoEncoderSettings {
 
 class VideoEncoder {
  public:
-  // Starts ffmpeg. Throws std::runtime_error when it cannot be started.
+  // Starts ffmpeg. Throws EnvironmentError when it cannot be started (not installed).
   VideoEncoder(const std::string& path, cv::Size size, const VideoEncoderSettings& settings);
   ~VideoEncoder();  // an unfinished file is removed
   VideoEncoder(const VideoEncoder&) = delete;

@@ -1,7 +1,7 @@
 // The subcommands of the `uphill` program. Each lives in its own file and adds itself to the
 // application here; main.cpp only wires them together and maps errors to exit codes.
 //
-// Exit codes (documented in README.md): 0 success; 1 internal error; 2 bad input (a flag, a
+// Exit codes (documented in docs/exit-codes.md): 0 success; 1 internal error; 2 bad input (a flag, a
 // file, a row or a column), with a one-line message naming it and the rule broken.
 #pragma once
 

@@ -121,7 +121,7 @@ void AddConvertCommand(CLI::App& app) {
   cmd->add_option("--at-x", flags->at_x, "positions for the path, comma-separated, with unit");
   cmd->add_option("--mu", flags->mu, "rolling-resistance coefficient (rest band where |dz/dx| <= mu)");
   cmd->add_flag("--csv", flags->csv, "CSV output (units named in the header)");
-  cmd->add_flag("--json", flags->json, "JSON output (SI units; see README)");
+  cmd->add_flag("--json", flags->json, "JSON output (SI units; keys in docs/convert.md)");
   cmd->add_option("--length-unit", flags->length_unit, "length unit of table and CSV: mm, cm, m, in")
       ->capture_default_str();
   cmd->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials for the uncertainties")

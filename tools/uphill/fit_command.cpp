@@ -125,7 +125,7 @@ void AddFitCommand(CLI::App& app) {
   fit->add_option("experiment", flags->experiment, "experiment folder (experiment.json + measurements.csv)");
   fit->add_option("--xy", flags->xy, "CSV with header X,Y and optionally uX,uY (plain numbers, same units)");
   fit->add_option("--method", flags->method, "with --xy: ols | wls | york | robust")->capture_default_str();
-  fit->add_flag("--json", flags->json, "JSON output (see README: stable keys)");
+  fit->add_flag("--json", flags->json, "JSON output (stable keys: docs/fit.md)");
   fit->add_flag("--no-rows", flags->no_rows, "with --xy --json: leave the per-row entries out (\"rows\": [])");
   fit->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials per row for u(X)")->capture_default_str();
   fit->callback([flags, fit] {

@@ -121,7 +121,7 @@ void AddSimulateCommand(CLI::App& app) {
   cmd->add_option("--t-end", flags->t_end, "with --dt: stop at this time (needed when the motion never ends)");
   cmd->add_option("--method", flags->method, "quadrature, ode or auto (ode when --mu > 0, or --v0 != 0 for a spheroid on rods)")->capture_default_str();
   cmd->add_flag("--csv", flags->csv, "CSV output (SI, units in the header)");
-  cmd->add_flag("--json", flags->json, "JSON output (SI; keys in README)");
+  cmd->add_flag("--json", flags->json, "JSON output (SI; keys in docs/simulate.md)");
   cmd->add_option("--length-unit", flags->length_unit, "length unit of the table: mm, cm, m, in")
       ->capture_default_str();
   flags->command = cmd;
