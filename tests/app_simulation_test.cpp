@@ -3,6 +3,9 @@
 // paper_fig4_b_over_a_1.6 in the 60-digit reference (x at given t, t at given x, t to x_max).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "app/simulation.hpp"
 #include "model/input_error.hpp"
 #include "reference_cases.hpp"
@@ -91,6 +94,51 @@ TEST(Simulate, ErrorsNameTheOption) {
   r.method = SimulationMethod::kAuto;
   r.x0 = -1.0;
   EXPECT_EQ(error(r).rfind("--x0: ", 0), 0u);
+}
+
+// Issue 11: `simulate --method ode --v0 1e20m/s` failed with an internal error from a root solver
+// (then a NaN end time in the message); --v0 1e300 m/s printed v = inf. The contract
+// (app/simulation.hpp: |v0| <= kFastestV0, g in (0, kLargestG], mu in [0, kLargestMu]) is the
+// truth: outside it, an InputError naming the flag and no number that is not finite; at its edge,
+// a finite answer.
+TEST(Simulate, RefusesSpeedsAndAccelerationsBeyondTheApparatus) {
+  SimulationRequest r;
+  r.x0 = Release().at("x0");
+  r.at_times = {0.0};
+  const auto error = [&](SimulationRequest q) {
+    try {
+      Simulate(ReleaseScene(), q);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  for (const double v0 : {1e20, -1e20, 1e300, kFastestV0 * 1.01, std::numeric_limits<double>::infinity(),
+                          std::numeric_limits<double>::quiet_NaN()}) {
+    for (const SimulationMethod method : {SimulationMethod::kOde, SimulationMethod::kAuto}) {
+      SimulationRequest q = r;
+      q.v0 = v0;
+      q.method = method;
+      const std::string e = error(q);
+      EXPECT_EQ(e.rfind("--v0: must be at most 1000 m/s in size", 0), 0u) << v0 << ": " << e;
+    }
+  }
+  for (const double g : {0.0, -1.0, 1e300, std::numeric_limits<double>::quiet_NaN()}) {
+    SimulationRequest q = r;
+    q.g = g;
+    EXPECT_EQ(error(q).rfind("--g: ", 0), 0u) << g;
+  }
+  SimulationRequest q = r;
+  q.mu = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(error(q).rfind("--mu: ", 0), 0u);
+  // At the edge the motion still answers in finite numbers.
+  q = r;
+  q.v0 = kFastestV0;
+  q.method = SimulationMethod::kOde;
+  const Simulation s = Simulate(ReleaseScene(), q);
+  ASSERT_EQ(s.samples.size(), 1u);
+  EXPECT_TRUE(std::isfinite(s.samples[0].v));
+  EXPECT_TRUE(std::isfinite(s.samples[0].x));
 }
 
 }  // namespace

@@ -42,8 +42,14 @@ Motion MakeMotion(const Scene& scene, double x0, const MotionOptions& o) {
 }  // namespace
 
 Simulation Simulate(const Scene& scene, const SimulationRequest& request) {
-  if (!(request.g > 0.0)) throw InputError("--g", "must be > 0");
-  if (!(request.mu >= 0.0)) throw InputError("--mu", "must be >= 0");
+  // The ranges the motion answers for: a ball on a lab's rails. Far outside them the integrator's
+  // steps and the quadrature's end time lose every digit (--v0 1e20 m/s gave a NaN end time).
+  if (!(request.g > 0.0 && request.g <= kLargestG))
+    throw InputError("--g", "must be > 0 and at most " + Short(kLargestG) + " m/s2 (got " + Short(request.g) + " m/s2)");
+  if (!(request.mu >= 0.0 && request.mu <= kLargestMu))
+    throw InputError("--mu", "must be between 0 and " + Short(kLargestMu) + " (got " + Short(request.mu) + ")");
+  if (!(std::abs(request.v0) <= kFastestV0))
+    throw InputError("--v0", "must be at most " + Short(kFastestV0) + " m/s in size (got " + Short(request.v0) + " m/s)");
   Simulation s;
   s.options.v0 = request.v0;
   s.options.g = request.g;

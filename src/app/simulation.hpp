@@ -21,11 +21,17 @@ namespace uphill {
 // resistance μ > 0, or an initial speed for a spheroid on rods), else the quadrature.
 enum class SimulationMethod { kAuto, kQuadrature, kOde };
 
+// The ranges Simulate answers for (a ball on a lab's rails); outside them it throws InputError
+// naming the flag. Far beyond them the ODE's steps and the end time lose every digit.
+inline constexpr double kFastestV0 = 1e3;  // m/s, |v0|
+inline constexpr double kLargestG = 1e3;   // m/s²
+inline constexpr double kLargestMu = 10;   // slope threshold
+
 struct SimulationRequest {
   double x0 = 0;   // release position of the centre, m
-  double v0 = 0;   // initial speed of the centre, m/s, signed (+ away from O)
-  double g = 9.80665;  // m/s², > 0
-  double mu = 0;   // rolling resistance (slope threshold), >= 0
+  double v0 = 0;   // initial speed of the centre, m/s, signed (+ away from O), |v0| <= kFastestV0
+  double g = 9.80665;  // m/s², in (0, kLargestG]
+  double mu = 0;   // rolling resistance (slope threshold), in [0, kLargestMu]
   SimulationMethod method = SimulationMethod::kAuto;
   // Exactly one sampling: times (s, >= 0, within the motion), positions (m, reached by the
   // motion; each adds its passage event), or every dt (s, > 0) up to t_end (s; default: the end

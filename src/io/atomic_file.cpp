@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "internal/file_kind.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill {
@@ -28,13 +29,7 @@ std::string Shown(const std::string& directory_name, const std::string& name) {
 std::string ObstacleAt(int directory_fd, const std::string& name) {
   struct stat st {};
   if (::fstatat(directory_fd, name.c_str(), &st, AT_SYMLINK_NOFOLLOW) != 0) return "";
-  if (S_ISREG(st.st_mode)) return "";
-  if (S_ISDIR(st.st_mode)) return "a folder";
-  if (S_ISLNK(st.st_mode)) return "a symbolic link";
-  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) return "a device";
-  if (S_ISFIFO(st.st_mode)) return "a named pipe";
-  if (S_ISSOCK(st.st_mode)) return "a socket";
-  return "not a regular file";
+  return internal::FileKindName(st.st_mode);
 }
 
 void RefuseObstacle(int directory_fd, const std::string& shown, const std::string& name) {

@@ -7,21 +7,13 @@
 #include <cstring>
 #include <filesystem>
 
+#include "internal/file_kind.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string KindOf(const struct stat& st) {
-  if (S_ISDIR(st.st_mode)) return "a folder";
-  if (S_ISLNK(st.st_mode)) return "a symbolic link";
-  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) return "a device";
-  if (S_ISFIFO(st.st_mode)) return "a named pipe";
-  if (S_ISSOCK(st.st_mode)) return "a socket";
-  return "not a regular file";
-}
 
 // "out/x.csv" → "out"; "x.csv" → "."
 std::string FolderOf(const std::string& path) {
@@ -73,7 +65,7 @@ void OutputPaths::CheckFile(const std::string& path, const std::string& flag) {
                                       " (the same file): an output never replaces an input; write elsewhere");
   struct stat st {};
   if (::lstat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
-    throw InputError(context, "is " + KindOf(st) + ", not a regular file: never replaced (write to a file)");
+    throw InputError(context, "is " + internal::FileKindName(st.st_mode) + ", not a regular file: never replaced (write to a file)");
   CheckWritableFolder(FolderOf(path), context);
   std::error_code ec;
   const std::string resolved = fs::weakly_canonical(fs::absolute(path), ec).string();
