@@ -15,6 +15,7 @@
 #include "io/atomic_file.hpp"
 #include "io/contained_directory.hpp"
 #include "io/output_paths.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 #include "file_test_support.hpp"
 

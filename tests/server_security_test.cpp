@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "io/experiment.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 #include "server/experiment_store.hpp"
 #include "server/journal.hpp"

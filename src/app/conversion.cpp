@@ -6,6 +6,7 @@
 
 #include "io/units.hpp"
 #include "model/input_error.hpp"
+#include "model/length_range.hpp"
 #include "model/number_text.hpp"
 
 namespace uphill {

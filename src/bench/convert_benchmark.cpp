@@ -19,6 +19,7 @@
 #include "bench/synthetic_data.hpp"
 #include "model/number_text.hpp"
 #include "model/batch_convert.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 #include "model/propagation.hpp"
 

@@ -19,6 +19,7 @@
 #include "fit/least_squares_line.hpp"
 #include "fit/robust_line.hpp"
 #include "fit/york_line.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 #include "oracle/friction_reference.hpp"
 #include "oracle/line_references.hpp"

@@ -19,6 +19,7 @@
 #include "bench/support.hpp"
 #include "bench/synthetic_data.hpp"
 #include "io/csv_records.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 #include "oracle/line_references.hpp"
 

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill::bench {

@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "internal/file_kind.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill {

@@ -4,6 +4,7 @@
 
 #include "io/units.hpp"
 #include "model/input_error.hpp"
+#include "model/length_range.hpp"
 
 namespace uphill {
 namespace {

@@ -16,6 +16,7 @@
 #include <filesystem>
 
 #include "io/atomic_file.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill {

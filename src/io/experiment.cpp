@@ -7,6 +7,7 @@
 #include "io/csv_table.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
+#include "model/length_range.hpp"
 
 namespace uphill {
 namespace {

@@ -1,4 +1,5 @@
 #include "model/input_error.hpp"
+#include "model/length_range.hpp"
 
 #include <cmath>
 #include <sstream>

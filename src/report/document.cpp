@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill {

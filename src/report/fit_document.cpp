@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "io/atomic_file.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 #include "report/analysis_figures.hpp"
 #include "report/fit_json.hpp"

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "io/atomic_file.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill {

@@ -12,6 +12,7 @@
 #include <filesystem>
 
 #include "io/experiment_folder.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 #include "server/journal.hpp"
 

@@ -8,6 +8,7 @@
 #include "io/contained_directory.hpp"
 #include "io/experiment.hpp"
 #include "io/utf8.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 #include "report/analysis.hpp"
 #include "report/fit_document.hpp"

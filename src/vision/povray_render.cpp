@@ -11,6 +11,7 @@
 
 #include "internal/child_process.hpp"
 #include "internal/content_key.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill {

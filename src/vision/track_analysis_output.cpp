@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "io/atomic_file.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
 

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "internal/child_process.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill {

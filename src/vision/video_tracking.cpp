@@ -17,6 +17,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/output_paths.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 #include "vision/library_logs.hpp"
 

@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 #include "self_documentation.hpp"
 #include "vision_program.hpp"
