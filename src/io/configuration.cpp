@@ -1,6 +1,7 @@
 #include "io/configuration.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "io/units.hpp"
 #include "model/input_error.hpp"
@@ -214,6 +215,10 @@ std::optional<Dimension> NumericFieldDimension(std::string_view name) {
 }
 
 bool SetNumericField(Configuration& c, std::string_view name, double si) {
+  // A length outside the model's range (model/length_range.hpp): the full parse names it.
+  if (NumericFieldDimension(name) == Dimension::kLength && si != 0.0 &&
+      !(std::abs(si) >= kShortestModelLength && std::abs(si) <= kLongestModelLength))
+    return false;
   const bool is_u = name.rfind("u_", 0) == 0;
   if (is_u) {
     name.remove_prefix(2);
