@@ -16,6 +16,7 @@
 
 #include "cli_test_support.hpp"
 #include "file_test_support.hpp"
+#include "tiny_clip_suite.hpp"
 
 namespace uphill {
 namespace {
@@ -105,18 +106,8 @@ TEST(OutputCli, AFolderInTheWayOfAFigureIsNamedAndLeavesNoTemporaries) {
 // --overlay into a missing folder failed (exit 1) where -o creates its folder. Truth: the input's
 // bytes before and after, lstat of /dev/full, and docs/exit-codes.md (status 2, one line naming
 // the flag). The clip: tools/make_video (12 frames).
-class TrackOutputCli : public ::testing::Test {
+class TrackOutputCli : public testing::TinyClipSuite {
  protected:
-  static void SetUpTestSuite() {
-    clip_ = new fs::path(testing::FreshFolder("track-output-clip"));
-    const std::string command = std::string(UPHILL_MAKE_VIDEO) + " " + clip_->string() +
-                                " --width 480 --height 270 --frames 12 --boards 0 > /dev/null 2>&1";
-    ASSERT_EQ(std::system(command.c_str()), 0);
-  }
-  static void TearDownTestSuite() {
-    fs::remove_all(*clip_);
-    delete clip_;
-  }
   // `uphill track` on the clip in `work` (make_video's apparatus), `outputs` appended.
   static testing::CommandResult Track(const fs::path& work, const std::string& outputs) {
     return RunUphill("track " + (work / "clip.mp4").string() + " --camera " + (work / "cam.json").string() +
@@ -125,12 +116,10 @@ class TrackOutputCli : public ::testing::Test {
   }
   static fs::path Work(const std::string& name) {
     const fs::path work = testing::FreshFolder(name);
-    for (const char* f : {"clip.mp4", "cam.json", "scene.json"}) fs::copy_file(*clip_ / f, work / f);
+    CopyClipInto(work);
     return work;
   }
-  static fs::path* clip_;
 };
-fs::path* TrackOutputCli::clip_ = nullptr;
 
 TEST_F(TrackOutputCli, NeverWritesOverItsInputsOrADevice) {
   const fs::path work = Work("track-inputs");

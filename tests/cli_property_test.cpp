@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "file_test_support.hpp"
+#include "tiny_clip_suite.hpp"
 
 namespace uphill {
 namespace {
@@ -492,27 +493,13 @@ TEST(CliProperty, CalibrateTargetAndScene) {
 }
 
 // The tiny clip for `track`, made once (tools/make_video).
-class TrackProperty : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    clip_ = new fs::path(testing::FreshFolder("property-track-clip"));
-    const std::string command = std::string(UPHILL_MAKE_VIDEO) + " " + clip_->string() +
-                                " --width 480 --height 270 --frames 12 --boards 0 > /dev/null 2>&1";
-    ASSERT_EQ(std::system(command.c_str()), 0);
-  }
-  static void TearDownTestSuite() {
-    fs::remove_all(*clip_);
-    delete clip_;
-  }
-  static fs::path* clip_;
-};
-fs::path* TrackProperty::clip_ = nullptr;
+class TrackProperty : public testing::TinyClipSuite {};
 
 TEST_F(TrackProperty, Track) {
   Draw d(9);
   for (int i = 0, n = Runs(8); i < n; ++i) {
     const fs::path work = Work("track");
-    for (const char* f : {"clip.mp4", "cam.json", "scene.json"}) fs::copy_file(*clip_ / f, work / f);
+    CopyClipInto(work);
     std::vector<Arg> a = {{"", "clip.mp4"}, {"--camera", "cam.json"}, {"--scene", "scene.json"}};
     // The clip's own scene (make_video's default apparatus), sometimes with a flag drawn.
     std::vector<Arg> scene = {{"--body", "sphere"}, {"--R", "25.4mm"}, {"--L", "1000mm"}, {"--H", "100mm"},
