@@ -304,12 +304,8 @@ TEST_F(SecurityTest, IdleConnectionsDoNotHoldUpOtherClients) {
   // 40 connections that never send anything (cpp-httplib's own pool of 8 threads stalled here).
   std::vector<int> idle;
   for (int i = 0; i < 40; ++i) {
-    const int s = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(static_cast<uint16_t>(port_));
-    ::inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
-    ASSERT_EQ(::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+    const int s = testing::ConnectLoopback(port_);
+    ASSERT_GE(s, 0);
     idle.push_back(s);
   }
   std::this_thread::sleep_for(100ms);
@@ -333,12 +329,8 @@ class ShortDeadlineTest : public ServerFixture {
 
 TEST_F(ShortDeadlineTest, ASlowClientIsCutOffAtTheDeadline) {
   Create();
-  const int s = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(static_cast<uint16_t>(port_));
-  ::inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
-  ASSERT_EQ(::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  const int s = testing::ConnectLoopback(port_);
+  ASSERT_GE(s, 0);
   // One byte every 100 ms: each recv is quick, the request never ends.
   const std::string trickle = "GET /api/state HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa";
   bool closed = false;

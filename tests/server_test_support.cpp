@@ -31,16 +31,23 @@ json Row(const std::string& trial, double D, double Y) {
   return {{"trial", trial}, {"series", "s2"}, {"L", "1165"}, {"D", d}, {"Y", y}, {"note", "ok"}};
 }
 
-std::string RawExchange(int port, const std::string& request, std::chrono::milliseconds timeout) {
+int ConnectLoopback(int port) {
   const int sock = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (sock < 0) return -1;
   sockaddr_in address{};
   address.sin_family = AF_INET;
   address.sin_port = htons(static_cast<uint16_t>(port));
   ::inet_pton(AF_INET, "127.0.0.1", &address.sin_addr);
   if (::connect(sock, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
     ::close(sock);
-    return "";
+    return -1;
   }
+  return sock;
+}
+
+std::string RawExchange(int port, const std::string& request, std::chrono::milliseconds timeout) {
+  const int sock = ConnectLoopback(port);
+  if (sock < 0) return "";
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   std::string answer;
   std::size_t sent = 0;

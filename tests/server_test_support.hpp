@@ -34,6 +34,9 @@ json ExperimentMetadata();
 // 200, 229.1 at 250 (the fall-off 5-8 mm further): Y a little beyond X.
 json Row(const std::string& trial, double D = 150, double Y = 392);
 
+// A TCP connection to 127.0.0.1:port, its descriptor (the caller closes it), or -1.
+int ConnectLoopback(int port);
+
 // Sends raw bytes to 127.0.0.1:port and returns what comes back until the server closes the
 // connection or `timeout` passes ("" if nothing came back).
 std::string RawExchange(int port, const std::string& request, std::chrono::milliseconds timeout);
