@@ -9,21 +9,21 @@
 #include <numbers>
 
 #include "io/units.hpp"
+#include "model/decimal_text.hpp"
 #include "model/number_text.hpp"
 
 namespace uphill::cli {
 namespace {
 
 
-// The longest text of one number below: printf's %.6f of the largest double (309 digits, sign,
-// point, 6 decimals), longer than any %.6g.
-constexpr std::size_t kNumberText = 320;
+// The longest text of one number below (model/decimal_text.hpp): printf's %.6f of the largest
+// double, longer than any %.6g.
+constexpr std::size_t kNumberText = kDecimalTextRoom;
 
-// printf's %.6f and %.6g written at p, which has room for kNumberText characters (std::to_chars
-// with a precision is specified as printf is, and is several times faster: a large batch prints
-// millions of these).
-char* Fixed6(char* p, double v) { return std::to_chars(p, p + kNumberText, v, std::chars_format::fixed, 6).ptr; }
-char* General6(char* p, double v) { return std::to_chars(p, p + kNumberText, v, std::chars_format::general, 6).ptr; }
+// printf's %.6f and %.6g written at p, which has room for kNumberText characters (FixedText and
+// GeneralText give printf's characters several times faster: a large batch prints millions).
+char* Fixed6(char* p, double v) { return FixedText(p, p + kNumberText, v, 6); }
+char* General6(char* p, double v) { return GeneralText(p, p + kNumberText, v, 6); }
 
 char* Copy(char* p, std::string_view s) {
   if (!s.empty()) std::memcpy(p, s.data(), s.size());

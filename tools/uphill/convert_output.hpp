@@ -4,7 +4,7 @@
 //
 // Rows are printed as they come (a batch of any size is never held): JSON as the elements of one
 // array (from each row's ConversionResult), CSV line by line (from each row's ConversionSummary,
-// numbers written with std::to_chars straight into the output buffer); the table holds its first kTableSample rows to size its columns, then
+// numbers written with model/decimal_text.hpp straight into the output buffer); the table holds its first kTableSample rows to size its columns, then
 // prints the rest with those widths (a wider cell shifts its line; an error after the sample, when
 // the sample had none, goes at the end of its line). The optional columns - label, the
 // uncertainties, the rest band, θ0 - are chosen before the first row: for a batch from its header
