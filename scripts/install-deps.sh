@@ -19,6 +19,8 @@ packages=(
   # example's figure (docs/python-example.py, tested too)
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
   librandom123-dev povray ffmpeg
+  # XXH3, the content hash of the experiment's video cache (data/README.md)
+  libxxhash-dev
 )
 # The browser test of `uphill serve` (tests/e2e) runs on node + npm and Debian's chromium. A
 # machine that already has Node (e.g. a newer one from elsewhere) keeps it: Debian's npm would

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "experiment_test_support.hpp"
 #include "io/experiment.hpp"
 #include "model/input_error.hpp"
 
@@ -24,15 +25,6 @@ std::string MakeExperiment(const std::string& name, const std::string& json, con
 
 const char* kJson = R"({"format": "uphill-experiment/1", "body": {"type": "spheroid", "a": "15.875 mm",
   "b": "25.4 mm"}, "apparatus": {"H": "300 mm"}, "uncertainties": {"L": "2 mm", "D": "0.5 mm", "Y": "1.5 mm"}})";
-
-std::string LoadError(const std::string& dir) {
-  try {
-    LoadExperiment(dir);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "loaded";
-}
 
 TEST(Experiment, SampleSeriesLoadCompletely) {
   const Experiment e = LoadExperiment(kSamples + "/series2-fixed-L");
@@ -84,7 +76,7 @@ TEST(Experiment, BadRowsAreNamedAndTheOthersKept) {
 TEST(Experiment, FolderLevelProblemsThrowWithTheFileAndKey) {
   EXPECT_EQ(LoadError("/nonexistent/exp"), "/nonexistent/exp: is not an experiment folder");
   std::string dir = MakeExperiment("fmt", R"({"format": "uphill-experiment/9", "body": {}})", "trial,Y_mm\n");
-  EXPECT_EQ(LoadError(dir), dir + "/experiment.json: format: must be \"uphill-experiment/1\" (got \"uphill-experiment/9\")");
+  EXPECT_EQ(LoadError(dir), dir + "/experiment.json: format: must be \"uphill-experiment/1\" or \"uphill-experiment/2\" (got \"uphill-experiment/9\")");
   dir = MakeExperiment("json", "{not json", "trial,Y_mm\n");
   EXPECT_NE(LoadError(dir).find(dir + "/experiment.json: is not valid JSON"), std::string::npos);
   dir = MakeExperiment("key", R"({"format": "uphill-experiment/1", "body": {"type": "sphere", "R": "1 mm"},
@@ -133,7 +125,7 @@ TEST(FuzzRegression, DeeplyNestedJsonValuesAreRefusedWithoutRecursion) {
       "trial,Y_mm\nt,5\n");
   EXPECT_EQ(LoadError(dir), dir + "/experiment.json: notes: must be a string with a unit, e.g. \"300 mm\" (got an array)");
   dir = MakeExperiment("deep_format", R"({"format": )" + deep + "}", "trial,Y_mm\nt,5\n");
-  EXPECT_EQ(LoadError(dir), dir + "/experiment.json: format: must be \"uphill-experiment/1\" (got an array)");
+  EXPECT_EQ(LoadError(dir), dir + "/experiment.json: format: must be \"uphill-experiment/1\" or \"uphill-experiment/2\" (got an array)");
   dir = MakeExperiment("deep_unused", std::string(R"({"format": "uphill-experiment/1", "body": {"type": "spheroid",)") +
                                           R"( "a": "15.875 mm", "b": "25.4 mm"}, "apparatus": {"H": "300 mm"},)" +
                                           R"( "uncertainties": {"h": )" + deep + "}}",

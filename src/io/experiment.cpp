@@ -1,9 +1,11 @@
 #include "io/experiment.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 
+#include "io/contained_directory.hpp"
 #include "io/csv_table.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
@@ -14,12 +16,16 @@ namespace {
 
 using nlohmann::json;
 
-bool IsColumn(const std::string& name) {
-  const auto& labels = MeasurementLabelColumns();
-  const auto& quantities = MeasurementQuantities();
-  return std::find(labels.begin(), labels.end(), name) != labels.end() ||
-         std::find(quantities.begin(), quantities.end(), name) != quantities.end();
+bool Contains(const std::vector<std::string>& list, const std::string& name) {
+  return std::find(list.begin(), list.end(), name) != list.end();
 }
+
+bool IsColumn(const std::string& name) {
+  return Contains(MeasurementLabelColumns(), name) || Contains(MeasurementVideoColumns(), name) ||
+         Contains(MeasurementQuantities(), name);
+}
+
+std::string NeedsVersion2() { return std::string("needs format ") + kExperimentFormat2; }
 
 // A JSON value for a message: scalars as written, arrays and objects by their type only. Dumping
 // them recursed once per nesting level: a value nested 2·10^5 deep (a 400 KB file) overflowed
@@ -52,21 +58,109 @@ std::string OptionalString(const json& meta, const std::string& key, const std::
   throw InputError(file + ": " + key, "must be a string");
 }
 
+// A path of experiment.json or measurements.csv inside the folder (`context` names where it is).
+std::string ContainedPath(const std::string& text, const std::string& context) {
+  try {
+    SplitContainedPath(text);
+  } catch (const InputError& e) {
+    throw InputError(context, "'" + text + "' " + e.rule());
+  }
+  return text;
+}
+
+// Version 2's keys of experiment.json into `e` (nothing when absent).
+void ReadVideoKeys(const json& meta, const std::string& json_path, Experiment* e) {
+  if (meta.contains("camera"))
+    e->camera = ContainedPath(Text(meta.at("camera"), json_path + ": camera"), json_path + ": camera");
+  if (meta.contains("scenes")) {
+    const json& scenes = meta.at("scenes");
+    if (!scenes.is_object() || scenes.empty())
+      throw InputError(json_path + ": scenes", "must be an object of scene name -> scene file, with at least one");
+    for (const auto& [name, file] : scenes.items()) {
+      const std::string where = json_path + ": scenes." + name;
+      if (name.empty() || name.find_first_of(",\"\r\n") != std::string::npos)
+        throw InputError(where, "a scene name must be non-empty text without commas, quotes or line breaks");
+      e->scenes[name] = ContainedPath(Text(file, where), where);
+    }
+  }
+  if (meta.contains("video_analysis")) {
+    const json& options = meta.at("video_analysis");
+    CheckKeys(options, VideoAnalysisKeys(), json_path + ": video_analysis");
+    VideoAnalysisSettings& v = e->video_analysis;
+    if (options.contains("fit")) {
+      v.fit = Text(options.at("fit"), json_path + ": video_analysis.fit");
+      if (v.fit != "g" && v.fit != "mu")
+        throw InputError(json_path + ": video_analysis.fit",
+                         "must be \"g\" (an effective g) or \"mu\" (rolling resistance), got '" + v.fit + "'");
+    }
+    if (options.contains("u_x")) {
+      const std::string where = json_path + ": video_analysis.u_x";
+      v.u_x = ParseQuantity(Text(options.at("u_x"), where), Dimension::kLength, where);
+      if (!(v.u_x > 0.0) || !std::isfinite(v.u_x))
+        throw InputError(where, "must be > 0 (the standard uncertainty of a tracked position)");
+    }
+    if (options.contains("g")) {
+      const std::string where = json_path + ": video_analysis.g";
+      v.g = ParseQuantity(Text(options.at("g"), where), Dimension::kAcceleration, where);
+      if (!(v.g > 0.0) || !std::isfinite(v.g)) throw InputError(where, "must be > 0");
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<const ExperimentRow*> Experiment::UsableRows() const {
   std::vector<const ExperimentRow*> out;
   for (const auto& r : rows)
-    if (r.error.empty()) out.push_back(&r);
+    if (r.error.empty() && r.HasY()) out.push_back(&r);
   return out;
 }
 
 std::vector<std::string> Experiment::Errors() const {
   std::vector<std::string> out;
   for (const auto& r : rows)
-    if (!r.error.empty()) out.push_back(r.error);
+    if (!r.error.empty()) {
+      out.push_back(r.error);
+    } else if (!r.HasY()) {
+      out.push_back(directory + "/" + kMeasurementsCsvFile + ", row " + std::to_string(r.row) +
+                    ", column Y: is empty and the video '" + r.video +
+                    "' has not been analysed (`uphill report` analyses the videos)");
+    }
   return out;
 }
+
+bool Experiment::HasVideos() const {
+  return std::any_of(rows.begin(), rows.end(), [](const ExperimentRow& r) { return !r.video.empty(); });
+}
+
+namespace {
+
+// The `video` and `scene` cells of a row (version 2) into `row`; InputError naming the cell.
+void ReadVideoCells(const Experiment& e, const CsvTable& table, int row_number, const std::string& video,
+                    const std::string& scene, ExperimentRow* row) {
+  const std::string video_context = CellContext(table, row_number, "video");
+  const std::string scene_context = CellContext(table, row_number, "scene");
+  if (video.empty()) {
+    if (!scene.empty()) throw InputError(scene_context, "names a scene but the row has no video");
+    return;
+  }
+  row->video = ContainedPath(video, video_context);
+  if (e.camera.empty())
+    throw InputError(video_context, "a video needs the camera file: experiment.json has no \"camera\"");
+  if (e.scenes.empty())
+    throw InputError(video_context, "a video needs a scene file: experiment.json has no \"scenes\"");
+  if (scene.empty()) {
+    if (e.scenes.size() != 1)
+      throw InputError(scene_context, "is empty: name one of the " + std::to_string(e.scenes.size()) +
+                                          " scenes of experiment.json");
+    row->scene = e.scenes.begin()->first;
+  } else {
+    if (!e.scenes.count(scene)) throw InputError(scene_context, "'" + scene + "' is not a key of experiment.json's scenes");
+    row->scene = scene;
+  }
+}
+
+}  // namespace
 
 Experiment LoadExperiment(const std::string& directory) {
   ExperimentFolder folder = ReadExperimentJson(directory);
@@ -77,10 +171,17 @@ Experiment LoadExperiment(const std::string& directory) {
   e.metadata = std::move(folder.metadata);
   const json& meta = e.metadata;
   CheckKeys(meta, ExperimentKeys(), json_path);
-  if (!meta.contains("format") || meta.at("format") != kExperimentFormat)
+  if (meta.contains("format") && meta.at("format") == kExperimentFormat2) {
+    e.format_version = 2;
+  } else if (!meta.contains("format") || meta.at("format") != kExperimentFormat1) {
     throw InputError(json_path + ": format",
-                     std::string("must be \"") + kExperimentFormat + "\" (got " +
+                     std::string("must be \"") + kExperimentFormat1 + "\" or \"" + kExperimentFormat2 + "\" (got " +
                          (meta.contains("format") ? Shown(meta.at("format")) : "nothing") + ")");
+  }
+  if (e.format_version == 1)
+    for (const std::string& key : ExperimentKeysOfVersion2())
+      if (meta.contains(key)) throw InputError(json_path + ": " + key, NeedsVersion2());
+  ReadVideoKeys(meta, json_path, &e);
   e.title = OptionalString(meta, "title", json_path);
   e.operator_name = OptionalString(meta, "operator", json_path);
   e.date = OptionalString(meta, "date", json_path);
@@ -112,6 +213,9 @@ Experiment LoadExperiment(const std::string& directory) {
     const std::string base = SplitUnitSuffix(table.header[i]).first;
     const std::string where = CellContext(table, 1, table.header[i]);
     if (!IsColumn(base)) throw InputError(where, "unknown column (see data/README.md)");
+    if (e.format_version == 1 && Contains(MeasurementVideoColumns(), base)) throw InputError(where, NeedsVersion2());
+    if (Contains(MeasurementVideoColumns(), base) && base != table.header[i])
+      throw InputError(where, "'" + base + "' is text: its header has no unit");
     if (!column.emplace(base, static_cast<int>(i)).second)
       throw InputError(where, "gives '" + base + "' a second time");
     if (apparatus.contains(base))
@@ -119,7 +223,7 @@ Experiment LoadExperiment(const std::string& directory) {
                                   "): give it in one place only");
   }
   for (const char* required : {"trial", "Y"})
-    if (!column.count(required))
+    if (!column.count(required) && !(std::string(required) == "Y" && column.count("video")))
       throw InputError(csv_path + ", row 1", std::string("column '") + required + "' is missing");
   if (table.rows.empty()) throw InputError(csv_path, "has a header but no data rows");
 
@@ -141,6 +245,7 @@ Experiment LoadExperiment(const std::string& directory) {
       if (!trials.insert(row.trial).second)
         throw InputError(CellContext(table, row.row, table.header[column.at("trial")]),
                          "duplicate trial label '" + row.trial + "'");
+      ReadVideoCells(e, table, row.row, cell("video"), cell("scene"), &row);
       FieldSource source;
       source.lookup = [&](const std::string& name) -> std::optional<FieldSource::Field> {
         if (name == "body") return FieldSource::Field{Text(body.at("type"), json_path + ": body.type"), ""};
@@ -174,6 +279,11 @@ Experiment LoadExperiment(const std::string& directory) {
       };
       row.configuration = ParseConfiguration(source);
       const auto y = source.lookup("Y");
+      if (!row.video.empty() && (!y || y->text.find_first_not_of(" \t") == std::string::npos)) {
+        row.y_typed = false;  // from the video's rest position (app/video_trials.hpp)
+        e.rows.push_back(std::move(row));
+        continue;
+      }
       row.Y.value = ParseQuantity(y ? y->text : "", Dimension::kLength, source.context("Y"),
                                   y ? y->default_unit : "");
       if (!(row.Y.value > 0.0)) throw InputError(source.context("Y"), "must be > 0 (a position beyond O)");

@@ -10,7 +10,18 @@ namespace uphill {
 
 const std::set<std::string>& ExperimentKeys() {
   static const std::set<std::string> keys = {"format", "title", "operator", "date", "notes", "body",
-                                             "apparatus", "uncertainties"};
+                                             "apparatus", "uncertainties", "camera", "scenes",
+                                             "video_analysis"};
+  return keys;
+}
+
+const std::set<std::string>& ExperimentKeysOfVersion2() {
+  static const std::set<std::string> keys = {"camera", "scenes", "video_analysis"};
+  return keys;
+}
+
+const std::set<std::string>& VideoAnalysisKeys() {
+  static const std::set<std::string> keys = {"fit", "u_x", "g"};
   return keys;
 }
 
@@ -31,6 +42,11 @@ const std::set<std::string>& UncertaintyKeys() {
 
 const std::vector<std::string>& MeasurementLabelColumns() {
   static const std::vector<std::string> columns = {"trial", "series", "note"};
+  return columns;
+}
+
+const std::vector<std::string>& MeasurementVideoColumns() {
+  static const std::vector<std::string> columns = {"video", "scene"};
   return columns;
 }
 

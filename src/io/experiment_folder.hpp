@@ -1,5 +1,5 @@
-// ExperimentFolder: the one reader of an experiment folder's files (format uphill-experiment/1,
-// data/README.md), and the one place that names them, the keys of experiment.json and the columns
+// ExperimentFolder: the one reader of an experiment folder's files (formats uphill-experiment/1
+// and /2, data/README.md), and the one place that names them, the keys of experiment.json and the columns
 // of measurements.csv. LoadExperiment (experiment.hpp: the rows as configurations, for analysis)
 // and the server's editable state (server/experiment_state.hpp: the rows as typed) both read the
 // folder through it; the server writes the files it names.
@@ -20,20 +20,32 @@
 
 namespace uphill {
 
-inline constexpr const char* kExperimentFormat = "uphill-experiment/1";
+// Version 1: typed rows only. Version 2 adds the trials' recordings: experiment.json's `camera`,
+// `scenes` and `video_analysis`, measurements.csv's `video` and `scene` columns, and an empty Y in
+// a row with a video (Y then comes from the video's rest position). A version-1 file that uses any
+// of these is refused ("needs format uphill-experiment/2"). A writer keeps a folder at version 1
+// until it uses a version-2 feature (kExperimentFormat: what a new folder is written as).
+inline constexpr const char* kExperimentFormat1 = "uphill-experiment/1";
+inline constexpr const char* kExperimentFormat2 = "uphill-experiment/2";
+inline constexpr const char* kExperimentFormat = kExperimentFormat1;
 inline constexpr const char* kExperimentJsonFile = "experiment.json";
 inline constexpr const char* kMeasurementsCsvFile = "measurements.csv";
 
 // The keys experiment.json may have: at the top, in "body", in "apparatus" (constants of the
-// apparatus) and in "uncertainties" (default standard uncertainties).
-const std::set<std::string>& ExperimentKeys();    // format title operator date notes body apparatus uncertainties
+// apparatus), in "uncertainties" (default standard uncertainties) and in "video_analysis" (the
+// options of `uphill analyse-track` for the trials' recordings).
+const std::set<std::string>& ExperimentKeys();    // format title operator date notes body apparatus
+                                                  // uncertainties, and (version 2) camera scenes video_analysis
+const std::set<std::string>& ExperimentKeysOfVersion2();  // camera scenes video_analysis
 const std::set<std::string>& BodyKeys();          // type R a b h
 const std::set<std::string>& ApparatusKeys();     // L H D theta alpha rod_diameter L_convention
 const std::set<std::string>& UncertaintyKeys();   // L H D Y R a b h theta alpha rod_diameter
+const std::set<std::string>& VideoAnalysisKeys(); // fit u_x g
 
 // The columns of measurements.csv: the label columns, then the numeric quantities (a length unit
 // in the header, `L_mm`, or in every cell), in the order the server writes them.
 const std::vector<std::string>& MeasurementLabelColumns();  // trial series note
+const std::vector<std::string>& MeasurementVideoColumns();  // video scene (version 2: text cells)
 const std::vector<std::string>& MeasurementQuantities();    // L H D Y u_L u_H u_D u_Y
 
 struct ExperimentFolder {

@@ -16,6 +16,7 @@
 #include "fit/fit_report.hpp"
 #include "fit/friction_fit.hpp"
 #include "io/experiment.hpp"
+#include "report/video_trials.hpp"
 
 namespace uphill {
 
@@ -50,6 +51,9 @@ struct ExperimentAnalysis {
   std::vector<FitOutcome> fits;             // ols, wls, york, robust, friction, in this order
   std::optional<ModelComparison> friction_vs_line;
   std::vector<std::string> notes;           // findings in plain words
+  // What the trials' recordings measured (app/video_trials.hpp fills it in; empty without
+  // videos), in the order of the rows with a video.
+  std::vector<VideoTrial> video_trials;
 
   const FitOutcome* Fit(const std::string& method) const;
 };

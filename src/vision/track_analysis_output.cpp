@@ -12,8 +12,7 @@ namespace uphill {
 namespace {
 
 constexpr const char* kAnalysisFile = "track_analysis.json";
-constexpr const char* kPositionFigure = "track_x_vs_t";
-constexpr const char* kResidualFigure = "track_residuals";
+constexpr const char* kFigureStem = "track";  // track_x_vs_t, track_residuals (report/video_trials.hpp)
 
 nlohmann::json Optional(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
 
@@ -155,52 +154,26 @@ nlohmann::json TrackAnalysisJson(const TrackAnalysis& a) {
   return j;
 }
 
+TrackFigureData TrackFigureDataOf(const TrackAnalysis& a) {
+  TrackFigureData d;
+  d.measured = a.measured;
+  d.curve = a.fit.curve;
+  d.fitted = a.fit.fitted;
+  d.fit_available = a.fit.available;
+  d.fit_t = a.fit.t;
+  for (std::size_t i = 0; i < a.fit.t.size(); ++i) d.fit_residual.push_back(a.fit.measured[i] - a.fit.predicted[i]);
+  d.u_x = a.options.u_x;
+  d.rms_residual = a.fit.rms_residual;
+  return d;
+}
+
 std::vector<GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& a) {
-  std::vector<GnuplotFigure> figures;
-  GnuplotFigure x;
-  x.name = kPositionFigure;
-  x.title = "Measured x(t) against the fitted model";
-  x.caption = "Each point is one video frame where the ball was found (x of its centre in the apparatus frame); "
-              "the line is the model motion fitted to them (x0, t0 and " +
-              (a.fit.fitted.empty() ? std::string("g or mu") : a.fit.fitted) + ").";
-  std::ostringstream data;
-  data << "# t_s x_mm (every frame with the ball)\n";
-  for (const auto& [t, xv] : a.measured) data << Num(t) << " " << Num(xv * 1e3) << "\n";
-  data << "\n\n# t_s x_mm (fitted model)\n";
-  for (const auto& [t, xv] : a.fit.curve) data << Num(t) << " " << Num(xv * 1e3) << "\n";
-  x.data = data.str();
-  std::ostringstream plot;
-  plot << "set xlabel 't (s)'\nset ylabel 'x, centre (mm)'\nset offsets graph 0.02, graph 0.02, graph 0.05, graph 0.05\n"
-       << "plot '" << x.name << ".dat' index 0 using 1:2 with points pt 7 ps 0.5 lc rgb '#1f4e79' title 'measured'";
-  if (!a.fit.curve.empty())
-    plot << ", \\\n  '" << x.name << ".dat' index 1 using 1:2 with lines lw 2 lc rgb '#d62728' title 'fitted model'";
-  x.plot = plot.str();
-  figures.push_back(x);
-  if (a.fit.available) {
-    GnuplotFigure r;
-    r.name = kResidualFigure;
-    r.title = "Residuals of the model fit";
-    r.caption = "Measured minus fitted x for every frame of the fit window, with the stated u_x as error bars. "
-                "Structure (a trend, a wave) means the model misses something.";
-    std::ostringstream rd;
-    rd << "# t_s residual_mm u_x_mm\n";
-    for (std::size_t i = 0; i < a.fit.t.size(); ++i)
-      rd << Num(a.fit.t[i]) << " " << Num((a.fit.measured[i] - a.fit.predicted[i]) * 1e3) << " "
-         << Num(a.options.u_x * 1e3) << "\n";
-    r.data = rd.str();
-    r.plot = "set xlabel 't (s)'\nset ylabel 'measured - fitted x (mm)'\n"
-             "set offsets graph 0.02, graph 0.02, graph 0.1, graph 0.1\n"
-             "plot 0 with lines lc rgb '#777777' notitle, \\\n  '" +
-             r.name + ".dat' using 1:2:3 with yerrorbars pt 7 ps 0.5 lc rgb '#1f4e79' title sprintf('RMS %.3g mm', " +
-             Num(a.fit.rms_residual * 1e3) + ")";
-    figures.push_back(r);
-  }
-  return figures;
+  return TrackFigures(TrackFigureDataOf(a), kFigureStem);
 }
 
 std::vector<std::string> TrackAnalysisFiles() {
   std::vector<std::string> files = {kAnalysisFile};
-  for (const char* name : {kPositionFigure, kResidualFigure})
+  for (const std::string name : {std::string(kFigureStem) + "_x_vs_t", std::string(kFigureStem) + "_residuals"})
     for (std::string& file : FigureFiles(name)) files.push_back(std::move(file));
   return files;
 }

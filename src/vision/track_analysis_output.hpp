@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "report/gnuplot_figure.hpp"
+#include "report/video_trials.hpp"
 #include "vision/track_analysis.hpp"
 
 namespace uphill {
@@ -20,6 +21,8 @@ namespace uphill {
 std::string TrackAnalysisTable(const TrackAnalysis& analysis);
 nlohmann::json TrackAnalysisJson(const TrackAnalysis& analysis);
 std::vector<GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& analysis);
+// The figures' data (report/video_trials.hpp draws them, for analyse-track and the fit report).
+TrackFigureData TrackFigureDataOf(const TrackAnalysis& analysis);
 // Writes DIR/track_analysis.json and the figures (.dat, .gp, .svg, .png). Throws
 // EnvironmentError when a file cannot be written or gnuplot fails.
 void WriteTrackAnalysis(const TrackAnalysis& analysis, const std::string& directory);
