@@ -22,6 +22,10 @@ void RequireOptions(const TrackAnalysisOptions& o) {
   if (o.confirm_frames < 1) throw InputError("confirm_frames", "must be >= 1");
   if (o.reference_frames < 1) throw InputError("reference_frames", "must be >= 1");
   if (o.rest_frames < 2) throw InputError("rest_frames", "must be >= 2");
+  if (!(o.tracker_floor_px >= 0.0 && std::isfinite(o.tracker_floor_px)))
+    throw InputError("tracker_floor_px", "must be >= 0 (the tracker's systematic error at rest, px)");
+  if (!(o.tracker_blur >= 0.0 && std::isfinite(o.tracker_blur)))
+    throw InputError("tracker_blur", "must be >= 0 (the tracker's systematic error per pixel of motion per frame)");
 }
 
 }  // namespace
@@ -54,6 +58,8 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
       s.t.push_back(f.t);
       s.x.push_back(f.x);
       s.z.push_back(f.z);
+      s.u.push_back(f.u);
+      s.v.push_back(f.v);
       s.rows.push_back(f.row);
       a.measured.emplace_back(f.t, f.x);
     }
@@ -202,7 +208,10 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
   if (a.fit.available && a.fit.covariance) {
     const FittedParameter* x0 = a.fit.Parameter("x0");
     const FittedParameter* t0 = a.fit.Parameter("t0");
-    const auto inflated = [&](const FittedParameter* p) { return *p->se * std::max(1.0, std::sqrt(a.fit.reduced_chi2)); };
+    // The larger of the stated σ's standard error inflated by χ²/ν and the uncertainty to quote.
+    const auto inflated = [&](const FittedParameter* p) {
+      return std::max(*p->se * std::max(1.0, std::sqrt(a.fit.reduced_chi2)), p->u.value_or(0.0));
+    };
     if (a.turning_points.empty()) {
       a.release->method = "model fit (x0, t0); " + a.release->method;
       a.release->t = {t0->value, inflated(t0)};

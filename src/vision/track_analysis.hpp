@@ -93,6 +93,10 @@ struct TrackAnalysisOptions {
   int reference_frames = 25;                         // frames of the release band's median
   int rest_frames = 10;                              // a final rest lasts at least this many frames
   double huber_sigmas = 3.0;                         // Huber loss threshold, in σ
+  // The tracker's systematic error of one position, 1σ in raw pixels (see "Uncertainty of the
+  // fit"): tracker_floor_px + tracker_blur × (pixels the centre moves in one frame interval).
+  double tracker_floor_px = 0.08;
+  double tracker_blur = 0.015;
 };
 
 // A measured or fitted value with its standard uncertainty (none when not meaningful).
@@ -112,6 +116,12 @@ struct FittedParameter {
   std::string unit;    // SI unit: "m", "s", "m/s2", ""
   double value = 0;
   std::optional<double> se, se_scaled;  // unscaled (stated σ) and scaled by sqrt(χ²/ν)
+  // "Uncertainty of the fit": the statistical part from the residuals (AR(1) sandwich), the
+  // tracker's systematic part (worst correlation length), and u = their quadrature sum, the
+  // standard uncertainty to quote. systematic_length: that worst length along the path, m
+  // (0: independent frames, +inf: one bias shared by every frame).
+  std::optional<double> se_statistical, se_systematic, u;
+  double systematic_length = 0;
 };
 
 struct TrackFit {
@@ -122,7 +132,10 @@ struct TrackFit {
   std::optional<Eigen::Matrix3d> covariance;  // unscaled, order as parameters
   double chi2 = 0, reduced_chi2 = 0, rms_residual = 0;  // rms in m
   int dof = 0;
+  double residual_lag1 = 0;                     // lag-1 autocorrelation of the residuals (≥ 0)
+  double metres_per_pixel = 0;                  // the track's own scale, m/px (0: no pixel coordinates)
   std::vector<double> t, measured, predicted;  // the frames of the window, s and m
+  std::vector<double> systematic;               // the tracker's systematic error of each frame, 1σ, m
   std::vector<int> rows;                        // their CSV rows
   std::vector<TrackEvent> model_events;         // events of the fitted motion, absolute times
   std::vector<std::pair<double, double>> curve; // (t, x) of the fitted model, dense, for figures

@@ -66,16 +66,25 @@ std::string TrackAnalysisTable(const TrackAnalysis& a) {
   } else {
     out << "model fit (x0, t0, " << f.fitted << "; Huber loss at " << Printf("%.3g", a.options.huber_sigmas)
         << " u_x), " << f.t.size() << " frames:\n";
-    out << "  parameter      value            se (from u_x)    se (scaled by sqrt(chi2/dof))\n";
+    out << "  parameter      value            se (from u_x)    se (scaled by sqrt(chi2/dof))  statistical  systematic  "
+           "u (to quote)\n";
+    const auto text = [](const std::optional<double>& v, double factor) {
+      return v ? Printf("%.3g", *v * factor) : std::string("-");
+    };
     for (const auto& p : f.parameters) {
       const double factor = p.unit == "m" ? 1e3 : 1.0;
       const std::string unit = p.unit == "m" ? "mm" : p.unit.empty() ? "1" : p.unit;
-      char line[256];
-      std::snprintf(line, sizeof line, "  %-6s %-7s %-16s %-16s %s\n", p.name.c_str(), ("[" + unit + "]").c_str(),
-                    Printf("%.8g", p.value * factor).c_str(), p.se ? Printf("%.3g", *p.se * factor).c_str() : "-",
-                    p.se_scaled ? Printf("%.3g", *p.se_scaled * factor).c_str() : "-");
+      char line[320];
+      std::snprintf(line, sizeof line, "  %-6s %-7s %-16s %-16s %-30s %-12s %-11s %s\n", p.name.c_str(),
+                    ("[" + unit + "]").c_str(), Printf("%.8g", p.value * factor).c_str(), text(p.se, factor).c_str(),
+                    text(p.se_scaled, factor).c_str(), text(p.se_statistical, factor).c_str(),
+                    text(p.se_systematic, factor).c_str(), text(p.u, factor).c_str());
       out << line;
     }
+    out << "  statistical: from the residuals (lag-1 autocorrelation " << Printf("%.2f", f.residual_lag1)
+        << "); systematic: the tracker's " << Printf("%.3g", a.options.tracker_floor_px) << " px + "
+        << Printf("%.3g", a.options.tracker_blur) << " x (px moved per frame) at "
+        << Printf("%.3g", f.metres_per_pixel * 1e3) << " mm/px, worst correlation length\n";
     out << "  chi2 = " << Printf("%.4g", f.chi2) << ", dof = " << f.dof << ", chi2/dof = " << Printf("%.4g", f.reduced_chi2)
         << ", RMS residual = " << Printf("%.3g", f.rms_residual * 1e3) << " mm\n";
     for (const auto& e : f.model_events)
@@ -96,6 +105,8 @@ nlohmann::json TrackAnalysisJson(const TrackAnalysis& a) {
   j["frame_interval"] = a.frame_interval;
   j["u_x"] = a.options.u_x;
   j["band_sigmas"] = a.options.band_sigmas;
+  j["tracker_floor_px"] = a.options.tracker_floor_px;
+  j["tracker_blur"] = a.options.tracker_blur;
   j["g"] = a.options.g;
   j["scatter_at_rest"] = Optional(a.scatter_at_rest);
   j["direction"] = a.direction;
@@ -114,7 +125,13 @@ nlohmann::json TrackAnalysisJson(const TrackAnalysis& a) {
   fit["fitted"] = f.fitted;
   fit["parameters"] = nlohmann::json::object();
   for (const auto& p : f.parameters)
-    fit["parameters"][p.name] = {{"value", p.value}, {"se", Optional(p.se)}, {"se_scaled", Optional(p.se_scaled)},
+    fit["parameters"][p.name] = {{"value", p.value},
+                                 {"se", Optional(p.se)},
+                                 {"se_scaled", Optional(p.se_scaled)},
+                                 {"se_statistical", Optional(p.se_statistical)},
+                                 {"se_systematic", Optional(p.se_systematic)},
+                                 {"u", Optional(p.u)},
+                                 {"systematic_length", p.se_systematic ? Finite(p.systematic_length) : nullptr},
                                  {"unit", p.unit}};
   if (f.covariance) {
     nlohmann::json c = nlohmann::json::array(), r = nlohmann::json::array();
@@ -138,6 +155,8 @@ nlohmann::json TrackAnalysisJson(const TrackAnalysis& a) {
     fit["dof"] = f.dof;
     fit["reduced_chi2"] = f.reduced_chi2;
     fit["rms_residual"] = f.rms_residual;
+    fit["residual_lag1"] = f.residual_lag1;
+    fit["metres_per_pixel"] = f.metres_per_pixel;
     fit["n"] = f.t.size();
     fit["iterations"] = f.iterations;
     fit["termination"] = f.termination;
@@ -146,8 +165,12 @@ nlohmann::json TrackAnalysisJson(const TrackAnalysis& a) {
   for (const auto& e : f.model_events) fit["model_events"].push_back(EventJson(e));
   fit["frames"] = nlohmann::json::array();
   for (std::size_t i = 0; i < f.t.size(); ++i)
-    fit["frames"].push_back({{"row", f.rows[i]}, {"t", f.t[i]}, {"x", f.measured[i]}, {"predicted", f.predicted[i]},
-                             {"residual", f.measured[i] - f.predicted[i]}});
+    fit["frames"].push_back({{"row", f.rows[i]},
+                             {"t", f.t[i]},
+                             {"x", f.measured[i]},
+                             {"predicted", f.predicted[i]},
+                             {"residual", f.measured[i] - f.predicted[i]},
+                             {"u_systematic", i < f.systematic.size() ? nlohmann::json(f.systematic[i]) : nullptr}});
   fit["notes"] = f.notes;
   j["fit"] = fit;
   j["notes"] = a.notes;

@@ -8,6 +8,7 @@
 #include "scene_flags.hpp"
 #include "vision_program.hpp"
 #if UPHILL_VISION_PROGRAM
+#include <cmath>
 #include <iostream>
 
 #include "io/output_paths.hpp"
@@ -21,20 +22,32 @@
 namespace uphill::cli {
 namespace {
 
+// TrackAnalysisOptions' defaults (asserted in Run, where the header is seen).
+constexpr double kTrackerFloorPx = 0.08, kTrackerBlur = 0.015;
+
 struct AnalyseTrackFlags {
   SceneFlags scene;
   std::string track, g = "9.80665m/s2", fit = "g", u_x = "0.5mm", output;
+  double tracker_floor_px = kTrackerFloorPx, tracker_blur = kTrackerBlur;
   bool json = false;
 };
 
 #if UPHILL_VISION_PROGRAM
 void Run(const AnalyseTrackFlags& f) {
+  static_assert(TrackAnalysisOptions{}.tracker_floor_px == kTrackerFloorPx &&
+                TrackAnalysisOptions{}.tracker_blur == kTrackerBlur);
   const Scene scene = ParseConfiguration(FlagSource(f.scene)).MakeScene();
   TrackAnalysisOptions o;
   o.g = ParseQuantity(f.g, Dimension::kAcceleration, "--g");
   if (!(o.g > 0.0)) throw InputError("--g", "must be > 0");
   o.u_x = ParseQuantity(f.u_x, Dimension::kLength, "--u-x");
   if (!(o.u_x > 0.0)) throw InputError("--u-x", "must be > 0 (the standard uncertainty of a tracked position)");
+  if (!(f.tracker_floor_px >= 0.0 && std::isfinite(f.tracker_floor_px)))
+    throw InputError("--tracker-floor-px", "must be >= 0 (pixels)");
+  if (!(f.tracker_blur >= 0.0 && std::isfinite(f.tracker_blur)))
+    throw InputError("--tracker-blur", "must be >= 0 (pixels of error per pixel moved per frame)");
+  o.tracker_floor_px = f.tracker_floor_px;
+  o.tracker_blur = f.tracker_blur;
   if (f.fit == "g") {
     o.fit = TrackFitParameter::kEffectiveG;
   } else if (f.fit == "mu") {
@@ -80,6 +93,12 @@ void AddAnalyseTrackCommand(CLI::App& app) {
   cmd->add_option("--fit", flags->fit, "third fit parameter besides x0, t0: g (effective g) or mu")
       ->capture_default_str();
   cmd->add_option("--u-x", flags->u_x, "standard uncertainty of a tracked position, e.g. 0.3mm")->capture_default_str();
+  cmd->add_option("--tracker-floor-px", flags->tracker_floor_px,
+                  "the tracker's systematic error of a position at rest, 1 sigma, raw pixels")
+      ->capture_default_str();
+  cmd->add_option("--tracker-blur", flags->tracker_blur,
+                  "the tracker's systematic error added per pixel the ball moves in one frame interval")
+      ->capture_default_str();
   cmd->add_option("-o,--output", flags->output, "folder for track_analysis.json and the figures (created if needed)");
   cmd->add_flag("--json", flags->json, "print track_analysis.json instead of the table");
   cmd->callback([flags] { Run(*flags); });

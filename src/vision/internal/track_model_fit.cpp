@@ -9,6 +9,7 @@
 
 #include "model/input_error.hpp"
 #include "motion/motion.hpp"
+#include "track_fit_errors.hpp"
 
 namespace uphill::internal {
 namespace {
@@ -97,6 +98,68 @@ std::vector<MotionEvent> ModelEvents(const ModelCache& model, const Eigen::Vecto
   std::vector<MotionEvent> events = m.events();
   for (auto& e : events) e.t = t_ref + q(1) + e.t / scale;
   return events;
+}
+
+// The track's own scale, m per raw pixel: the median of |Δ(x, z)| / |Δ(u, v)| between each frame
+// of the window and the first later one at least 5 px away (far above the tracker's error, near
+// enough that perspective changes the scale little); 0 when the centre never moved that far.
+double MetresPerPixel(const Series& s, const std::vector<int>& use) {
+  std::vector<double> ratios;
+  for (std::size_t k = 0; k < use.size(); ++k)
+    for (std::size_t l = k + 1; l < use.size(); ++l) {
+      const int i = use[k], j = use[l];
+      const double px = std::hypot(s.u[j] - s.u[i], s.v[j] - s.v[i]);
+      if (!(px >= 5.0)) continue;
+      ratios.push_back(std::hypot(s.x[j] - s.x[i], s.z[j] - s.z[i]) / px);
+      break;
+    }
+  return ratios.empty() ? 0.0 : Median(ratios);
+}
+
+// The statistical and systematic parts of each parameter's uncertainty (track_fit_errors.hpp).
+void AddErrorParts(const Series& s, const std::vector<int>& use, const TrackAnalysisOptions& o,
+                   ceres::Problem& problem, TrackFit* fit) {
+  ceres::Problem::EvaluateOptions plain;
+  plain.apply_loss_function = false;
+  std::vector<double> scaled;  // residuals / u_x
+  ceres::CRSMatrix crs;
+  if (!problem.Evaluate(plain, nullptr, &scaled, nullptr, &crs)) return;
+  const int n = static_cast<int>(use.size());
+  FitErrorInputs in;
+  in.derivatives = Eigen::MatrixXd::Zero(n, 3);
+  for (int r = 0; r < crs.num_rows; ++r)
+    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) in.derivatives(r, crs.cols[k]) = crs.values[k] * o.u_x;
+  in.weights.resize(n);
+  in.residuals.resize(n);
+  in.x.resize(n);
+  in.systematic.resize(n);
+  for (int i = 0; i < n; ++i) {
+    in.residuals(i) = scaled[i] * o.u_x;
+    in.weights(i) = std::abs(scaled[i]) <= o.huber_sigmas ? 1.0 : o.huber_sigmas / std::abs(scaled[i]);
+    in.x(i) = s.x[use[i]];
+  }
+  // The motion blur grows with the image speed: pixels per frame interval, from the neighbours.
+  std::vector<double> steps;
+  for (std::size_t k = 1; k < use.size(); ++k) steps.push_back(s.t[use[k]] - s.t[use[k - 1]]);
+  const double frame = Median(steps);
+  fit->metres_per_pixel = MetresPerPixel(s, use);
+  for (int i = 0; i < n; ++i) {
+    const int a = use[std::max(i - 1, 0)], b = use[std::min(i + 1, n - 1)];
+    const double speed = std::hypot(s.u[b] - s.u[a], s.v[b] - s.v[a]) / (s.t[b] - s.t[a]) * frame;
+    in.systematic(i) = fit->metres_per_pixel * (o.tracker_floor_px + o.tracker_blur * (std::isfinite(speed) ? speed : 0.0));
+    fit->systematic.push_back(in.systematic(i));
+  }
+  if (fit->metres_per_pixel == 0.0)
+    fit->notes.push_back("the track's pixel coordinates do not move: the tracker's systematic error is not estimated");
+  const FitErrors errors = EstimateFitErrors(in);
+  fit->residual_lag1 = errors.lag1;
+  for (int j = 0; j < 3; ++j) {
+    FittedParameter& p = fit->parameters[j];
+    p.se_statistical = std::sqrt(errors.residual_covariance(j, j));
+    p.se_systematic = std::sqrt(errors.systematic_variance(j));
+    p.systematic_length = errors.systematic_length(j);
+    p.u = std::hypot(*p.se_statistical, *p.se_systematic);
+  }
 }
 
 }  // namespace
@@ -256,13 +319,17 @@ void FitModel(const Series& s, int begin, int end, int direction, const Scene& s
   const char* units[] = {"m", "s", fit_g ? "m/s2" : ""};
   const double values[] = {q(0), t0, q(2)};
   for (int j = 0; j < 3; ++j) {
-    FittedParameter p{names[j], units[j], values[j], std::nullopt, std::nullopt};
+    FittedParameter p;
+    p.name = names[j];
+    p.unit = units[j];
+    p.value = values[j];
     if (fit->covariance) {
       p.se = std::sqrt((*fit->covariance)(j, j));
       p.se_scaled = *p.se * scale;
     }
     fit->parameters.push_back(p);
   }
+  if (fit->covariance) AddErrorParts(s, use, o, problem, fit);
   if (q(0) <= lo + 1e-9 * std::abs(lo) || q(0) >= hi - 1e-9 * std::abs(hi))
     fit->notes.push_back("x0 ended at its bound (" + Mm(q(0)) + "): the data want a release where the model cannot " +
                          "start this motion (" + (scene.x_eq() ? "the other side of X" : "outside the path") + ")");

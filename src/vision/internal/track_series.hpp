@@ -16,6 +16,7 @@ namespace uphill::internal {
 // The frames found, in time order.
 struct Series {
   std::vector<double> t, x, z;
+  std::vector<double> u, v;  // raw pixels of the centre (the tracker's systematic error is in pixels)
   std::vector<int> rows;
   int size() const { return static_cast<int>(t.size()); }
 };
