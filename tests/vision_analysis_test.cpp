@@ -495,6 +495,18 @@ TEST(AnalyseTrackCommand, PrintsTheFitAndWritesJsonAndFigures) {
   const double x0 = j["fit"]["parameters"]["x0"]["value"], se = j["fit"]["parameters"]["x0"]["se"];
   EXPECT_LT(std::abs(x0 - r.x0), 4 * se);
   EXPECT_EQ(j["fit"]["frames"].size(), j["fit"]["n"].get<std::size_t>());
+  // The uncertainty to quote: the statistical and systematic parts in quadrature (track_analysis.hpp).
+  for (const char* name : {"x0", "t0", "g"}) {
+    const nlohmann::json& p = j["fit"]["parameters"][name];
+    EXPECT_NEAR(p["u"].get<double>(), std::hypot(p["se_statistical"].get<double>(), p["se_systematic"].get<double>()),
+                1e-12 * p["u"].get<double>())
+        << name;
+  }
+  EXPECT_EQ(j["tracker_floor_px"], 0.08);
+  EXPECT_TRUE(j["fit"]["frames"][0]["u_systematic"].is_number());
+  const auto negative = testing::RunUphill("analyse-track " + csv + scene_flags + " --tracker-floor-px -0.1");
+  EXPECT_EQ(negative.status, 2);
+  EXPECT_NE(negative.err.find("--tracker-floor-px"), std::string::npos) << negative.err;
   for (const char* name : {"track_x_vs_t.svg", "track_x_vs_t.png", "track_x_vs_t.gp", "track_residuals.svg"})
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / name)) << name;
   // Bad input: exit 2 and one line naming the file, row and column, or the flag.

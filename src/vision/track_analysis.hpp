@@ -58,6 +58,41 @@
 // Covariance: ceres::Covariance (dense SVD) of (x0, t0, g or μ); standard errors unscaled (from
 // the stated σ) and scaled by sqrt(χ²/ν); χ² and the RMS residual from the raw residuals.
 //
+// Uncertainty of the fit (FittedParameter::u, the one to quote). A tracker's error is mostly
+// systematic: an edge bias that varies along the path (the background behind the outline changes)
+// and with the speed (motion blur), so neighbouring frames share it, the residuals are correlated,
+// and the part of it that looks like a change of x0, t0 or g is absorbed by the fit and never
+// shows in the residuals. Both parts below are sandwich covariances BΣBᵀ of the linearised
+// estimator δ = B·e, B = (AᵀWA)⁻¹AᵀW (A: derivatives of the predicted x by the parameters at the
+// solution, W: the Huber loss' IRLS weights), for two models Σ of the position errors e:
+//  - statistical (se_statistical): Σ_ij = s²·ρ^|i−j|, an AR(1) along the frames of the window, s²
+//    the weighted residual variance (÷ (Σw − 3)), ρ their lag-1 autocorrelation (clamped to
+//    [0, 0.98]). With uncorrelated residuals it equals se_scaled.
+//  - systematic (se_systematic): the tracker's error of one position, 1σ, in raw pixels, is
+//    tracker_floor_px + tracker_blur × (pixels the centre moves in one frame interval, from the
+//    track's u, v), turned into metres by the track's own scale (the median |Δ(x, z)|/|Δ(u, v)|
+//    over steps of ≥ 5 px: the scene's projection as the tracker applied it). Errors at
+//    positions x_i, x_j are correlated as exp(−|x_i − x_j|/ℓ): equal at the same place (the
+//    frames at rest share one bias, which no number of frames averages away). ℓ is not known,
+//    so each parameter takes the largest variance over ℓ ∈ {0 (independent), span/256 … span
+//    (×2 steps), ∞ (one bias)}: a worst case over the nuisance ℓ, conservative by design
+//    (systematic_length says which ℓ it was).
+//  - u = sqrt(se_statistical² + se_systematic²) (the residuals also hold part of the bias: a
+//    small double count, on the safe side). The release event quotes max(u, se·sqrt(max(1, χ²/ν))).
+// Assumptions: the bias is smooth along the path at the scales tried and of the size the two
+// options state; the model is right (fed the true positions, the fit recovers x0, t0, g to 1e-8).
+// The defaults (0.08 px, 0.015) are calibrated on main's tracker over the 720p clips of the
+// robustness matrix (uphill bench track: clean, baseline, cloth, spheroid-band): along the path
+// its error is 0.03–0.07 px at rest (0.12 px on the spheroid) and grows to 0.15–0.2 px at
+// 12.5 px/frame with a 180° shutter (1/500 s: no growth). Footage with a longer shutter, or a
+// tracker measured worse on it, needs larger values (measure them with uphill bench track).
+// Accuracy (tests/vision_povray_analysis_test.cpp, tests/vision_analysis_test.cpp,
+// docs/analyse-track.md "Accuracy"): on 7 independent POV-Ray clips, |fitted − truth| ≤ 2.7 u for
+// x0, t0, g (pulls 0.2–0.7 on the 720p lab clips, 1.4–2.7 on the spheroid main's tracker loses
+// half of, < 0.25 on 320 × 180 clips where the tracker beats the floor: there u is 5–20× the
+// real error); on synthetic tracks with an injected bias of the stated size the pulls' RMS is
+// 0.4–0.7. Without the systematic part the same fits miss by up to 11 se_scaled.
+//
 // Accuracy (tests/vision_analysis_test.cpp): on tracks simulated by Motion (a 1-inch ball,
 // θ = 3°, α = 40°) with 0.3 mm Gaussian noise at 120 frames/s and lost frames, the fitted x0,
 // t0, g or μ, the turning and rest positions and the fall-off time lie within 4 standard errors

@@ -41,7 +41,8 @@ FitErrors EstimateFitErrors(const FitErrorInputs& in) {
         const double rho = i == j ? 1.0 : length == 0 ? 0.0 : std::isinf(length) ? 1.0 : std::exp(-d / length);
         sigma(i, j) = in.systematic(i) * in.systematic(j) * rho;
       }
-    const Eigen::Vector3d variance = (b * sigma * b.transpose()).diagonal();
+    out.systematic_covariances.push_back(b * sigma * b.transpose());
+    const Eigen::Vector3d variance = out.systematic_covariances.back().diagonal();
     for (int p = 0; p < 3; ++p)
       if (variance(p) > out.systematic_variance(p)) {
         out.systematic_variance(p) = variance(p);
@@ -49,6 +50,12 @@ FitErrors EstimateFitErrors(const FitErrorInputs& in) {
       }
   }
   return out;
+}
+
+double FitErrors::WorstVariance(const Eigen::Vector3d& g) const {
+  double worst = 0;
+  for (const Eigen::Matrix3d& c : systematic_covariances) worst = std::max(worst, g.dot(c * g));
+  return g.dot(residual_covariance * g) + worst;
 }
 
 }  // namespace uphill::internal

@@ -31,6 +31,10 @@ struct FitErrors {
   // Σ_ij = σ_i σ_j exp(−|x_i − x_j|/ℓ), ℓ from independent frames (0) to one bias (+inf).
   Eigen::Vector3d systematic_variance = Eigen::Vector3d::Zero();
   Eigen::Vector3d systematic_length = Eigen::Vector3d::Zero();  // the ℓ of that maximum, m
+  std::vector<Eigen::Matrix3d> systematic_covariances;         // one per ℓ tried
+
+  // The largest variance of a linear combination gᵀδ over the ℓ tried, statistical part included.
+  double WorstVariance(const Eigen::Vector3d& g) const;
 };
 
 // Requires n ≥ 4 rows and AᵀWA invertible (the caller checked the fit's rank).

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include "model/input_error.hpp"
 #include "motion/motion.hpp"
@@ -117,13 +118,13 @@ double MetresPerPixel(const Series& s, const std::vector<int>& use) {
 }
 
 // The statistical and systematic parts of each parameter's uncertainty (track_fit_errors.hpp).
-void AddErrorParts(const Series& s, const std::vector<int>& use, const TrackAnalysisOptions& o,
-                   ceres::Problem& problem, TrackFit* fit) {
+std::optional<FitErrors> AddErrorParts(const Series& s, const std::vector<int>& use, const TrackAnalysisOptions& o,
+                                      ceres::Problem& problem, TrackFit* fit) {
   ceres::Problem::EvaluateOptions plain;
   plain.apply_loss_function = false;
   std::vector<double> scaled;  // residuals / u_x
   ceres::CRSMatrix crs;
-  if (!problem.Evaluate(plain, nullptr, &scaled, nullptr, &crs)) return;
+  if (!problem.Evaluate(plain, nullptr, &scaled, nullptr, &crs)) return std::nullopt;
   const int n = static_cast<int>(use.size());
   FitErrorInputs in;
   in.derivatives = Eigen::MatrixXd::Zero(n, 3);
@@ -160,6 +161,7 @@ void AddErrorParts(const Series& s, const std::vector<int>& use, const TrackAnal
     p.systematic_length = errors.systematic_length(j);
     p.u = std::hypot(*p.se_statistical, *p.se_systematic);
   }
+  return errors;
 }
 
 }  // namespace
@@ -329,7 +331,8 @@ void FitModel(const Series& s, int begin, int end, int direction, const Scene& s
     }
     fit->parameters.push_back(p);
   }
-  if (fit->covariance) AddErrorParts(s, use, o, problem, fit);
+  std::optional<FitErrors> errors;
+  if (fit->covariance) errors = AddErrorParts(s, use, o, problem, fit);
   if (q(0) <= lo + 1e-9 * std::abs(lo) || q(0) >= hi - 1e-9 * std::abs(hi))
     fit->notes.push_back("x0 ended at its bound (" + Mm(q(0)) + "): the data want a release where the model cannot " +
                          "start this motion (" + (scene.x_eq() ? "the other side of X" : "outside the path") + ")");
@@ -341,7 +344,8 @@ void FitModel(const Series& s, int begin, int end, int direction, const Scene& s
                          "or the model misses something (see the residual figure)");
 
   // Events of the fitted motion, with uncertainties propagated by central differences through
-  // the covariance (inflated by χ²/ν when that exceeds 1); none when a step changes the events.
+  // the covariance (inflated by χ²/ν when that exceeds 1) or the statistical + systematic parts
+  // (the larger); none when a step changes the events.
   const std::vector<MotionEvent> events = ModelEvents(*model, q, t_ref);
   Eigen::MatrixXd dt = Eigen::MatrixXd::Zero(events.size(), 3), dx = dt;
   bool propagate = fit->covariance.has_value();
@@ -372,8 +376,12 @@ void FitModel(const Series& s, int begin, int end, int direction, const Scene& s
     e.x.value = events[k].x;
     if (propagate && std::isfinite(events[k].t)) {
       const Eigen::Vector3d gt = dt.row(k).transpose(), gx = dx.row(k).transpose();
-      e.t.u = std::sqrt(gt.dot(c_events * gt));
-      e.x.u = std::sqrt(gx.dot(c_events * gx));
+      // The larger of the stated σ's (inflated by χ²/ν) and the statistical + systematic parts'.
+      const auto worst = [&](const Eigen::Vector3d& g) {
+        return std::sqrt(std::max(g.dot(c_events * g), errors ? errors->WorstVariance(g) : 0.0));
+      };
+      e.t.u = worst(gt);
+      e.x.u = worst(gx);
       if (*e.x.u == 0.0) e.x.u.reset();  // x_max, x_low: fixed by the scene
     }
     e.method = "fitted model";
