@@ -408,6 +408,31 @@ TEST(TrackAnalysis, UncertaintyCoversACorrelatedSpeedDependentTrackerBias) {
   EXPECT_GT(naive_misses, seeds / 2) << "the injected bias should defeat the scatter-only standard errors";
 }
 
+// The same with μ fitted (the ODE motion): the systematic part reaches the third parameter
+// whichever it is. Truth: the Motion with μ = 0.005 that made the tracks.
+TEST(TrackAnalysis, UncertaintyOfMuCoversACorrelatedTrackerBias) {
+  const Scene scene = Ball();
+  for (int seed = 0; seed < 4; ++seed) {
+    Recording r = Released(10e-3, 2.3);
+    r.motion.mu = 0.005;
+    r.motion.method = MotionMethod::kOde;
+    r.seed = 700 + seed;
+    BiasedRecording bias;
+    TrackAnalysisOptions o;
+    o.u_x = 0.01e-3;
+    o.fit = TrackFitParameter::kMu;
+    const TrackAnalysis a = AnalyseTrack(RecordBiased(scene, r, &bias), scene, o);
+    ASSERT_TRUE(a.fit.available) << a.fit.unavailable;
+    const double truth[3] = {r.x0, r.t0, 0.005};
+    for (int j = 0; j < 3; ++j) {
+      const FittedParameter& p = a.fit.parameters[j];
+      ASSERT_TRUE(p.u.has_value());
+      if (std::getenv("V3_PRINT")) std::cout << p.name << " pull " << (p.value - truth[j]) / *p.u << "\n";
+      EXPECT_LT(std::abs(p.value - truth[j]), 3 * *p.u) << p.name << ", seed " << r.seed;
+    }
+  }
+}
+
 // ---- The CSV reader ----------------------------------------------------------------------------
 
 Track Parse(const std::string& text) {

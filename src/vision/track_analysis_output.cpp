@@ -24,8 +24,6 @@ nlohmann::json EventJson(const std::optional<TrackEvent>& e) {
           {"u_x", Optional(e->x.u)}, {"method", e->method}};
 }
 
-std::string Num(double v) { return Printf("%.10g", v); }
-
 // "123.456 ± 0.012" with the uncertainty's scale deciding the digits.
 std::string WithU(double value, const std::optional<double>& u, double factor, const char* unit) {
   if (!std::isfinite(value)) return "never";
@@ -196,7 +194,7 @@ std::vector<GnuplotFigure> TrackAnalysisFigures(const TrackAnalysis& a) {
 
 std::vector<std::string> TrackAnalysisFiles() {
   std::vector<std::string> files = {kAnalysisFile};
-  for (const std::string name : {std::string(kFigureStem) + "_x_vs_t", std::string(kFigureStem) + "_residuals"})
+  for (const std::string& name : {std::string(kFigureStem) + "_x_vs_t", std::string(kFigureStem) + "_residuals"})
     for (std::string& file : FigureFiles(name)) files.push_back(std::move(file));
   return files;
 }
