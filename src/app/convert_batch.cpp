@@ -49,13 +49,13 @@ class NumericRows {
     for (const std::string& column : header) {
       const auto [name, unit] = SplitUnitSuffix(column);
       if (name == "note") {
-        columns_.push_back({"", 0.0});
+        columns_.push_back({std::nullopt, 0.0});
         continue;
       }
       const auto dimension = NumericFieldDimension(name);
       const double factor = dimension && !unit.empty() ? UnitFactor(*dimension, unit) : 0.0;
       if (factor == 0.0) return;  // a text column, or units in the cells: every row in full
-      columns_.push_back({name, factor});
+      columns_.push_back({FindNumericField(name), factor});
     }
     usable_ = true;
   }
@@ -67,11 +67,11 @@ class NumericRows {
     if (!usable_ || !row_) return nullptr;
     Configuration& c = *row_;
     for (std::size_t j = 0; j < cells.size(); ++j) {
-      if (columns_[j].name.empty()) continue;
+      if (!columns_[j].field) continue;
       double number = 0;
       if (!Plain(cells[j], &number)) return nullptr;
       const double si = number * columns_[j].factor;  // as ParseQuantity
-      if (!std::isfinite(si) || !SetNumericField(c, columns_[j].name, si)) return nullptr;
+      if (!std::isfinite(si) || !SetNumericField(c, *columns_[j].field, si)) return nullptr;
     }
     return &c;
   }
@@ -81,7 +81,7 @@ class NumericRows {
     if (!usable_ || row_) return;
     double number = 0;
     for (std::size_t j = 0; j < cells.size(); ++j)
-      if (!columns_[j].name.empty() && !Plain(cells[j], &number)) return;
+      if (columns_[j].field && !Plain(cells[j], &number)) return;
     row_ = c;
   }
 
@@ -100,8 +100,8 @@ class NumericRows {
     return ec == std::errc() && ptr == end && ptr != begin && std::isnormal(*number);
   }
   struct Column {
-    std::string name;  // "" for note
-    double factor;     // SI per unit of the header's suffix
+    std::optional<NumericField> field;  // none for note
+    double factor;                      // SI per unit of the header's suffix
   };
   std::vector<Column> columns_;
   bool usable_ = false;

@@ -214,39 +214,64 @@ std::optional<Dimension> NumericFieldDimension(std::string_view name) {
   return std::nullopt;
 }
 
-bool SetNumericField(Configuration& c, std::string_view name, double si) {
+std::optional<NumericField> FindNumericField(std::string_view name) {
+  const auto dimension = NumericFieldDimension(name);
+  if (!dimension) return std::nullopt;
+  NumericField f;
+  f.length = *dimension == Dimension::kLength;
+  f.uncertainty = name.rfind("u_", 0) == 0;
+  if (f.uncertainty) name.remove_prefix(2);
+  using T = NumericField::Target;
+  f.target = name == "R" ? T::kR : name == "a" ? T::kA : name == "b" ? T::kB : name == "h" ? T::kConeH
+           : name == "L" ? T::kL : name == "H" ? T::kH : name == "D" ? T::kD : name == "theta" ? T::kTheta
+           : name == "alpha" ? T::kAlpha : T::kRodDiameter;
+  if (f.target == T::kRodDiameter && name != "rod_diameter") return std::nullopt;
+  return f;
+}
+
+bool SetNumericField(Configuration& c, const NumericField& field, double si) {
   // A length outside the model's range (model/length_range.hpp): the full parse names it.
-  if (NumericFieldDimension(name) == Dimension::kLength && si != 0.0 &&
-      !(std::abs(si) >= kShortestModelLength && std::abs(si) <= kLongestModelLength))
+  if (field.length && si != 0.0 && !(std::abs(si) >= kShortestModelLength && std::abs(si) <= kLongestModelLength))
     return false;
-  const bool is_u = name.rfind("u_", 0) == 0;
-  if (is_u) {
-    name.remove_prefix(2);
-    if (si < 0.0) return false;  // Reader::Get refuses it, naming the cell
+  if (field.uncertainty && si < 0.0) return false;  // Reader::Get refuses it, naming the cell
+  const auto set = [&](Uncertain& m, double v) { (field.uncertainty ? m.u : m.value) = v; };
+  using T = NumericField::Target;
+  switch (field.target) {
+    case T::kR:
+      if (c.body_kind == BodyKind::kSpheroid) return false;
+      set(c.across, si);
+      if (c.body_kind == BodyKind::kSphere) set(c.along, si);
+      return true;
+    case T::kA:
+    case T::kB:
+      if (c.body_kind != BodyKind::kSpheroid) return false;
+      set(field.target == T::kA ? c.across : c.along, si);
+      return true;
+    case T::kConeH:
+      if (c.body_kind != BodyKind::kDoubleCone) return false;
+      set(c.along, si);
+      return true;
+    case T::kL:
+    case T::kH:
+    case T::kD:
+      if (!c.from_apparatus) return false;
+      set(field.target == T::kL ? c.L : field.target == T::kH ? c.H : c.D, si);
+      return true;
+    case T::kTheta:
+    case T::kAlpha:
+      if (c.from_apparatus) return false;
+      set(field.target == T::kTheta ? c.theta : c.alpha, si);
+      return true;
+    case T::kRodDiameter:
+      set(c.rod_radius, si / 2);
+      return true;
   }
-  const auto set = [&](Uncertain& m, double v) { (is_u ? m.u : m.value) = v; };
-  if (name == "R") {
-    if (c.body_kind == BodyKind::kSpheroid) return false;
-    set(c.across, si);
-    if (c.body_kind == BodyKind::kSphere) set(c.along, si);
-  } else if (name == "a" || name == "b") {
-    if (c.body_kind != BodyKind::kSpheroid) return false;
-    set(name == "a" ? c.across : c.along, si);
-  } else if (name == "h") {
-    if (c.body_kind != BodyKind::kDoubleCone) return false;
-    set(c.along, si);
-  } else if (name == "L" || name == "H" || name == "D") {
-    if (!c.from_apparatus) return false;
-    set(name == "L" ? c.L : name == "H" ? c.H : c.D, si);
-  } else if (name == "theta" || name == "alpha") {
-    if (c.from_apparatus) return false;
-    set(name == "theta" ? c.theta : c.alpha, si);
-  } else if (name == "rod_diameter") {
-    set(c.rod_radius, si / 2);
-  } else {
-    return false;
-  }
-  return true;
+  return false;
+}
+
+bool SetNumericField(Configuration& c, std::string_view name, double si) {
+  const std::optional<NumericField> field = FindNumericField(name);
+  return field && SetNumericField(c, *field, si);
 }
 
 }  // namespace uphill

@@ -14,6 +14,10 @@ constexpr double kPow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1
                                1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 constexpr std::uint64_t kPow10Int[10] = {1, 10, 100, 1000, 10000, 100000, 1000000, 10000000, 100000000,
                                          1000000000};
+// The integer path writes whole blocks of kCopy characters (only the first few count) from a
+// buffer whose digits end at kDigitsEnd, and needs kFastRoom characters of room.
+constexpr std::size_t kCopy = 16, kDigitsEnd = 24, kDigitsBuffer = kDigitsEnd + kCopy;
+constexpr std::ptrdiff_t kFastRoom = 48;
 // Below this, y < 2^50: y − floor(y) is exact and the margin y·2^−52 stays under 1/4.
 constexpr double kLargestScaled = 1e15;
 
@@ -57,21 +61,22 @@ inline char* DigitsBefore(char* end, std::uint64_t n, int width) {
 char* FixedText(char* first, char* last, double v, int precision) {
   const double a = std::abs(v);
   // At most 16 integer digits, a point and 9 decimals, and the sign, on the integer path.
-  if (precision >= 0 && precision <= 9 && last - first >= 32 && a < kLargestScaled) {
+  if (precision >= 0 && precision <= 9 && last - first >= kFastRoom && a < kLargestScaled) {
     const std::int64_t n = RoundedScaled(a, precision);
     if (n >= 0) {
       // The digits (at least one before the point), then the point moved in.
-      char digits[24];
-      char* const end = digits + sizeof digits;
+      char digits[kDigitsBuffer];
+      char* const end = digits + kDigitsEnd;
       const char* d = DigitsBefore(end, static_cast<std::uint64_t>(n), precision + 1);
       char* p = first;
-      if (std::signbit(v)) *p++ = '-';
+      *p = '-';
+      p += std::signbit(v);
       const std::size_t whole = static_cast<std::size_t>(end - d - precision);
-      std::memcpy(p, d, whole);
+      std::memcpy(p, d, kCopy);  // whole ≤ 16 of them count
       p += whole;
       if (precision > 0) {
         *p++ = '.';
-        std::memcpy(p, end - precision, static_cast<std::size_t>(precision));
+        std::memcpy(p, end - precision, kCopy);  // precision of them count
         p += precision;
       }
       return p;
@@ -82,7 +87,7 @@ char* FixedText(char* first, char* last, double v, int precision) {
 
 char* GeneralText(char* first, char* last, double v, int precision) {
   const double a = std::abs(v);
-  if (precision >= 1 && precision <= 9 && last - first >= 32 && std::isnormal(a)) {
+  if (precision >= 1 && precision <= 9 && last - first >= kFastRoom && std::isnormal(a)) {
     // a in [2^(e2−1), 2^e2): its decimal exponent is e10 or e10 + 1, e10 = floor((e2 − 1)·log10 2)
     // (78913 / 2^18 is log10 2 to 6 digits: exact floors for |e2| < 1650).
     const int e2 = static_cast<int>(std::bit_cast<std::uint64_t>(a) >> 52) - 1022;  // a normal
@@ -96,34 +101,35 @@ char* GeneralText(char* first, char* last, double v, int precision) {
     if (n >= static_cast<std::int64_t>(kPow10Int[precision])) n = digits_at(++exponent);  // rounds up to one more digit
     if (n >= 0) {
       // n has exactly `precision` digits; printf drops the trailing zeros.
-      char buffer[24];
-      const char* digits = DigitsBefore(buffer + sizeof buffer, static_cast<std::uint64_t>(n), precision);
+      char buffer[kDigitsBuffer];
+      const char* digits = DigitsBefore(buffer + kDigitsEnd, static_cast<std::uint64_t>(n), precision);
       int count = precision;
       while (count > 1 && digits[count - 1] == '0') --count;
       char* p = first;
-      if (std::signbit(v)) *p++ = '-';
+      *p = '-';
+      p += std::signbit(v);
+      // Copies of kCopy characters of which the first `count`, `whole`, ... count.
       if (exponent >= -4 && exponent < precision) {  // %f with precision − 1 − exponent decimals
         if (exponent >= 0) {
           const int whole = exponent + 1;
-          std::memcpy(p, digits, static_cast<std::size_t>(whole));
+          std::memcpy(p, digits, kCopy);
           p += whole;
           if (count > whole) {
             *p++ = '.';
-            std::memcpy(p, digits + whole, static_cast<std::size_t>(count - whole));
+            std::memcpy(p, digits + whole, kCopy);
             p += count - whole;
           }
         } else {
-          *p++ = '0';
-          *p++ = '.';
-          for (int i = 0; i < -exponent - 1; ++i) *p++ = '0';
-          std::memcpy(p, digits, static_cast<std::size_t>(count));
+          std::memcpy(p, "0.00000", 8);  // "0." and −exponent − 1 ≤ 3 zeros
+          p += 1 - exponent;
+          std::memcpy(p, digits, kCopy);
           p += count;
         }
       } else {  // %e with precision − 1 decimals: d[.ddd]e±XX
         *p++ = digits[0];
         if (count > 1) {
           *p++ = '.';
-          std::memcpy(p, digits + 1, static_cast<std::size_t>(count - 1));
+          std::memcpy(p, digits + 1, kCopy);
           p += count - 1;
         }
         *p++ = 'e';
