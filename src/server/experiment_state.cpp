@@ -26,7 +26,8 @@ ordered_json Canonical(const json& j) {
   if (!j.is_object()) return ordered_json(j);
   static const std::vector<std::string> order = {
       "format", "title", "operator", "date", "notes", "body", "apparatus", "uncertainties", "type", "L", "H", "D",
-      "Y", "R", "a", "b", "h", "theta", "alpha", "rod_diameter", "L_convention"};
+      "Y", "R", "a", "b", "h", "theta", "alpha", "rod_diameter", "L_convention", "camera", "scenes",
+      "video_analysis"};
   ordered_json out = ordered_json::object();
   for (const std::string& key : order)
     if (j.contains(key)) out[key] = Canonical(j.at(key));
@@ -102,6 +103,34 @@ std::string FormatNumber(double v) {
 
 const std::vector<std::string>& RowQuantities() { return MeasurementQuantities(); }
 
+const std::set<std::string>& VideoExperimentKeys() {
+  static const std::set<std::string> keys = {"camera", "scenes", "video_analysis"};
+  return keys;
+}
+
+void CheckRelativePath(const std::string& path, const std::string& field) {
+  const std::string s = CheckText(json(path), field, kMaxPathLength);
+  if (s.empty()) throw InputError(field, "is empty");
+  if (s.front() == '/') throw InputError(field, "must be a path inside the experiment folder, not an absolute one");
+  if (s.find('\\') != std::string::npos) throw InputError(field, "must use '/' between folders");
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t end = s.find('/', start);
+    const std::string part = s.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    if (part.empty() || part == "." || part == "..")
+      throw InputError(field, "must be a path inside the experiment folder (no empty, \".\" or \"..\" part)");
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+}
+
+bool ExperimentState::UsesVideo() const {
+  if (metadata.is_object())
+    for (const std::string& key : VideoExperimentKeys())
+      if (metadata.contains(key)) return true;
+  return std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.video.empty() || !r.scene.empty(); });
+}
+
 const std::string& Row::Value(const std::string& quantity) const {
   static const std::string empty;
   const auto it = values.find(quantity);
@@ -125,10 +154,10 @@ std::vector<std::string> ExperimentState::Columns() const {
   return out;
 }
 
-std::vector<std::string> ExperimentState::RequiredQuantities() const {
+std::vector<std::string> ExperimentState::RequiredQuantities(const Row* row) const {
   std::vector<std::string> out;
   for (const std::string& c : Columns())
-    if (c.rfind("u_", 0) != 0) out.push_back(c);
+    if (c.rfind("u_", 0) != 0 && !(c == "Y" && row && !row->video.empty())) out.push_back(c);
   return out;
 }
 
@@ -138,17 +167,28 @@ int ExperimentState::IndexOf(std::int64_t id) const {
   return -1;
 }
 
-std::string ExperimentState::ExperimentJson() const { return metadata.dump(2) + "\n"; }
+std::string ExperimentState::ExperimentJson() const {
+  if (!UsesVideo() || !metadata.is_object()) return metadata.dump(2) + "\n";
+  ordered_json j = metadata;
+  j["format"] = kExperimentFormatVideo;
+  return j.dump(2) + "\n";
+}
 
 std::string ExperimentState::MeasurementsCsv() const {
   const std::vector<std::string> columns = Columns();
   std::string out = "trial,series";
   // Appended piece by piece (`"," + c` trips GCC 12's false -Wrestrict).
   for (const std::string& c : columns) out.append(",").append(c).append("_").append(unit);
+  const bool video = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.video.empty(); });
+  const bool scene = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.scene.empty(); });
+  if (video) out += ",video";
+  if (scene) out += ",scene";
   out += ",note\n";
   for (const Row& r : rows) {
     out.append(CsvCell(r.trial)).append(",").append(CsvCell(r.series));
     for (const std::string& c : columns) out.append(",").append(CsvCell(r.Value(c)));
+    if (video) out.append(",").append(CsvCell(r.video));
+    if (scene) out.append(",").append(CsvCell(r.scene));
     out.append(",").append(CsvCell(r.note)).append("\n");
   }
   return out;
@@ -161,6 +201,8 @@ ordered_json ToJson(const Row& row) {
   j["series"] = row.series;
   for (const std::string& q : RowQuantities())
     if (!row.Value(q).empty()) j[q] = row.Value(q);
+  if (!row.video.empty()) j["video"] = row.video;
+  if (!row.scene.empty()) j["scene"] = row.scene;
   j["note"] = row.note;
   return j;
 }
@@ -173,6 +215,7 @@ ordered_json ToJson(const ExperimentState& state) {
   j["next_id"] = state.next_id;
   j["rows"] = ordered_json::array();
   for (const Row& r : state.rows) j["rows"].push_back(ToJson(r));
+  if (!state.files.empty()) j["files"] = state.files;
   return j;
 }
 
@@ -186,6 +229,8 @@ Row RowFromJournal(const json& j) {
   r.trial = j.value("trial", "");
   r.series = j.value("series", "");
   r.note = j.value("note", "");
+  r.video = j.value("video", "");
+  r.scene = j.value("scene", "");
   for (const std::string& q : RowQuantities())
     if (j.contains(q)) r.values[q] = j.at(q).get<std::string>();
   return r;
@@ -201,6 +246,7 @@ ExperimentState StateFromJson(const json& j) {
     s.unit = j.at("unit").get<std::string>();
     s.next_id = j.at("next_id").get<std::int64_t>();
     for (const json& r : j.at("rows")) s.rows.push_back(RowFromJournal(r));
+    if (j.contains("files")) s.files = j.at("files").get<std::map<std::string, std::string>>();
     return s;
   } catch (const json::exception& e) {
     throw InputError("journal snapshot", e.what());
@@ -215,7 +261,7 @@ void ValidateUnit(const std::string& unit) {
 Row ValidateRow(const json& j, const ExperimentState& state) {
   if (!j.is_object()) throw InputError("row", "must be a JSON object");
   Row r;
-  std::set<std::string> allowed = {"id", "trial", "series", "note"};
+  std::set<std::string> allowed = {"id", "trial", "series", "note", "video", "scene"};
   for (const std::string& q : RowQuantities()) allowed.insert(q);
   for (const auto& [key, value] : j.items())
     if (!allowed.count(key)) throw InputError("row." + key.substr(0, 32), "unknown field");
@@ -223,12 +269,20 @@ Row ValidateRow(const json& j, const ExperimentState& state) {
   if (r.trial.empty()) throw InputError("row.trial", "is empty: every trial needs a label");
   r.series = Trim(CheckText(j.value("series", json("")), "row.series", kMaxLabelLength));
   r.note = CheckText(j.value("note", json("")), "row.note", kMaxNoteLength);
+  r.video = Trim(CheckText(j.value("video", json("")), "row.video", kMaxPathLength));
+  if (!r.video.empty()) CheckRelativePath(r.video, "row.video");
+  r.scene = Trim(CheckText(j.value("scene", json("")), "row.scene", kMaxLabelLength));
+  if (!r.scene.empty()) {
+    const bool known = state.metadata.is_object() && state.metadata.contains("scenes") &&
+                       state.metadata.at("scenes").contains(r.scene);
+    if (!known) throw InputError("row.scene", "names no scene of the experiment (\"" + r.scene + "\")");
+  }
   for (const std::string& q : RowQuantities()) {
     if (!j.contains(q) || j.at(q).is_null()) continue;
     const std::string v = CheckNumber(j.at(q), "row." + q);
     if (!v.empty()) r.values[q] = v;
   }
-  for (const std::string& q : state.RequiredQuantities())
+  for (const std::string& q : state.RequiredQuantities(&r))
     if (r.Value(q).empty()) throw InputError("row." + q, "is missing (a number in " + state.unit + ")");
   return r;
 }
@@ -236,11 +290,13 @@ Row ValidateRow(const json& j, const ExperimentState& state) {
 ordered_json ValidateMetadata(const json& j) {
   if (!j.is_object()) throw InputError("experiment", "must be a JSON object");
   for (const auto& [key, value] : j.items())
-    if (!ExperimentKeys().count(key)) throw InputError("experiment." + key.substr(0, 32), "unknown key");
+    if (!ExperimentKeys().count(key) && !VideoExperimentKeys().count(key))
+      throw InputError("experiment." + key.substr(0, 32), "unknown key");
   ordered_json out;
   out["format"] = kExperimentFormat;
-  if (j.contains("format") && j.at("format") != kExperimentFormat)
-    throw InputError("experiment.format", std::string("must be \"") + kExperimentFormat + "\"");
+  if (j.contains("format") && j.at("format") != kExperimentFormat && j.at("format") != kExperimentFormatVideo)
+    throw InputError("experiment.format", std::string("must be \"") + kExperimentFormat + "\" or \"" +
+                                              kExperimentFormatVideo + "\"");
   for (const char* key : {"title", "operator", "date"})
     if (j.contains(key)) {
       const std::string s = CheckText(j.at(key), std::string("experiment.") + key, kMaxNoteLength);
@@ -311,6 +367,30 @@ ordered_json ValidateMetadata(const json& j) {
     }
     if (!o.empty()) out[section] = o;
   }
+  if (j.contains("camera")) {
+    CheckRelativePath(j.at("camera").is_string() ? j.at("camera").get<std::string>() : "", "experiment.camera");
+    out["camera"] = j.at("camera");
+  }
+  if (j.contains("scenes")) {
+    const json& scenes = j.at("scenes");
+    if (!scenes.is_object()) throw InputError("experiment.scenes", "must be a JSON object (name -> scene file)");
+    if (scenes.size() > 100) throw InputError("experiment.scenes", "has more than 100 scenes");
+    ordered_json o = ordered_json::object();
+    for (const auto& [name, path] : scenes.items()) {
+      const std::string field = "experiment.scenes." + name.substr(0, 32);
+      CheckText(json(name), field, kMaxLabelLength);
+      if (name.empty()) throw InputError("experiment.scenes", "a scene's name is empty");
+      CheckRelativePath(path.is_string() ? path.get<std::string>() : "", field);
+      o[name] = path;
+    }
+    if (!o.empty()) out["scenes"] = o;
+  }
+  if (j.contains("video_analysis")) {
+    const json& v = j.at("video_analysis");
+    if (!v.is_object() || v.size() > 16) throw InputError("experiment.video_analysis", "must be a JSON object");
+    for (const auto& [key, value] : v.items()) CheckText(value, "experiment.video_analysis." + key.substr(0, 32), 64);
+    out["video_analysis"] = v;
+  }
   return out;
 }
 
@@ -380,6 +460,35 @@ json ApplyOperation(ExperimentState& state, const json& op) {
     state.rows.insert(state.rows.begin() + at, std::move(row));
     return inverse;
   }
+  if (type == "file") {
+    const std::string role = op.at("role").get<std::string>();
+    const std::string path = op.at("path").get<std::string>();
+    const std::string name = op.value("name", "");
+    CheckRelativePath(path, "path");
+    if (role != "scene" && role != "camera") throw InputError("role", "must be scene or camera");
+    ordered_json& meta = state.metadata;
+    // The inverse names the file the name pointed to before, with its text (or removes the name).
+    std::string old_path = path;
+    if (role == "camera" && meta.contains("camera")) old_path = meta.at("camera").get<std::string>();
+    if (role == "scene" && meta.contains("scenes") && meta.at("scenes").contains(name))
+      old_path = meta.at("scenes").at(name).get<std::string>();
+    json inverse = {{"type", "file"}, {"role", role}, {"name", name}, {"path", old_path}, {"content", nullptr}};
+    if (const auto it = state.files.find(old_path); it != state.files.end()) inverse["content"] = it->second;
+    if (op.at("content").is_null()) {
+      state.files.erase(path);
+      if (role == "camera") meta.erase("camera");
+      else if (meta.contains("scenes")) {
+        meta["scenes"].erase(name);
+        if (meta["scenes"].empty()) meta.erase("scenes");
+      }
+    } else {
+      state.files[path] = op.at("content").get<std::string>();
+      if (role == "camera") meta["camera"] = path;
+      else meta["scenes"][name] = path;
+    }
+    state.metadata = Canonical(meta);
+    return inverse;
+  }
   if (type == "delete") {
     const std::int64_t id = op.at("id").get<std::int64_t>();
     const int index = state.IndexOf(id);
@@ -426,6 +535,8 @@ ExperimentState StateFromFolder(const ExperimentFolder& folder, const std::optio
       if (base == "trial") r.trial = cell;
       else if (base == "series") r.series = cell;
       else if (base == "note") r.note = cell;
+      else if (base == "video") r.video = Trim(cell);
+      else if (base == "scene") r.scene = Trim(cell);
       else if (std::find(RowQuantities().begin(), RowQuantities().end(), base) != RowQuantities().end()) {
         const std::string text = Trim(cell);
         if (text.empty()) continue;

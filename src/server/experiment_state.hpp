@@ -11,6 +11,11 @@
 //   {"type":"meta","experiment":{...},"unit":"mm"}     replace experiment.json and the unit
 //   {"type":"put","row":{...},"index":i}               insert (new id) or replace (same id) a row
 //   {"type":"delete","id":n}                           remove a row
+//   {"type":"file","role":"scene"|"camera","name":s,"path":p,"content":text|null}
+//                                                      a calibration file of the folder (format
+//                                                      uphill-experiment/2): its text, and its
+//                                                      name in experiment.json (`scenes`.s or
+//                                                      `camera`); null removes the name
 // ApplyOperation returns the operation that undoes it, so undo is itself just an operation.
 #pragma once
 
@@ -18,6 +23,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -35,9 +41,21 @@ inline constexpr std::size_t kMaxNumberLength = 32;
 // The quantities a row may carry: the crossbar measurements, Y, and per-row uncertainties.
 const std::vector<std::string>& RowQuantities();  // L, H, D, Y, u_L, u_H, u_D, u_Y
 
+// experiment.json's keys of format uphill-experiment/2 (ISSUE 13: the videos of the trials), and
+// the format a folder is written in once it uses one of them or a row's video or scene.
+inline constexpr const char* kExperimentFormatVideo = "uphill-experiment/2";
+const std::set<std::string>& VideoExperimentKeys();  // camera scenes video_analysis
+inline constexpr std::size_t kMaxPathLength = 240;     // a video's or calibration file's path
+
+// A path relative to the experiment folder, as experiment.json and measurements.csv name files:
+// '/'-separated, no empty, "." or ".." component, not absolute, no control characters or
+// backslashes, at most kMaxPathLength bytes. Throws InputError(field, rule).
+void CheckRelativePath(const std::string& path, const std::string& field);
+
 struct Row {
   std::int64_t id = 0;  // assigned by the store, stable across edits; never reused
   std::string trial, series, note;
+  std::string video, scene;  // the trial's recording (a path in the folder) and its scene's name
   std::map<std::string, std::string> values;  // quantity -> plain number text in `unit`
 
   // The value as typed, or "" when absent.
@@ -50,12 +68,18 @@ struct ExperimentState {
   std::string unit = "mm";          // of every length in measurements.csv
   std::vector<Row> rows;
   std::int64_t next_id = 1;
+  // The calibration files the state owns (path in the folder -> text), written with the others.
+  std::map<std::string, std::string> files;
+
+  // Whether the folder uses a feature of uphill-experiment/2 (a video key or column).
+  bool UsesVideo() const;
 
   // The measured quantities that are columns (vary per row): L, H, D unless experiment.json's
   // apparatus gives them (or gives θ/α), then Y; then the u_ columns some row uses.
   std::vector<std::string> Columns() const;
-  // The quantities a row must give: Columns() without the u_ ones.
-  std::vector<std::string> RequiredQuantities() const;
+  // The quantities a row must give: Columns() without the u_ ones (and without Y for a row with
+  // a video: Y then comes from the video's rest position).
+  std::vector<std::string> RequiredQuantities(const Row* row = nullptr) const;
   // Index into rows, or -1.
   int IndexOf(std::int64_t id) const;
 

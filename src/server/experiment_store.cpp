@@ -173,6 +173,7 @@ ExperimentStore::ExperimentStore(std::string directory) {
       }
     } else {
       state_ = load_files();
+      LoadCalibrationFiles();
       version_ = highest_version + 1;
       need_snapshot_ = true;
       journal_message_ = "the files were changed outside the server: they win; the journal continues with a "
@@ -181,6 +182,7 @@ ExperimentStore::ExperimentStore(std::string directory) {
   } else if (!damage) {
     if (json_text) {
       state_ = load_files();
+      LoadCalibrationFiles();
       version_ = highest_version + 1;
       journal_message_ = journal_text ? "opened the files (the journal holds no entries)" : "opened the files (no journal yet)";
     } else {
@@ -197,6 +199,7 @@ ExperimentStore::ExperimentStore(std::string directory) {
                                          " to fall back on: repair the journal, or move it aside to start a new "
                                          "experiment");
     state_ = load_files();
+    LoadCalibrationFiles();
     undo_.clear();
     version_ = highest_version + 1;
     need_snapshot_ = true;
@@ -215,8 +218,13 @@ ExperimentStore::ExperimentStore(std::string directory) {
       journal_message_ = "cut off an unfinished (unacknowledged) journal line (" + *scan.torn_tail + "); " + journal_message_;
     }
     // Bring the files up to the journal (a crash may have left them one change behind).
+    if (replayed)
+      for (const auto& [path, content] : state_.files)
+        if (const auto text = folder_ ? folder_->ReadFile(path, kMaxCalibrationFileBytes) : std::nullopt)
+          file_hashes_[path] = ContentHash(*text);
     if (replayed && state_.exists &&
-        (ContentHash(state_.ExperimentJson()) != json_hash_ || ContentHash(state_.MeasurementsCsv()) != csv_hash_)) {
+        (ContentHash(state_.ExperimentJson()) != json_hash_ || ContentHash(state_.MeasurementsCsv()) != csv_hash_ ||
+         CalibrationFilesBehind())) {
       WriteFiles();
       journal_message_ += "; rewrote the files from the journal (they were behind it)";
     }
@@ -317,8 +325,51 @@ void ExperimentStore::Append(json entry) {
   ++seq_;
 }
 
+void ExperimentStore::LoadCalibrationFiles() {
+  // The calibration files experiment.json names become part of the state (so that undo and the
+  // journal restore them); one that is missing or unreadable is left to the reader that needs it.
+  if (!folder_ || !state_.metadata.is_object()) return;
+  std::vector<std::string> paths;
+  if (state_.metadata.contains("camera") && state_.metadata.at("camera").is_string())
+    paths.push_back(state_.metadata.at("camera").get<std::string>());
+  if (state_.metadata.contains("scenes") && state_.metadata.at("scenes").is_object())
+    for (const auto& [name, path] : state_.metadata.at("scenes").items())
+      if (path.is_string()) paths.push_back(path.get<std::string>());
+  for (const std::string& path : paths) {
+    try {
+      CheckRelativePath(path, "path");
+      if (const auto text = folder_->ReadFile(path, kMaxCalibrationFileBytes)) {
+        state_.files[path] = *text;
+        file_hashes_[path] = ContentHash(*text);
+      }
+    } catch (const std::exception&) {
+    }
+  }
+}
+
+bool ExperimentStore::CalibrationFilesBehind() const {
+  for (const auto& [path, content] : state_.files) {
+    const auto it = file_hashes_.find(path);
+    if (it == file_hashes_.end() || it->second != ContentHash(content)) return true;
+  }
+  return false;
+}
+
 void ExperimentStore::WriteFiles() {
   EnsureFolder();
+  // Calibration files first: experiment.json then names files that are there.
+  for (const auto& [path, content] : state_.files) {
+    const std::string h = ContentHash(content);
+    if (const auto it = file_hashes_.find(path); it != file_hashes_.end() && it->second == h) continue;
+    const std::size_t slash = path.rfind('/');
+    if (slash == std::string::npos) {
+      folder_->WriteFileAtomically(path, content);
+    } else {
+      const ContainedDirectory sub = folder_->Subdirectory(path.substr(0, slash), true);
+      sub.WriteFileAtomically(path.substr(slash + 1), content);
+    }
+    file_hashes_[path] = h;
+  }
   const std::string json_text = state_.ExperimentJson();
   const std::string csv_text = state_.MeasurementsCsv();
   // experiment.json first: recovery accepts a new experiment.json with the previous CSV.
@@ -406,6 +457,16 @@ StoreSnapshot ExperimentStore::DeleteRow(std::int64_t version, std::int64_t id) 
   std::lock_guard lock(mutex_);
   CheckVersion(version);
   return Commit({{"type", "delete"}, {"id", id}}, false);
+}
+
+StoreSnapshot ExperimentStore::SaveCalibrationFile(std::int64_t version, const std::string& role,
+                                                   const std::string& name, const std::string& path,
+                                                   const std::string& content) {
+  std::lock_guard lock(mutex_);
+  CheckVersion(version);
+  if (!state_.exists) throw InputError("experiment", "does not exist yet: create it first");
+  if (content.size() > kMaxCalibrationFileBytes) throw InputError(path, "is too large for a calibration file");
+  return Commit({{"type", "file"}, {"role", role}, {"name", name}, {"path", path}, {"content", content}}, false);
 }
 
 StoreSnapshot ExperimentStore::Undo(std::int64_t version) {

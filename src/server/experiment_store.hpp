@@ -45,6 +45,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -63,6 +64,7 @@ inline constexpr std::size_t kMaxUndo = 500;
 // Reading limits: experiment files are small; a journal of a long lab day stays far below this.
 inline constexpr std::size_t kMaxExperimentFileBytes = 64u << 20;
 inline constexpr std::size_t kMaxJournalBytes = 1u << 30;
+inline constexpr std::size_t kMaxCalibrationFileBytes = 1u << 20;
 
 struct StoreSnapshot {
   std::int64_t version = 0;
@@ -111,6 +113,11 @@ class ExperimentStore {
   StoreSnapshot EditRow(std::int64_t version, std::int64_t id, const nlohmann::json& row);
   StoreSnapshot DeleteRow(std::int64_t version, std::int64_t id);
   StoreSnapshot Undo(std::int64_t version);
+  // A calibration file of the folder (experiment_state.hpp, operation "file"): `content` becomes
+  // the file at `path` and `path` the experiment's `camera` (role "camera") or its scene `name`
+  // (role "scene"). Journaled, written atomically and undone like a row.
+  StoreSnapshot SaveCalibrationFile(std::int64_t version, const std::string& role, const std::string& name,
+                                    const std::string& path, const std::string& content);
 
   // The folder's resolved absolute path.
   const std::string& directory() const { return directory_; }
@@ -131,6 +138,8 @@ class ExperimentStore {
   void Append(nlohmann::json entry);
   void WriteFiles();
   void WriteHead();
+  void LoadCalibrationFiles();
+  bool CalibrationFilesBehind() const;
 
   std::string directory_;
   std::unique_ptr<ContainedDirectory> parent_;  // while the folder does not exist yet
@@ -145,6 +154,7 @@ class ExperimentStore {
   std::string journal_id_;
   std::int64_t seq_ = 0;              // of the last entry written
   std::string json_hash_, csv_hash_;  // of the files as they are on disk ("" = absent)
+  std::map<std::string, std::string> file_hashes_;  // of the calibration files on disk
   int journal_fd_ = -1;
   std::string recovery_note_;
   std::string journal_message_;

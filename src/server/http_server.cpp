@@ -4,6 +4,8 @@
 #include <cctype>
 #include <filesystem>
 #include <regex>
+#include <sstream>
+#include <type_traits>
 
 #include "io/contained_directory.hpp"
 #include "io/experiment.hpp"
@@ -12,7 +14,10 @@
 #include "model/input_error.hpp"
 #include "report/analysis.hpp"
 #include "report/fit_document.hpp"
+#include "vision/camera.hpp"
+#include "internal/calibration_api.hpp"
 #include "internal/page_assets.hpp"
+#include "internal/video_upload.hpp"
 #include "server/row_check.hpp"
 // Last: it includes <httplib.h>, which includes <resolv.h>, whose `_res` macro breaks Eigen.
 #include "internal/bounded_http_server.hpp"
@@ -112,6 +117,11 @@ std::int64_t VersionOf(const json& body) {
   return body.at("version").get<std::int64_t>();
 }
 
+// The one route whose body is not JSON: an upload, streamed to disk (internal/video_upload.hpp).
+constexpr const char* kUploadPattern = R"(/api/videos/([^/]{1,120}))";
+const std::regex kUploadRoute(kUploadPattern);
+bool IsUpload(const httplib::Request& req) { return req.method == "PUT" && std::regex_match(req.path, kUploadRoute); }
+
 bool ValidReportName(const std::string& name) {
   static const std::regex ok("[A-Za-z0-9][A-Za-z0-9._-]{0,127}");
   return std::regex_match(name, ok) && name.find("..") == std::string::npos;
@@ -137,6 +147,7 @@ std::string ContentType(const std::string& name) {
   if (ext == ".json") return "application/json; charset=utf-8";
   if (ext == ".svg") return "image/svg+xml";
   if (ext == ".png") return "image/png";
+  if (ext == ".jpg" || ext == ".jpeg") return "image/jpeg";
   return "text/plain; charset=utf-8";  // .md, .gp, .dat, anything else: shown, never run
 }
 
@@ -209,10 +220,15 @@ struct Server::Impl {
 
   // Runs a change: maps every outcome to its status code; success returns the new state.
   template <class Change>
-  void Mutate(const httplib::Request& req, httplib::Response& res, Change change) {
+  void Mutate(const httplib::Request& req, httplib::Response& res, Change change, bool state_answer = true) {
     try {
       const json body = ParseBody(req);
-      SendJson(res, 200, StateJson(change(body)));
+      if constexpr (std::is_same_v<decltype(change(body)), StoreSnapshot>) {
+        SendJson(res, 200, StateJson(change(body)));
+      } else {
+        (void)state_answer;
+        SendJson(res, 200, change(body));
+      }
     } catch (const VersionConflict& e) {
       SendJson(res, 409, {{"error", e.what()}, {"state", StateJson(e.current())}});
     } catch (const InputError& e) {
@@ -239,7 +255,9 @@ struct Server::Impl {
   }
 
   void Routes() {
-    http.set_payload_max_length(options.max_request_bytes);
+    // Uploads may be large; every other request is held to max_request_bytes before its body is
+    // read (pre-routing handler) and by its connection's byte budget.
+    http.set_payload_max_length(std::max(options.max_request_bytes, options.max_upload_bytes));
 
     // Every request, before its body is read: the headers that decide how it is read and whom it
     // comes from must be there once, the body must have a length, and it must come from here.
@@ -254,9 +272,21 @@ struct Server::Impl {
         const std::string origin = req.get_header_value("Origin");
         if (!origin.empty() && origin != "http://" + req.get_header_value("Host"))
           return Refuse(res, 403, "cross-origin change refused");
+        if (IsUpload(req)) {
+          if (req.get_header_value("Content-Type") != "application/octet-stream")
+            return Refuse(res, 415, "an upload must be sent as application/octet-stream");
+          const std::size_t length = req.get_header_value<std::uint64_t>("Content-Length");
+          if (length > options.max_upload_bytes)
+            return Refuse(res, 413, "the file is larger than the upload limit (" +
+                                        std::to_string(options.max_upload_bytes >> 20) + " MiB)");
+          internal::BoundedHttpServer::AllowLargeRequest(length + 32 * 1024, options.upload_deadline);
+          return httplib::Server::HandlerResponse::Unhandled;
+        }
         if (!IsJsonContentType(req.get_header_value("Content-Type")))
           return Refuse(res, 415, "changes must be sent as application/json");
       }
+      if (req.get_header_value<std::uint64_t>("Content-Length") > options.max_request_bytes)
+        return Refuse(res, 413, "request too large (at most " + std::to_string(options.max_request_bytes / 1024) + " KiB)");
       return httplib::Server::HandlerResponse::Unhandled;
     });
     http.set_post_routing_handler([](const httplib::Request&, httplib::Response& res) { SecurityHeaders(res); });
@@ -377,6 +407,7 @@ struct Server::Impl {
         SendError(res, 500, e.what());
       }
     });
+    VideoRoutes();
     http.Get("/report/(.*)", [this](const httplib::Request& req, httplib::Response& res) {
       const std::string name = req.matches[1].str();
       if (!ValidReportName(name)) {
@@ -407,6 +438,146 @@ struct Server::Impl {
         SendError(res, 403, std::string("refused: ") + e.what());
       }
     });
+  }
+
+  // Runs a request that answers JSON (no change): maps every outcome to its status code.
+  template <class Answer>
+  void Respond(const httplib::Request& req, httplib::Response& res, Answer answer) {
+    Mutate(req, res, [&](const json& body) -> ordered_json { return answer(body); }, false);
+  }
+
+  void VideoRoutes() {
+    http.Get("/api/videos", [this](const httplib::Request& req, httplib::Response& res) {
+      Respond(req, res, [this](const json&) { return internal::ListVideos(store); });
+    });
+    http.Get("/api/video/frame", [this](const httplib::Request& req, httplib::Response& res) {
+      try {
+        int frame = 0;
+        if (req.has_param("frame")) {
+          const std::string f = req.get_param_value("frame");
+          if (f.empty() || f.size() > 9 || f.find_first_not_of("0123456789") != std::string::npos)
+            throw InputError("frame", "must be a frame number (0 = the first)");
+          frame = std::stoi(f);
+        }
+        const EncodedFrame image = internal::VideoFrame(store, req.get_param_value("video"), frame,
+                                                        req.get_param_value("format") == "jpeg");
+        res.set_header("X-Frame-Index", std::to_string(image.index));
+        res.set_header("X-Video-Size", std::to_string(image.video.width) + "x" + std::to_string(image.video.height));
+        res.set_header("X-Video-Frames", std::to_string(image.video.frames));
+        res.set_content(image.bytes, image.content_type);
+      } catch (const InputError& e) {
+        SendError(res, 422, e.what(), e.quantity());
+      } catch (const std::exception& e) {
+        SendError(res, 500, e.what());
+      }
+    });
+    http.Get("/api/scene/points", [this](const httplib::Request& req, httplib::Response& res) {
+      Respond(req, res, [this, &req](const json&) {
+        json query = json::object();
+        const auto number = [](const std::string& text, const std::string& field) {
+          try {
+            std::size_t used = 0;
+            const double v = std::stod(text, &used);
+            if (used == text.size()) return v;
+          } catch (const std::exception&) {
+          }
+          throw InputError(field, "must be a number (got \"" + text.substr(0, 32) + "\")");
+        };
+        if (req.has_param("row")) query["row"] = static_cast<std::int64_t>(number(req.get_param_value("row"), "row"));
+        if (req.has_param("table_z")) query["table_z"] = number(req.get_param_value("table_z"), "table_z");
+        if (req.has_param("marks")) {
+          query["marks"] = json::array();
+          std::stringstream in(req.get_param_value("marks"));
+          for (std::string item; std::getline(in, item, ',');)
+            if (!item.empty()) query["marks"].push_back(number(item, "marks"));
+        }
+        return internal::ScenePoints(store.Get(), query);
+      });
+    });
+    http.Post("/api/scene/solve", [this](const httplib::Request& req, httplib::Response& res) {
+      Respond(req, res, [this](const json& b) { return internal::SolveScene(store, store.Get(), b); });
+    });
+    http.Put(R"(/api/scenes/([^/]{1,64}))", [this](const httplib::Request& req, httplib::Response& res) {
+      Mutate(req, res, [this, &req](const json& b) {
+        const std::int64_t version = VersionOf(b);
+        const std::string name = req.matches[1].str();
+        const std::string path = internal::SceneFilePath(name);
+        std::string text;
+        internal::SolveScene(store, store.Get(), b, &text);
+        return store.SaveCalibrationFile(version, "scene", name, path, text);
+      });
+    });
+    http.Post("/api/camera/calibrate", [this](const httplib::Request& req, httplib::Response& res) {
+      Respond(req, res, [this](const json& b) {
+        const std::int64_t version = VersionOf(b);
+        std::string text;
+        ordered_json calibration = internal::CalibrateCameraViews(store, store.Get(), b, &text);
+        const StoreSnapshot s = store.SaveCalibrationFile(version, "camera", "", "calibration/camera.json", text);
+        return ordered_json{{"calibration", calibration}, {"state", StateJson(s)}};
+      });
+    });
+    http.Post(R"(/api/rows/(\d{1,12})/video)", [this](const httplib::Request& req, httplib::Response& res) {
+      Mutate(req, res, [this, &req](const json& b) {
+        const std::int64_t version = VersionOf(b);
+        const std::int64_t id = std::stoll(req.matches[1].str());
+        const StoreSnapshot s = store.Get();
+        const int index = s.state.IndexOf(id);
+        if (index < 0) throw InputError("row", "row " + std::to_string(id) + " does not exist");
+        ordered_json row = ToJson(s.state.rows[index]);
+        const std::string video = b.value("video", json("")).is_string() ? b.value("video", "") : "";
+        if (video.empty()) {
+          row.erase("video");
+        } else {
+          const VideoProbe probe = ProbeVideo(internal::FolderFile(store, video, "video"), video);
+          CheckSceneFits(s, s.state.rows[index].scene, video, probe);
+          row["video"] = video;
+        }
+        return store.EditRow(version, id, row);
+      });
+    });
+    http.Put(kUploadPattern, [this](const httplib::Request& req, httplib::Response& res,
+                                  const httplib::ContentReader& reader) {
+      try {
+        const ContainedDirectory* folder = store.folder();
+        if (!folder) throw InputError("experiment", "does not exist yet: create it first");
+        const std::string name = req.matches[1].str();
+        const std::string path = internal::ReceiveUpload(
+            *folder, "videos", name, req.get_header_value<std::uint64_t>("Content-Length"), options.max_upload_bytes,
+            [&](const std::function<bool(const char*, std::size_t)>& sink) { return reader(sink); },
+            [&](const std::string& staged) { ProbeVideo(staged, name); });
+        const VideoProbe probe = ProbeVideo(folder->path() + "/" + path, path);
+        SendJson(res, 200, {{"path", path}, {"width", probe.width}, {"height", probe.height}, {"fps", probe.fps},
+                            {"frames", probe.frames}});
+      } catch (const InputError& e) {
+        SendError(res, 422, e.what(), e.quantity());
+        res.set_header("Connection", "close");  // the rest of the body, if any, is not read
+        internal::BoundedHttpServer::CloseAfterResponse();
+      } catch (const std::exception& e) {
+        SendError(res, 500, e.what());
+        res.set_header("Connection", "close");
+        internal::BoundedHttpServer::CloseAfterResponse();
+      }
+    });
+  }
+
+  // A scene file that does not fit the video's size is refused when the video is attached (the
+  // track would be wrong everywhere): the row's scene, or the experiment's only scene.
+  static void CheckSceneFits(const StoreSnapshot& s, std::string scene, const std::string& video,
+                             const VideoProbe& probe) {
+    const ordered_json& meta = s.state.metadata;
+    if (!meta.is_object() || !meta.contains("scenes")) return;
+    if (scene.empty() && meta.at("scenes").size() == 1) scene = meta.at("scenes").begin().key();
+    if (scene.empty() || !meta.at("scenes").contains(scene)) return;
+    const std::string path = meta.at("scenes").at(scene).get<std::string>();
+    const auto it = s.state.files.find(path);
+    if (it == s.state.files.end()) return;
+    const SceneCalibration calibration = ParseSceneFile(path, it->second);
+    if (calibration.camera.width != probe.width || calibration.camera.height != probe.height)
+      throw InputError("video", video + " is " + std::to_string(probe.width) + "×" + std::to_string(probe.height) +
+                                    " px but the scene file " + path + " (scene \"" + scene + "\") is for " +
+                                    std::to_string(calibration.camera.width) + "×" +
+                                    std::to_string(calibration.camera.height) +
+                                    " px: calibrate a scene for this video's camera setting");
   }
 
   // The fit report of the files as they are, written into a private staging folder inside the

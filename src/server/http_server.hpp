@@ -11,6 +11,18 @@
 //   POST   /api/check                     {row}: check a draft row (nothing stored)
 //   POST   /api/report                    {}: write the fit report to EXP/report/
 //   GET    /report/<name>                 a file of EXP/report/, read-only
+// Videos and calibration (internal/calibration_api.hpp says what each answers):
+//   GET    /api/videos                    the video files in the folder
+//   PUT    /api/videos/<name>             the body (application/octet-stream, at most
+//                                         max_upload_bytes) becomes EXP/videos/<name>, atomically
+//   GET    /api/video/frame?video=P&frame=N[&format=jpeg]   a frame as PNG (or JPEG)
+//   POST   /api/rows/<id>/video           {version, video}: attach a video of the folder to a row
+//   GET    /api/scene/points?row=ID[&table_z=Z&marks=M,M]   the apparatus points to click
+//   POST   /api/scene/solve               {video, row?, clicks}: the pose, residuals, the path
+//   PUT    /api/scenes/<name>             {version, video, row?, clicks}: solve and save the
+//                                         scene file calibration/scene-<name>.json
+//   POST   /api/camera/calibrate          {version, folder, cols, rows, square}: the camera file
+//                                         calibration/camera.json from chessboard views
 // The state: {version, can_undo, directory, exists, experiment, unit, columns, rows:[{id, trial,
 // series, L, H, D, Y, u_*, note, check:{theta_deg, alpha_deg, x, u_x, x_max, crossbar, y,
 // residual, flags:[{code, field, message, severity}]}}], fit:{...}, report:{exists, url},
@@ -47,6 +59,8 @@ struct ServerOptions {
   std::string host = "127.0.0.1";
   int port = 8080;                     // 0: any free port (Bind returns it)
   std::size_t max_request_bytes = 64 * 1024;  // a request's body; its headers get 32 KiB more
+  std::size_t max_upload_bytes = std::size_t{2} << 30;  // an uploaded video
+  std::chrono::milliseconds upload_deadline{30 * 60 * 1000};  // for the whole upload
   std::uint64_t report_mc_trials = 10000;  // per row, for u(X) by Monte Carlo in the report
   // A request must arrive whole within request_deadline; a connection idle for idle_timeout is
   // closed; at most max_connections are served at once (one thread each).

@@ -149,6 +149,14 @@ std::string FieldOf(const InputError& e) {
   return "";
 }
 
+}  // namespace
+
+Configuration RowConfiguration(const ExperimentState& state, const Row& row) {
+  return ParseConfiguration(MakeSource(state, row, state.Columns()));
+}
+
+namespace {
+
 RowCheck Check(const Context& context, const Row& row) {
   const ExperimentState& state = *context.state;
   RowCheck check;
@@ -205,7 +213,9 @@ RowCheck Check(const Context& context, const Row& row) {
   } catch (const InputError& e) {
     Add(check, "invalid", FieldOf(e), e.what(), true);
   }
-  try {
+  if (!row.video.empty() && row.Value("Y").empty()) {
+    // Y comes from the video's rest position (accepted in the page, or by the report).
+  } else try {
     const FieldSource source = MakeSource(state, row, columns);
     const auto y = source.lookup("Y");
     check.y = ParseQuantity(y ? y->text : "", Dimension::kLength, "Y", y ? y->default_unit : "");

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "io/configuration.hpp"
 #include "server/experiment_state.hpp"
 
 namespace uphill {
@@ -41,6 +42,10 @@ struct RowCheck {
   std::optional<double> theta, alpha, x_eq, u_x_eq, x_max, crossbar, y, u_y;
   std::vector<RowFlag> flags;
 };
+
+// The row's setting (body, rails, rods) from its cells and the experiment's constants. Throws
+// InputError naming the field.
+Configuration RowConfiguration(const ExperimentState& state, const Row& row);
 
 // Checks `row` against the experiment and the stored rows (a stored row with the same id is not
 // compared with itself). Never throws for bad input: that becomes a flag.

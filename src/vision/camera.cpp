@@ -160,7 +160,6 @@ void ValidateRotation(const Eigen::Matrix3d& r, const std::string& context) {
   if (r.determinant() < 0) throw InputError(context, "is a reflection (determinant −1), not a rotation");
 }
 
-void WriteJson(const std::string& path, const ordered_json& j) { WriteFileAtomically(path, j.dump(2) + "\n"); }
 
 }  // namespace
 
@@ -244,14 +243,36 @@ Eigen::Vector3d CameraCentre(const CameraPose& pose) {
   return -pose.rotation.transpose() * pose.translation;
 }
 
-CameraIntrinsics ReadCameraFile(const std::string& path) {
-  const json j = ReadJsonFile(path);
+namespace {
+
+json ParseJsonText(const std::string& path, const std::string& text) {
+  try {
+    return json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw InputError(path, std::string("is not valid JSON: ") + e.what());
+  }
+}
+
+CameraIntrinsics CameraFromJson(const std::string& path, const json& j) {
   CheckFormat(j, path, kCameraFormat);
   return IntrinsicsFromJson(j, path, {"format", "calibration"});
 }
 
-SceneCalibration ReadSceneFile(const std::string& path) {
-  const json j = ReadJsonFile(path);
+SceneCalibration SceneFromJson(const std::string& path, const json& j);
+
+}  // namespace
+
+CameraIntrinsics ReadCameraFile(const std::string& path) { return CameraFromJson(path, ReadJsonFile(path)); }
+CameraIntrinsics ParseCameraFile(const std::string& path, const std::string& text) {
+  return CameraFromJson(path, ParseJsonText(path, text));
+}
+SceneCalibration ReadSceneFile(const std::string& path) { return SceneFromJson(path, ReadJsonFile(path)); }
+SceneCalibration ParseSceneFile(const std::string& path, const std::string& text) {
+  return SceneFromJson(path, ParseJsonText(path, text));
+}
+
+namespace {
+SceneCalibration SceneFromJson(const std::string& path, const json& j) {
   CheckFormat(j, path, kSceneFormat);
   CheckKeys(j, {"format", "camera", "pose", "camera_centre_m", "viewing_direction", "calibration"}, path);
   SceneCalibration scene;
@@ -283,18 +304,27 @@ SceneCalibration ReadSceneFile(const std::string& path) {
   }
   return scene;
 }
+}  // namespace
 
-void WriteCameraFile(const std::string& path, const CameraIntrinsics& camera,
-                     const CalibrationSummary& summary) {
+std::string CameraFileText(const CameraIntrinsics& camera, const CalibrationSummary& summary) {
   ValidateIntrinsics(camera, "camera");
   ordered_json j{{"format", kCameraFormat}};
   j.update(IntrinsicsToJson(camera));
   j["calibration"] = SummaryToJson(summary);
-  WriteJson(path, j);
+  return j.dump(2) + "\n";
+}
+
+void WriteCameraFile(const std::string& path, const CameraIntrinsics& camera,
+                     const CalibrationSummary& summary) {
+  WriteFileAtomically(path, CameraFileText(camera, summary));
 }
 
 void WriteSceneFile(const std::string& path, const SceneCalibration& scene,
                     const CalibrationSummary& summary) {
+  WriteFileAtomically(path, SceneFileText(scene, summary));
+}
+
+std::string SceneFileText(const SceneCalibration& scene, const CalibrationSummary& summary) {
   ValidateIntrinsics(scene.camera, "camera");
   ValidateRotation(scene.pose.rotation, "pose.rotation");
   if (!scene.pose.translation.allFinite()) throw InputError("pose.translation", "must be finite");
@@ -311,7 +341,7 @@ void WriteSceneFile(const std::string& path, const SceneCalibration& scene,
          {"camera_centre_m", {centre.x(), centre.y(), centre.z()}},
          {"viewing_direction", {axis.x(), axis.y(), axis.z()}},
          {"calibration", SummaryToJson(summary)}};
-  WriteJson(path, j);
+  return j.dump(2) + "\n";
 }
 
 }  // namespace uphill

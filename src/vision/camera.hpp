@@ -96,5 +96,12 @@ void WriteCameraFile(const std::string& path, const CameraIntrinsics& camera,
                      const CalibrationSummary& summary);
 void WriteSceneFile(const std::string& path, const SceneCalibration& scene,
                     const CalibrationSummary& summary);
+// The files' text, exactly as the writers above write it (for a writer that stores the file
+// itself: the server journals it before writing). Same InputError checks.
+std::string CameraFileText(const CameraIntrinsics& camera, const CalibrationSummary& summary);
+std::string SceneFileText(const SceneCalibration& scene, const CalibrationSummary& summary);
+// The same readers from a file's text; `path` names it in messages.
+CameraIntrinsics ParseCameraFile(const std::string& path, const std::string& text);
+SceneCalibration ParseSceneFile(const std::string& path, const std::string& text);
 
 }  // namespace uphill

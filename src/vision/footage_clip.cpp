@@ -756,32 +756,9 @@ std::string FootageCacheRoot() {
 }
 
 std::vector<ApparatusPoint> FootageApparatusPoints(const FootageCondition& c) {
-  const double T = c.scene.rails().tan_half_alpha, B = c.scene.rails().tan_theta;
-  const double L = c.apparatus.crossbar_x;
-  std::vector<std::pair<std::string, Vector3d>> points = {{"O", Vector3d::Zero()},
-                                                         {"left rail crossbar", Vector3d(L, L * T, L * B)},
-                                                         {"right rail crossbar", Vector3d(L, -L * T, L * B)},
-                                                         {"left foot", Vector3d(L, L * T, c.apparatus.table_z)},
-                                                         {"right foot", Vector3d(L, -L * T, c.apparatus.table_z)}};
-  for (double m : c.apparatus.marks) {
-    if (m <= 0 || m >= L) continue;
-    const int mm = static_cast<int>(std::lround(m * 1000));
-    points.push_back({"mark " + std::to_string(mm) + " left", Vector3d(m, m * T, m * B)});
-    points.push_back({"mark " + std::to_string(mm) + " right", Vector3d(m, -m * T, m * B)});
-  }
-  std::vector<ApparatusPoint> out;
-  const CameraIntrinsics& k = c.camera.camera;
-  for (const auto& [name, p] : points) {
-    const Vector3d q = c.camera.pose.rotation * p + c.camera.pose.translation;
-    if (q.z() <= 0) continue;
-    const Vector2d pixel = ProjectApparatusPoint(k, c.camera.pose, p);
-    if (pixel.x() < 2 || pixel.y() < 2 || pixel.x() > k.width - 3 || pixel.y() > k.height - 3) continue;
-    // Only points really in view: the distortion polynomial folds rays far outside the field of
-    // view back into the image, and undistorting the pixel then gives another ray.
-    if ((UndistortPixel(k, pixel) - Vector2d(q.x() / q.z(), q.y() / q.z())).norm() > 1e-6) continue;
-    out.push_back({name, p, pixel});
-  }
-  return out;
+  return VisibleApparatusPoints(c.camera.camera, c.camera.pose,
+                                ApparatusCalibrationPoints(c.scene.rails(), c.apparatus.crossbar_x, c.apparatus.table_z,
+                                                           c.apparatus.marks));
 }
 
 FootageFiles RenderFootage(const FootageCondition& condition, const std::string& cache_root, bool fresh,

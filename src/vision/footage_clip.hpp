@@ -58,6 +58,7 @@
 #include <vector>
 
 #include "model/scene.hpp"
+#include "vision/apparatus_points.hpp"
 #include "vision/camera.hpp"
 #include "vision/chessboard_render.hpp"
 #include "vision/povray_render.hpp"
@@ -135,12 +136,7 @@ FootageFiles RenderFootage(const FootageCondition& condition, const std::string&
 std::vector<ClipTruth> ReadFootageTruth(const std::string& path);
 
 // The apparatus points of calibration/README.md (O, rails at the crossbar, feet, marks) with
-// their exact raw pixels for this camera and pose, those inside the image.
-struct ApparatusPoint {
-  std::string name;
-  Eigen::Vector3d position;  // m
-  Eigen::Vector2d pixel;
-};
+// their exact raw pixels for this camera and pose, those in view (vision/apparatus_points.hpp).
 std::vector<ApparatusPoint> FootageApparatusPoints(const FootageCondition& condition);
 
 }  // namespace uphill

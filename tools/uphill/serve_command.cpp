@@ -1,15 +1,21 @@
 // `uphill serve [EXPERIMENT_DIR] [--port 8080] [--host 127.0.0.1]`: the local web page on which
 // lab technicians enter measurements (src/server/). Prints the address, serves until SIGINT or
 // SIGTERM. Every acknowledged change is already on disk (journal + files), so stopping the
-// server in any way, even `kill -9`, loses nothing that the page showed as saved.
+// server in any way, even `kill -9`, loses nothing that the page showed as saved. The page
+// decodes video frames and calibrates (OpenCV): it runs in uphill-vision (vision_program.hpp).
+#include <memory>
+
+#include "commands.hpp"
+#include "vision_program.hpp"
+#if UPHILL_VISION_PROGRAM
 #include <pthread.h>
 #include <signal.h>
 
 #include <iostream>
 #include <thread>
 
-#include "commands.hpp"
 #include "server/http_server.hpp"
+#endif
 
 namespace uphill::cli {
 namespace {
@@ -21,6 +27,10 @@ struct ServeFlags {
 };
 
 void Serve(const ServeFlags& flags) {
+#if !UPHILL_VISION_PROGRAM
+  (void)flags;
+  RunInVisionProgram();
+#else
   ServerOptions options;
   options.directory = flags.directory;
   options.host = flags.host;
@@ -50,6 +60,7 @@ void Serve(const ServeFlags& flags) {
   // Run returned: by a signal (the waiter is done) or by a failure (wake the waiter).
   pthread_kill(waiter.native_handle(), SIGTERM);
   waiter.join();
+#endif
 }
 
 }  // namespace

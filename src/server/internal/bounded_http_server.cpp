@@ -57,6 +57,7 @@ class BoundedStream : public httplib::Stream {
   // A new request starts: a fresh budget (bytes already buffered count against it) and deadline.
   void StartRequest() {
     used_ = end_ - begin_;
+    budget_ = limits_.request_budget_bytes;
     deadline_ = Clock::now() + limits_.request_deadline;
     over_budget_ = timed_out_ = close_ = false;
   }
@@ -65,6 +66,10 @@ class BoundedStream : public httplib::Stream {
   bool timed_out() const { return timed_out_; }
   bool close_requested() const { return close_ || over_budget_ || timed_out_; }
   void RequestClose() { close_ = true; }
+  void AllowLarge(std::size_t bytes, std::chrono::milliseconds deadline) {
+    budget_ = std::max(budget_, bytes);
+    deadline_ = std::max(deadline_, Clock::now() + deadline);
+  }
 
   bool is_readable() const override { return has_buffered() || WaitFor(sock_, POLLIN, deadline_); }
   bool is_writable() const override {
@@ -73,7 +78,7 @@ class BoundedStream : public httplib::Stream {
 
   ssize_t read(char* ptr, size_t size) override {
     if (!has_buffered()) {
-      if (used_ >= limits_.request_budget_bytes) {
+      if (used_ >= budget_) {
         over_budget_ = true;
         return -1;
       }
@@ -81,7 +86,7 @@ class BoundedStream : public httplib::Stream {
         timed_out_ = true;
         return -1;
       }
-      const std::size_t room = std::min(sizeof buffer_, limits_.request_budget_bytes - used_);
+      const std::size_t room = std::min(sizeof buffer_, budget_ - used_);
       ssize_t n;
       do {
         n = ::recv(sock_, buffer_, room, 0);
@@ -124,6 +129,7 @@ class BoundedStream : public httplib::Stream {
   char buffer_[4096];
   std::size_t begin_ = 0, end_ = 0;
   std::size_t used_ = 0;
+  std::size_t budget_ = 0;
   Clock::time_point deadline_;
   bool over_budget_ = false, timed_out_ = false, close_ = false;
 };
@@ -201,6 +207,10 @@ void BoundedHttpServer::WidenBacklog(int backlog) {
 
 void BoundedHttpServer::CloseAfterResponse() {
   if (current_stream) current_stream->RequestClose();
+}
+
+void BoundedHttpServer::AllowLargeRequest(std::size_t bytes, std::chrono::milliseconds deadline) {
+  if (current_stream) current_stream->AllowLarge(bytes, deadline);
 }
 
 bool BoundedHttpServer::RequestOverBudget() { return current_stream && current_stream->over_budget(); }

@@ -48,6 +48,9 @@ class BoundedHttpServer : public httplib::Server {
 
   // For handlers (the thread serving the request): close the connection after this answer.
   static void CloseAfterResponse();
+  // For the pre-routing handler of an upload: this request may hold `bytes` (its headers
+  // included) and take until `deadline` from now.
+  static void AllowLargeRequest(std::size_t bytes, std::chrono::milliseconds deadline);
   // For the error handler: whether the current request ran out of its byte budget or deadline.
   static bool RequestOverBudget();
   static bool RequestTimedOut();

@@ -1,0 +1,39 @@
+#include "app/scene_clicks.hpp"
+
+#include "model/input_error.hpp"
+
+namespace uphill {
+
+std::vector<ApparatusPoint> SettingCalibrationPoints(const Configuration& setting, double table_z,
+                                                     const std::vector<double>& marks_x) {
+  const Rails rails = setting.MakeRails();
+  const std::optional<double> crossbar = setting.CrossbarDistance();
+  if (!crossbar)
+    throw InputError("L", "the rails are given by their angles: the points at the crossbar need L, H and D");
+  return ApparatusCalibrationPoints(rails, *crossbar, table_z, marks_x);
+}
+
+SceneClicksSolution SolveSceneClicks(const CameraIntrinsics& camera, const std::vector<ScenePoint>& clicks,
+                                     int frame_width, int frame_height, const std::optional<Scene>& scene) {
+  SceneClicksSolution out;
+  out.calibration = CalibrateScene(camera, clicks, frame_width, frame_height);
+  const CameraPose& pose = out.calibration.scene.pose;
+  std::vector<Eigen::Vector3d> positions;
+  for (const ScenePoint& p : clicks) positions.push_back(p.position);
+  out.reprojected = ProjectApparatusPoints(camera, pose, positions);
+  if (scene) {
+    std::vector<Eigen::Vector3d> path;
+    for (int i = 0; i <= 200; ++i) {
+      const double x = scene->x_low() + (scene->x_max() - scene->x_low()) * i / 200.0;
+      const Eigen::Vector3d p(x, 0, scene->At(x).z);
+      if ((pose.rotation * p + pose.translation).z() > 0) path.push_back(p);
+    }
+    out.centre_path = ProjectApparatusPoints(camera, pose, path);
+  }
+  CalibrationSummary summary = out.calibration.Summary();
+  summary.method = "points clicked in a frame of the video (uphill serve); " + summary.method;
+  out.scene_file = SceneFileText(out.calibration.scene, summary);
+  return out;
+}
+
+}  // namespace uphill

@@ -1,0 +1,43 @@
+// Scene calibration by clicks (the page of `uphill serve`, docs/serve.md "Calibrate the scene"):
+// the apparatus points the page offers for a setting, and the pose solved from the clicks so far,
+// exactly as `uphill calibrate scene --points` solves it (vision/calibration.hpp CalibrateScene),
+// with what the page draws over the frame: each point re-projected, its residual, and the model's
+// path of the body's centre.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "io/configuration.hpp"
+#include "model/scene.hpp"
+#include "vision/apparatus_points.hpp"
+#include "vision/calibration.hpp"
+
+namespace uphill {
+
+// The points of a setting (vision/apparatus_points.hpp) from its rails and crossbar distance.
+// Throws InputError("L") when the setting gives the rails by angles only (no crossbar distance:
+// then only O and typed points can be clicked), or the configuration's own InputError.
+std::vector<ApparatusPoint> SettingCalibrationPoints(const Configuration& setting, double table_z,
+                                                     const std::vector<double>& marks_x);
+
+struct SceneClicksSolution {
+  SceneCalibrationResult calibration;        // pose, RMS, residuals (one per click), verdict
+  std::vector<Eigen::Vector2d> reprojected;  // raw pixel of each click's point through the pose
+  // The body's centre along the model's path (x from x_low to x_max, 200 steps, y = 0, z from
+  // the scene) through the pose, raw pixels; the part behind the camera is left out. Empty
+  // without a scene.
+  std::vector<Eigen::Vector2d> centre_path;
+  std::string scene_file;                    // the scene file's text (uphill-scene/1)
+};
+
+// Solves the pose from ≥ 4 clicks (label, raw pixel, apparatus position). `frame_width` and
+// `frame_height`: the size of the video's frames, which must be the camera's (0: unchecked).
+// Throws InputError as CalibrateScene: fewer than 4 points ("points"), points on one line, a
+// pixel outside the image, a frame whose size is not the camera's ("frame").
+SceneClicksSolution SolveSceneClicks(const CameraIntrinsics& camera, const std::vector<ScenePoint>& clicks,
+                                     int frame_width, int frame_height, const std::optional<Scene>& scene);
+
+}  // namespace uphill

@@ -1,0 +1,50 @@
+// The calibration and video part of the server's API (http_server.hpp lists the routes): the
+// answers computed from the store's state and the folder's files. Private to src/server/.
+// Each function throws InputError (422, naming the field) for what the request or the folder's
+// files get wrong, EnvironmentError for the server's own folder; the caller maps them.
+// Lengths in requests and answers are plain numbers in the experiment's unit; pixels are raw
+// pixels of the video's frames (OpenCV's convention: (0, 0) the centre of the top-left pixel).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "app/video_frames.hpp"
+#include "server/experiment_store.hpp"
+
+namespace uphill::internal {
+
+// The absolute path of a regular file of the experiment folder, reached without links (for the
+// libraries that open paths). Throws InputError(field) when it is not there or not a file.
+std::string FolderFile(const ExperimentStore& store, const std::string& relative, const std::string& field);
+
+// GET /api/video/frame?video=P&frame=N&format=png|jpeg
+EncodedFrame VideoFrame(const ExperimentStore& store, const std::string& video, int frame, bool jpeg);
+
+// GET /api/videos: {videos:[{path, bytes}]} the video files in the folder (by extension, at most
+// 3 folders deep, links not followed), sorted.
+nlohmann::ordered_json ListVideos(const ExperimentStore& store);
+
+// GET /api/scene/points?row=ID&table_z=Z&marks=M1,M2: {points:[{name,x,y,z}]}, the apparatus
+// points of the row's setting (app/scene_clicks.hpp), or only O when the row gives no L, H, D.
+nlohmann::ordered_json ScenePoints(const StoreSnapshot& snapshot, const nlohmann::json& query);
+
+// POST /api/scene/solve {video, frame?, row?, clicks:[{name,u,v,x,y,z}]}: the pose from the
+// clicks (app/scene_clicks.hpp) with the experiment's camera file:
+// {rms_px, verdict, reasons, points:[{name,u,v,u_model,v_model,residual_px}], path:[[u,v]...],
+//  camera_centre:{x,y,z}}. `scene_file` (optional) receives the scene file's text.
+nlohmann::ordered_json SolveScene(const ExperimentStore& store, const StoreSnapshot& snapshot,
+                                  const nlohmann::json& body, std::string* scene_file = nullptr);
+
+// The scene's file in the folder: calibration/scene-<name>.json. Throws InputError("name")
+// unless the name is 1 to 32 letters, digits, '-' or '_'.
+std::string SceneFilePath(const std::string& name);
+
+// POST /api/camera/calibrate {folder, cols, rows, square}: CalibrateCamera over the images (.png,
+// .jpg, .jpeg, .bmp, .tif) of a folder of the experiment; `camera_file` receives the camera file's
+// text: {verdict, reasons, rms_px, views_used, coverage, fx, fy, cx, cy, width, height,
+// views:[{name, used, rejected_because, rms_px, tilt_deg}]}.
+nlohmann::ordered_json CalibrateCameraViews(const ExperimentStore& store, const StoreSnapshot& snapshot,
+                                            const nlohmann::json& body, std::string* camera_file);
+
+}  // namespace uphill::internal
