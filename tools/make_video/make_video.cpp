@@ -6,14 +6,19 @@
 // Usage: make_video OUT_DIR [--width 1280 --height 720] [--frames 60] [--fps 30] [--blur 8]
 //        [--noise 2] [--flicker 0.01] [--lossless] [--spheroid] [--boards 12] [--seed 1]
 // Writes OUT_DIR/clip.mp4 (H.264; clip.avi, FFV1, with --lossless), truth.csv, cam.json,
-// scene.json, boards/board_NN.png, and prints the `uphill track` command for the clip.
+// scene.json, points.csv (the apparatus points of calibration/README.md in view, O, the rails at
+// the crossbar, the feet on the table, marks at 300/600/900 mm, with their exact pixels: the
+// POINTS.csv of `uphill calibrate scene`, and the clicks of the page's end-to-end test),
+// boards/board_NN.png, and prints the `uphill track` command for the clip.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 
+#include "io/atomic_file.hpp"
 #include "model/input_error.hpp"
+#include "vision/apparatus_points.hpp"
 #include "vision/chessboard_render.hpp"
 #include "vision/synthetic_clip.hpp"
 
@@ -58,6 +63,17 @@ void Run(const Flags& f) {
   summary.reasons = {"the camera that rendered the clip: no calibration error"};
   WriteCameraFile((fs::path(f.out) / "cam.json").string(), setup.calibration.camera, summary);
   WriteSceneFile((fs::path(f.out) / "scene.json").string(), setup.calibration, summary);
+  std::string points = "name,u,v,x_mm,y_mm,z_mm\n";
+  for (const ApparatusPoint& p : VisibleApparatusPoints(
+           setup.calibration.camera, setup.calibration.pose,
+           ApparatusCalibrationPoints(setup.scene.rails(), setup.apparatus.crossbar_x, setup.apparatus.table_z,
+                                      {0.3, 0.6, 0.9}))) {
+    char line[200];
+    std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f\n", p.name.c_str(), p.pixel.x(), p.pixel.y(),
+                  p.position.x() * 1e3, p.position.y() * 1e3, p.position.z() * 1e3);
+    points += line;
+  }
+  WriteFileAtomically((fs::path(f.out) / "points.csv").string(), points);
   if (f.boards > 0) {
     const ChessboardTarget target;  // 9 x 6 inner corners, 20 mm squares
     const ChessboardRenderer boards(setup.calibration.camera, target);
@@ -72,7 +88,7 @@ void Run(const Flags& f) {
       cv::imwrite((fs::path(f.out) / "boards" / name).string(), boards.Render(pose, options).image);
     }
   }
-  std::cout << "wrote " << video << " (" << truth.size() << " frames), truth.csv, cam.json, scene.json";
+  std::cout << "wrote " << video << " (" << truth.size() << " frames), truth.csv, cam.json, scene.json, points.csv";
   if (f.boards > 0) std::cout << ", boards/ (" << f.boards << " chessboard views, 9x6 inner corners, 20 mm)";
   std::cout << "\ntrack it with:\n  uphill track " << video << " --camera " << f.out << "/cam.json --scene " << f.out
             << "/scene.json " << body_flags << " --L 1000mm --H 100mm --D 150mm --rod-diameter 8mm -o " << f.out

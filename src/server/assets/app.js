@@ -127,6 +127,7 @@ function applyState(state, fillForm) {
   renderFit();
   renderReport();
   renderJournal();
+  if (typeof onStateApplied === 'function') onStateApplied();  // video.js
 }
 
 // A journal the server could not trust: it kept the files and says what it found.
@@ -190,6 +191,8 @@ function experimentFromForm() {
   e.apparatus.L_convention = $('f-conv').value;
   e.uncertainties = {};
   for (const [k, id] of Object.entries(UNCERTAINTIES)) if ($(id).value.trim()) e.uncertainties[k] = $(id).value.trim();
+  // The calibration files and video options are set by the video section: kept as they are.
+  for (const k of ['camera', 'scenes', 'video_analysis']) if (S.experiment[k] !== undefined) e[k] = S.experiment[k];
   return e;
 }
 
@@ -259,7 +262,10 @@ function renderRows() {
     edit.addEventListener('click', () => startEdit(row.id));
     const del = el('button', { type: 'button', title: 'Delete this row (Delete)' }, 'Delete');
     del.addEventListener('click', () => deleteRow(row.id));
-    actions.append(edit, del);
+    const video = el('button', { type: 'button', class: 'video-button', title: row.video || 'Attach a video to this trial' },
+      row.video ? '▶ Video' : 'Video…');
+    video.addEventListener('click', () => { if (typeof openVideoOf === 'function') openVideoOf(row.id); });
+    actions.append(edit, del, video);
     tr.append(actions);
     tr.addEventListener('keydown', (ev) => {
       if (ev.target !== tr) return;
@@ -313,7 +319,7 @@ function rowFromInputs(tr) {
   if (tr.dataset.kind === 'edit') {
     row.id = editingId;
     const stored = S.rows.find((r) => r.id === editingId) || {};
-    for (const q of ['u_L', 'u_H', 'u_D', 'u_Y']) if (stored[q]) row[q] = stored[q];  // kept as they were
+    for (const q of ['u_L', 'u_H', 'u_D', 'u_Y', 'video', 'scene']) if (stored[q]) row[q] = stored[q];  // kept as they were
   }
   return row;
 }

@@ -1,0 +1,408 @@
+// The video section of the page of `uphill serve`: the camera from chessboard views, a trial's
+// recording (picked from the folder or uploaded), the scene calibrated by clicks on a frame, and
+// the track with its analysis. As in app.js, the server computes everything (the pose at each
+// click, the residuals, the model's path, the track) and this script only draws its answers.
+// Uses app.js's S, api, change, el, $, showMessage.
+'use strict';
+
+const V = {
+  rowId: null,      // the trial shown
+  video: '',        // its video (a path in the folder)
+  width: 0, height: 0,
+  points: [],       // [{name, x, y, z, u, v, own}] lengths in the experiment's unit, u v raw px
+  active: 0,        // index of the point the next click places
+  solution: null,   // the server's last answer to /api/scene/solve
+  track: null,      // the server's last answer to /api/rows/<id>/track
+  seq: 0,           // answers to older solves are ignored
+};
+const SVG = 'http://www.w3.org/2000/svg';
+const svgEl = (tag, attrs) => {
+  const e = document.createElementNS(SVG, tag);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+  return e;
+};
+const rowOf = (id) => (S ? S.rows.find((r) => r.id === id) : null);
+const clicksKey = () => `uphill-clicks:${S ? S.directory : ''}:${V.video}`;
+
+// ---- following the state ------------------------------------------------------------------------
+function onStateApplied() {
+  $('video-section').hidden = !S.exists;
+  for (const u of document.querySelectorAll('.unit-name')) u.textContent = S.unit;
+  const camera = S.experiment.camera;
+  $('camera-summary').textContent = camera ? `— ${camera}` : '— none yet: calibrate it from chessboard views';
+  const scenes = S.experiment.scenes || {};
+  $('scene-summary').textContent = Object.keys(scenes).length
+    ? '— saved: ' + Object.entries(scenes).map(([n, p]) => `${n} (${p})`).join(', ') : '';
+  const select = $('v-row');
+  const chosen = V.rowId ?? (S.rows.length ? S.rows[0].id : null);
+  select.replaceChildren();
+  for (const r of S.rows) {
+    const o = el('option', { value: String(r.id) }, r.trial + (r.video ? ` — ${r.video}` : ''));
+    select.append(o);
+  }
+  if (chosen !== null && rowOf(chosen)) select.value = String(chosen);
+  showRow(chosen !== null && rowOf(chosen) ? chosen : null);
+}
+
+function openVideoOf(id) {
+  $('v-row').value = String(id);
+  showRow(id);
+  $('video-section').scrollIntoView({ behavior: 'smooth', block: 'start' });
+}
+
+// Shows the trial's video panel (when it has a video), reloading the frame only when it changed.
+function showRow(id) {
+  V.rowId = id;
+  const row = id === null ? null : rowOf(id);
+  const video = row && row.video ? row.video : '';
+  $('v-panel').hidden = !video;
+  $('t-accept').hidden = !V.track || V.track.row !== id;
+  if (video === V.video) return;
+  V.video = video;
+  V.solution = null;
+  V.track = null;
+  $('t-result').replaceChildren();
+  $('t-strip').replaceChildren();
+  $('s-result').replaceChildren();
+  $('track-summary').textContent = '';
+  if (video) { loadFrame(); loadPoints(); }
+}
+
+// ---- videos in the folder, attach, upload -------------------------------------------------------
+async function loadVideoList(select) {
+  const { status, data } = await api('GET', '/api/videos');
+  if (status !== 200) return;
+  const list = $('v-file');
+  list.replaceChildren(el('option', { value: '' }, data.videos.length ? '— pick a video —' : '— no videos in the folder —'));
+  for (const v of data.videos) list.append(el('option', { value: v.path }, `${v.path} (${(v.bytes / 1048576).toFixed(1)} MiB)`));
+  if (select) list.value = select;
+}
+
+async function attach(video) {
+  if (V.rowId === null) { showMessage('Add a trial (a row) first, then attach its video', 'error'); return; }
+  if (!video) { showMessage('Pick a video from the list, or upload one', 'error'); return; }
+  $('v-status').textContent = 'Checking the video…';
+  const result = await change('POST', `/api/rows/${V.rowId}/video`, { video });
+  $('v-status').textContent = result && !result.error && !result.conflict ? `attached ${video}` : '';
+  if (result && result.error) $('v-status').textContent = result.error;
+}
+
+function upload(file) {
+  if (!file) return;
+  $('v-status').textContent = `Uploading ${file.name}…`;
+  const xhr = new XMLHttpRequest();
+  xhr.open('PUT', '/api/videos/' + encodeURIComponent(file.name));
+  xhr.setRequestHeader('Content-Type', 'application/octet-stream');
+  xhr.upload.onprogress = (ev) => {
+    if (ev.lengthComputable) $('v-status').textContent = `Uploading ${file.name}: ${Math.round(100 * ev.loaded / ev.total)} %`;
+  };
+  xhr.onerror = () => { $('v-status').textContent = 'Upload failed: the connection broke; nothing was kept'; };
+  xhr.onload = async () => {
+    let data = {};
+    try { data = JSON.parse(xhr.responseText); } catch (e) { data = { error: 'HTTP ' + xhr.status }; }
+    if (xhr.status !== 200) {
+      $('v-status').textContent = 'Not uploaded: ' + data.error;
+      showMessage('Not uploaded: ' + data.error, 'error');
+      return;
+    }
+    await loadVideoList(data.path);
+    await attach(data.path);
+  };
+  xhr.send(file);
+}
+
+// ---- camera -------------------------------------------------------------------------------------
+async function calibrateCamera(ev) {
+  ev.preventDefault();
+  const out = $('camera-result');
+  out.replaceChildren(el('p', { class: 'muted' }, 'Finding the chessboard in every view and calibrating…'));
+  $('cam-run').disabled = true;
+  try {
+    const body = { version: S.version, folder: $('cam-folder').value.trim(), cols: Number($('cam-cols').value),
+      rows: Number($('cam-rows').value), square: Number($('cam-square').value) };
+    const { status, data } = await api('POST', '/api/camera/calibrate', body);
+    if (status === 409) { applyState(data.state); showMessage(data.error, 'error'); out.replaceChildren(); return; }
+    if (status !== 200) { out.replaceChildren(el('p', { class: 'error' }, data.error)); return; }
+    applyState(data.state);
+    savedStatus();
+    const c = data.calibration;
+    const verdict = el('p', {}, '');
+    verdict.append(el('span', { class: 'verdict-' + c.verdict }, `Verdict: ${c.verdict}`),
+      document.createTextNode(` — RMS reprojection error ${c.rms_px.toFixed(3)} px, ${c.views_used} views used, ` +
+        `coverage ${(100 * c.coverage).toFixed(0)} %, fx ${c.fx.toFixed(1)} px, fy ${c.fy.toFixed(1)} px, ` +
+        `cx ${c.cx.toFixed(1)}, cy ${c.cy.toFixed(1)} (${c.width}×${c.height}); saved as ${S.experiment.camera}`));
+    const reasons = el('ul', { class: 'flag-list' });
+    for (const r of c.reasons) reasons.append(el('li', {}, r));
+    const views = el('ul', { class: 'muted' });
+    for (const v of c.views)
+      views.append(el('li', {}, v.used ? `${v.name}: ${v.rms_px.toFixed(3)} px, tilted ${v.tilt_deg.toFixed(0)}°`
+        : `${v.name}: not used (${v.rejected_because})`));
+    out.replaceChildren(verdict, reasons, views);
+  } finally {
+    $('cam-run').disabled = false;
+  }
+}
+
+// ---- the frame and the clicks -------------------------------------------------------------------
+function frameNumber() {
+  const n = Number($('s-frame').value);
+  return Number.isInteger(n) && n >= 0 ? n : 0;
+}
+
+function loadFrame() {
+  const img = $('s-img');
+  img.onerror = async () => {
+    // The server says why in JSON: ask again for the message.
+    const r = await fetch(img.src);
+    let msg = 'HTTP ' + r.status;
+    try { msg = (await r.json()).error; } catch (e) { /* keep the status */ }
+    $('s-result').replaceChildren(el('span', { class: 'error' }, msg));
+  };
+  img.onload = () => {
+    V.width = img.naturalWidth;
+    V.height = img.naturalHeight;
+    applyZoom();
+    drawOverlay();
+  };
+  img.src = `/api/video/frame?video=${encodeURIComponent(V.video)}&frame=${frameNumber()}`;
+}
+
+function applyZoom() {
+  if (!V.width) return;
+  const zoom = Number($('s-zoom').value) || 1;
+  const view = $('s-view');
+  // Zoom 1 fits the frame into the view; each step doubles it.
+  const fit = Math.min(1, (view.clientWidth || 860) / V.width);
+  $('s-stage').style.width = `${V.width * fit * zoom}px`;
+}
+
+function marksList() {
+  return $('s-marks').value.split(/[,;\s]+/).map((t) => t.trim()).filter((t) => t !== '').map(Number).filter((m) => isFinite(m));
+}
+
+// The points the setting offers (server: from the trial's L, H, D); clicks kept where names match.
+async function loadPoints() {
+  const q = new URLSearchParams({ row: String(V.rowId), table_z: String(Number($('s-table').value) || 0) });
+  const marks = marksList();
+  if (marks.length) q.set('marks', marks.join(','));
+  const { status, data } = await api('GET', '/api/scene/points?' + q.toString());
+  if (status !== 200) { $('s-result').replaceChildren(el('span', { class: 'error' }, data.error)); return; }
+  let saved = [];
+  try { saved = JSON.parse(localStorage.getItem(clicksKey()) || '[]'); } catch (e) { saved = []; }
+  const before = new Map([...V.points, ...saved].map((p) => [p.name, p]));
+  V.points = data.points.map((p) => {
+    const old = before.get(p.name);
+    return { name: p.name, x: p.x, y: p.y, z: p.z, u: old ? old.u : null, v: old ? old.v : null };
+  });
+  for (const p of before.values())
+    if (p.own && !V.points.some((q) => q.name === p.name)) V.points.push(p);
+  V.active = Math.max(0, V.points.findIndex((p) => p.u === null));
+  renderPoints();
+  solve();
+}
+
+function keepClicks() {
+  try { localStorage.setItem(clicksKey(), JSON.stringify(V.points.filter((p) => p.u !== null || p.own))); } catch (e) { /* private mode */ }
+}
+
+function renderPoints() {
+  const body = $('s-points').querySelector('tbody');
+  body.replaceChildren();
+  const d = lengthDecimals();
+  const residual = new Map((V.solution ? V.solution.points : []).map((p) => [p.name, p.residual_px]));
+  V.points.forEach((p, i) => {
+    const tr = el('tr', { class: i === V.active ? 'active' : '', dataset: { name: p.name } });
+    const pick = el('button', { type: 'button', class: 'pick', title: 'Click this point in the frame next' }, p.name);
+    pick.addEventListener('click', () => { V.active = i; renderPoints(); });
+    const nameCell = el('td');
+    nameCell.append(pick);
+    tr.append(nameCell);
+    for (const k of ['x', 'y', 'z']) {
+      const td = el('td', { class: 'num' });
+      if (p.own) {
+        const inp = el('input', { 'aria-label': `${p.name} ${k}`, inputmode: 'decimal', class: 'coord' });
+        inp.value = p[k] ?? '';
+        inp.addEventListener('change', () => { p[k] = Number(inp.value); keepClicks(); solve(); });
+        td.append(inp);
+      } else td.textContent = fmt(p[k], d);
+      tr.append(td);
+    }
+    tr.append(el('td', { class: 'num' }, p.u === null ? '—' : p.u.toFixed(2)),
+      el('td', { class: 'num' }, p.v === null ? '—' : p.v.toFixed(2)),
+      el('td', { class: 'num' }, residual.has(p.name) ? residual.get(p.name).toFixed(2) : ''));
+    const clear = el('button', { type: 'button', title: 'Forget this click' }, '×');
+    clear.addEventListener('click', () => {
+      p.u = p.v = null;
+      if (p.own) V.points.splice(i, 1);
+      V.active = Math.min(i, V.points.length - 1);
+      keepClicks(); renderPoints(); solve();
+    });
+    const td = el('td');
+    td.append(clear);
+    tr.append(td);
+    body.append(tr);
+  });
+}
+
+function addOwnPoint() {
+  const name = `point ${V.points.filter((p) => p.own).length + 1}`;
+  V.points.push({ name, x: 0, y: 0, z: 0, u: null, v: null, own: true });
+  V.active = V.points.length - 1;
+  renderPoints();
+}
+
+// A click on the frame: its raw pixel (OpenCV: (0, 0) is the centre of the top-left pixel).
+function frameClick(ev) {
+  if (!V.width || !V.points.length) return;
+  const rect = $('s-img').getBoundingClientRect();
+  const u = (ev.clientX - rect.left) * V.width / rect.width - 0.5;
+  const v = (ev.clientY - rect.top) * V.height / rect.height - 0.5;
+  const p = V.points[V.active];
+  p.u = Math.round(u * 100) / 100;
+  p.v = Math.round(v * 100) / 100;
+  const next = V.points.findIndex((q, i) => i > V.active && q.u === null);
+  V.active = next >= 0 ? next : Math.max(0, V.points.findIndex((q) => q.u === null));
+  keepClicks();
+  renderPoints();
+  drawOverlay();
+  solve();
+}
+
+function clickedPoints() {
+  return V.points.filter((p) => p.u !== null).map((p) => ({ name: p.name, u: p.u, v: p.v, x: p.x, y: p.y, z: p.z }));
+}
+
+async function solve() {
+  const clicks = clickedPoints();
+  const out = $('s-result');
+  if (clicks.length < 4) {
+    V.solution = null;
+    out.replaceChildren(el('span', { class: 'muted' }, `${clicks.length} point${clicks.length === 1 ? '' : 's'} clicked: ` +
+      `click ${4 - clicks.length} more (spread over the frame, not all on one line)`));
+    drawOverlay();
+    return;
+  }
+  const seq = ++V.seq;
+  const { status, data } = await api('POST', '/api/scene/solve', { video: V.video, row: V.rowId, clicks });
+  if (seq !== V.seq) return;
+  if (status !== 200) {
+    V.solution = null;
+    out.replaceChildren(el('span', { class: 'error' }, data.error));
+  } else {
+    V.solution = data;
+    const c = data.camera_centre, d = lengthDecimals();
+    const line = el('span', {}, '');
+    line.append(el('span', { class: 'verdict-' + data.verdict }, `Pose: ${data.verdict}`),
+      document.createTextNode(` — RMS ${data.rms_px.toFixed(3)} px over ${data.points.length} points; camera at ` +
+        `(${fmt(c.x, d)}, ${fmt(c.y, d)}, ${fmt(c.z, d)}) ${data.unit}`));
+    out.replaceChildren(line);
+    if (data.reasons.length) {
+      const ul = el('ul', { class: 'flag-list' });
+      for (const r of data.reasons) ul.append(el('li', {}, r));
+      out.append(ul);
+    }
+  }
+  renderPoints();
+  drawOverlay();
+}
+
+function drawOverlay() {
+  const svg = $('s-overlay');
+  svg.replaceChildren();
+  if (!V.width) return;
+  svg.setAttribute('viewBox', `-0.5 -0.5 ${V.width} ${V.height}`);
+  const scale = V.width / 800;  // marks keep their size on screen at zoom 1
+  const r = 6 * scale;
+  if (V.solution) {
+    const path = V.solution.path.map(([u, v]) => `${u.toFixed(2)},${v.toFixed(2)}`).join(' ');
+    if (path) svg.append(svgEl('polyline', { class: 'path', points: path, 'stroke-width': 2 * scale }));
+    for (const p of V.solution.points) {
+      const s = 5 * scale;
+      svg.append(svgEl('path', { class: 'model', 'stroke-width': 1.5 * scale,
+        d: `M${p.u_model - s},${p.v_model - s}L${p.u_model + s},${p.v_model + s}M${p.u_model - s},${p.v_model + s}L${p.u_model + s},${p.v_model - s}` }));
+      const t = svgEl('text', { x: p.u + r * 1.5, y: p.v - r, 'font-size': 12 * scale });
+      t.textContent = `${p.residual_px.toFixed(2)} px`;
+      svg.append(t);
+    }
+  }
+  for (const p of V.points)
+    if (p.u !== null) svg.append(svgEl('circle', { class: 'clicked', cx: p.u, cy: p.v, r, 'stroke-width': 1.5 * scale }));
+}
+
+async function saveScene() {
+  const clicks = clickedPoints();
+  const name = $('s-name').value.trim() || 'main';
+  const result = await change('PUT', `/api/scenes/${encodeURIComponent(name)}`, { video: V.video, row: V.rowId, clicks });
+  if (result && result.error) { $('s-result').replaceChildren(el('span', { class: 'error' }, 'Not saved: ' + result.error)); return; }
+  if (result && !result.conflict) showMessage(`Scene "${name}" saved as ${S.experiment.scenes[name]}`, 'info');
+}
+
+// ---- tracking -------------------------------------------------------------------------------------
+async function track() {
+  if (V.rowId === null) return;
+  const id = V.rowId;
+  $('t-run').disabled = true;
+  $('track-summary').textContent = '— tracking (every frame)…';
+  try {
+    const { status, data } = await api('POST', `/api/rows/${id}/track`, {});
+    if (status !== 200) {
+      $('track-summary').textContent = '';
+      $('t-result').replaceChildren(el('p', { class: 'error' }, data.error));
+      return;
+    }
+    V.track = Object.assign({ row: id }, data);
+    renderTrack();
+  } finally {
+    $('t-run').disabled = false;
+  }
+}
+
+function renderTrack() {
+  const t = V.track, d = lengthDecimals();
+  const out = $('t-result');
+  out.replaceChildren();
+  $('track-summary').textContent = `— ${t.frames_tracked} of ${t.frames} frames` + (t.partial ? ` (partial: ${t.partial_reason})` : '');
+  const dl = el('dl', { class: 'analysis' });
+  const add = (k, v) => { dl.append(el('dt', {}, k), el('dd', {}, v)); };
+  const pm = (q) => (q ? `${fmt(q.value, d)} ± ${fmt(q.u, d)} ${S.unit}` : '—');
+  add('release', t.release ? `x0 = ${pm(t.release.x0)} at t0 = ${t.release.t0.value.toFixed(3)} ± ${t.release.t0.u.toFixed(3)} s` : '—');
+  add('direction', t.direction || '—');
+  add('turning points', t.turns && t.turns.length ? t.turns.map((p) => `${fmt(p.x, d)} ${S.unit} at ${p.t.toFixed(2)} s`).join('; ') : 'none');
+  add('rest', t.rest ? `Y = ${pm(t.rest.y)} from ${t.rest.t.toFixed(2)} s` : (t.never_at_rest || 'never at rest'));
+  add('motion fit', t.fit ? t.fit.text : '—');
+  out.append(dl);
+  for (const w of t.warnings || []) out.append(el('p', { class: 'error' }, w));
+  $('t-accept').hidden = !t.rest;
+  const strip = $('t-strip');
+  strip.replaceChildren();
+  for (const f of t.strip || []) {
+    const fig = el('figure');
+    const img = el('img', { alt: `frame ${f.frame}`, src: `/api/video/frame?video=${encodeURIComponent(V.video)}&frame=${f.frame}&format=jpeg` });
+    const svg = svgEl('svg', { viewBox: `-0.5 -0.5 ${t.width} ${t.height}`, preserveAspectRatio: 'xMinYMin meet' });
+    if (f.u !== null) svg.append(svgEl('circle', { cx: f.u, cy: f.v, r: f.radius_px, 'vector-effect': 'non-scaling-stroke' }));
+    fig.append(img, svg, el('figcaption', {}, `${f.t.toFixed(2)} s` + (f.x === null ? ' (not found)' : `, x = ${fmt(f.x, d)}`)));
+    strip.append(fig);
+  }
+}
+
+async function acceptY() {
+  if (!V.track || V.track.row !== V.rowId) return;
+  const result = await change('POST', `/api/rows/${V.rowId}/accept-y`, {});
+  if (result && !result.error && !result.conflict) showMessage('Y set from the video\'s rest position', 'info');
+}
+
+// ---- wiring ---------------------------------------------------------------------------------------
+$('camera-form').addEventListener('submit', calibrateCamera);
+$('v-row').addEventListener('change', () => showRow(Number($('v-row').value)));
+$('v-attach').addEventListener('click', () => attach($('v-file').value));
+$('v-upload').addEventListener('change', () => upload($('v-upload').files[0]));
+$('s-img').addEventListener('click', frameClick);
+$('s-zoom').addEventListener('change', applyZoom);
+$('s-frame').addEventListener('change', loadFrame);
+$('s-table').addEventListener('change', loadPoints);
+$('s-marks').addEventListener('change', loadPoints);
+$('s-add').addEventListener('click', addOwnPoint);
+$('s-save').addEventListener('click', saveScene);
+$('t-run').addEventListener('click', track);
+$('t-accept').addEventListener('click', acceptY);
+loadVideoList();
