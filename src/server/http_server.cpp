@@ -516,23 +516,27 @@ struct Server::Impl {
         return ordered_json{{"calibration", calibration}, {"state", StateJson(s)}};
       });
     });
-    http.Post(R"(/api/rows/(\d{1,12})/video)", [this](const httplib::Request& req, httplib::Response& res) {
+    // A row id, or "new": a new trial (body `trial`: its label) with this video.
+    http.Post(R"(/api/rows/(\d{1,12}|new)/video)", [this](const httplib::Request& req, httplib::Response& res) {
       Mutate(req, res, [this, &req](const json& b) {
         const std::int64_t version = VersionOf(b);
-        const std::int64_t id = std::stoll(req.matches[1].str());
         const StoreSnapshot s = store.Get();
-        const int index = s.state.IndexOf(id);
-        if (index < 0) throw InputError("row", "row " + std::to_string(id) + " does not exist");
-        ordered_json row = ToJson(s.state.rows[index]);
+        const bool add = req.matches[1].str() == "new";
+        const std::int64_t id = add ? 0 : std::stoll(req.matches[1].str());
+        const int index = add ? -1 : s.state.IndexOf(id);
+        if (!add && index < 0) throw InputError("row", "row " + std::to_string(id) + " does not exist");
+        ordered_json row = add ? ordered_json{{"trial", b.value("trial", json("")).is_string() ? b.value("trial", "") : ""}}
+                               : ToJson(s.state.rows[index]);
         const std::string video = b.value("video", json("")).is_string() ? b.value("video", "") : "";
         if (video.empty()) {
+          if (add) throw InputError("video", "is missing");
           row.erase("video");
         } else {
           const VideoProbe probe = ProbeVideo(internal::FolderFile(store, video, "video"), video);
-          CheckSceneFits(s, s.state.rows[index].scene, video, probe);
+          CheckSceneFits(s, add ? "" : s.state.rows[index].scene, video, probe);
           row["video"] = video;
         }
-        return store.EditRow(version, id, row);
+        return add ? store.AddRow(version, row) : store.EditRow(version, id, row);
       });
     });
     http.Put(kUploadPattern, [this](const httplib::Request& req, httplib::Response& res,

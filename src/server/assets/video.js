@@ -2,7 +2,7 @@
 // recording (picked from the folder or uploaded), the scene calibrated by clicks on a frame, and
 // the track with its analysis. As in app.js, the server computes everything (the pose at each
 // click, the residuals, the model's path, the track) and this script only draws its answers.
-// Uses app.js's S, api, change, el, $, showMessage.
+// Uses app.js's S, api, change, el, svg, $, fmt, showMessage, nextTrial.
 'use strict';
 
 const V = {
@@ -14,12 +14,6 @@ const V = {
   solution: null,   // the server's last answer to /api/scene/solve
   track: null,      // the server's last answer to /api/rows/<id>/track
   seq: 0,           // answers to older solves are ignored
-};
-const SVG = 'http://www.w3.org/2000/svg';
-const svgEl = (tag, attrs) => {
-  const e = document.createElementNS(SVG, tag);
-  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
-  return e;
 };
 const rowOf = (id) => (S ? S.rows.find((r) => r.id === id) : null);
 const clicksKey = () => `uphill-clicks:${S ? S.directory : ''}:${V.video}`;
@@ -34,14 +28,15 @@ function onStateApplied() {
   $('scene-summary').textContent = Object.keys(scenes).length
     ? '— saved: ' + Object.entries(scenes).map(([n, p]) => `${n} (${p})`).join(', ') : '';
   const select = $('v-row');
-  const chosen = V.rowId ?? (S.rows.length ? S.rows[0].id : null);
+  const chosen = V.rowId !== null && rowOf(V.rowId) ? V.rowId : (S.rows.length ? S.rows[0].id : null);
   select.replaceChildren();
   for (const r of S.rows) {
     const o = el('option', { value: String(r.id) }, r.trial + (r.video ? ` — ${r.video}` : ''));
     select.append(o);
   }
-  if (chosen !== null && rowOf(chosen)) select.value = String(chosen);
-  showRow(chosen !== null && rowOf(chosen) ? chosen : null);
+  select.append(el('option', { value: 'new' }, `+ new trial ${nextTrial(S.rows.length ? S.rows[S.rows.length - 1].trial : '')}`));
+  select.value = chosen === null ? 'new' : String(chosen);
+  showRow(chosen);
 }
 
 function openVideoOf(id) {
@@ -79,12 +74,15 @@ async function loadVideoList(select) {
 }
 
 async function attach(video) {
-  if (V.rowId === null) { showMessage('Add a trial (a row) first, then attach its video', 'error'); return; }
   if (!video) { showMessage('Pick a video from the list, or upload one', 'error'); return; }
   $('v-status').textContent = 'Checking the video…';
-  const result = await change('POST', `/api/rows/${V.rowId}/video`, { video });
-  $('v-status').textContent = result && !result.error && !result.conflict ? `attached ${video}` : '';
-  if (result && result.error) $('v-status').textContent = result.error;
+  const fresh = V.rowId === null;
+  const trial = fresh ? nextTrial(S.rows.length ? S.rows[S.rows.length - 1].trial : '') : '';
+  const result = await change('POST', `/api/rows/${fresh ? 'new' : V.rowId}/video`, fresh ? { video, trial } : { video });
+  if (result && result.error) { $('v-status').textContent = result.error; return; }
+  if (!result || result.conflict) { $('v-status').textContent = ''; return; }
+  $('v-status').textContent = `attached ${video}`;
+  if (fresh) { V.rowId = S.rows[S.rows.length - 1].id; onStateApplied(); }
 }
 
 function upload(file) {
@@ -307,26 +305,26 @@ async function solve() {
 }
 
 function drawOverlay() {
-  const svg = $('s-overlay');
-  svg.replaceChildren();
+  const layer = $('s-overlay');
+  layer.replaceChildren();
   if (!V.width) return;
-  svg.setAttribute('viewBox', `-0.5 -0.5 ${V.width} ${V.height}`);
+  layer.setAttribute('viewBox', `-0.5 -0.5 ${V.width} ${V.height}`);
   const scale = V.width / 800;  // marks keep their size on screen at zoom 1
   const r = 6 * scale;
   if (V.solution) {
     const path = V.solution.path.map(([u, v]) => `${u.toFixed(2)},${v.toFixed(2)}`).join(' ');
-    if (path) svg.append(svgEl('polyline', { class: 'path', points: path, 'stroke-width': 2 * scale }));
+    if (path) layer.append(svg('polyline', { class: 'path', points: path, 'stroke-width': 2 * scale }));
     for (const p of V.solution.points) {
       const s = 5 * scale;
-      svg.append(svgEl('path', { class: 'model', 'stroke-width': 1.5 * scale,
+      layer.append(svg('path', { class: 'model', 'stroke-width': 1.5 * scale,
         d: `M${p.u_model - s},${p.v_model - s}L${p.u_model + s},${p.v_model + s}M${p.u_model - s},${p.v_model + s}L${p.u_model + s},${p.v_model - s}` }));
-      const t = svgEl('text', { x: p.u + r * 1.5, y: p.v - r, 'font-size': 12 * scale });
+      const t = svg('text', { x: p.u + r * 1.5, y: p.v - r, 'font-size': 12 * scale });
       t.textContent = `${p.residual_px.toFixed(2)} px`;
-      svg.append(t);
+      layer.append(t);
     }
   }
   for (const p of V.points)
-    if (p.u !== null) svg.append(svgEl('circle', { class: 'clicked', cx: p.u, cy: p.v, r, 'stroke-width': 1.5 * scale }));
+    if (p.u !== null) layer.append(svg('circle', { class: 'clicked', cx: p.u, cy: p.v, r, 'stroke-width': 1.5 * scale }));
 }
 
 async function saveScene() {
@@ -378,9 +376,9 @@ function renderTrack() {
   for (const f of t.strip || []) {
     const fig = el('figure');
     const img = el('img', { alt: `frame ${f.frame}`, src: `/api/video/frame?video=${encodeURIComponent(V.video)}&frame=${f.frame}&format=jpeg` });
-    const svg = svgEl('svg', { viewBox: `-0.5 -0.5 ${t.width} ${t.height}`, preserveAspectRatio: 'xMinYMin meet' });
-    if (f.u !== null) svg.append(svgEl('circle', { cx: f.u, cy: f.v, r: f.radius_px, 'vector-effect': 'non-scaling-stroke' }));
-    fig.append(img, svg, el('figcaption', {}, `${f.t.toFixed(2)} s` + (f.x === null ? ' (not found)' : `, x = ${fmt(f.x, d)}`)));
+    const outline = svg('svg', { viewBox: `-0.5 -0.5 ${t.width} ${t.height}`, preserveAspectRatio: 'xMinYMin meet' });
+    if (f.u !== null) outline.append(svg('circle', { cx: f.u, cy: f.v, r: f.radius_px, 'vector-effect': 'non-scaling-stroke' }));
+    fig.append(img, outline, el('figcaption', {}, `${f.t.toFixed(2)} s` + (f.x === null ? ' (not found)' : `, x = ${fmt(f.x, d)}`)));
     strip.append(fig);
   }
 }
@@ -393,7 +391,7 @@ async function acceptY() {
 
 // ---- wiring ---------------------------------------------------------------------------------------
 $('camera-form').addEventListener('submit', calibrateCamera);
-$('v-row').addEventListener('change', () => showRow(Number($('v-row').value)));
+$('v-row').addEventListener('change', () => showRow($('v-row').value === 'new' ? null : Number($('v-row').value)));
 $('v-attach').addEventListener('click', () => attach($('v-file').value));
 $('v-upload').addEventListener('change', () => upload($('v-upload').files[0]));
 $('s-img').addEventListener('click', frameClick);
