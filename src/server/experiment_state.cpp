@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "io/contained_directory.hpp"
 #include "io/csv_table.hpp"
 #include "io/experiment_folder.hpp"
 #include "io/units.hpp"
@@ -103,30 +104,19 @@ std::string FormatNumber(double v) {
 
 const std::vector<std::string>& RowQuantities() { return MeasurementQuantities(); }
 
-const std::set<std::string>& VideoExperimentKeys() {
-  static const std::set<std::string> keys = {"camera", "scenes", "video_analysis"};
-  return keys;
-}
-
 void CheckRelativePath(const std::string& path, const std::string& field) {
   const std::string s = CheckText(json(path), field, kMaxPathLength);
-  if (s.empty()) throw InputError(field, "is empty");
-  if (s.front() == '/') throw InputError(field, "must be a path inside the experiment folder, not an absolute one");
   if (s.find('\\') != std::string::npos) throw InputError(field, "must use '/' between folders");
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t end = s.find('/', start);
-    const std::string part = s.substr(start, end == std::string::npos ? std::string::npos : end - start);
-    if (part.empty() || part == "." || part == "..")
-      throw InputError(field, "must be a path inside the experiment folder (no empty, \".\" or \"..\" part)");
-    if (end == std::string::npos) break;
-    start = end + 1;
+  try {
+    SplitContainedPath(s);
+  } catch (const InputError& e) {
+    throw InputError(field, e.rule() + " (a path inside the experiment folder)");
   }
 }
 
 bool ExperimentState::UsesVideo() const {
   if (metadata.is_object())
-    for (const std::string& key : VideoExperimentKeys())
+    for (const std::string& key : ExperimentKeysOfVersion2())
       if (metadata.contains(key)) return true;
   return std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.video.empty() || !r.scene.empty(); });
 }
@@ -170,7 +160,7 @@ int ExperimentState::IndexOf(std::int64_t id) const {
 std::string ExperimentState::ExperimentJson() const {
   if (!UsesVideo() || !metadata.is_object()) return metadata.dump(2) + "\n";
   ordered_json j = metadata;
-  j["format"] = kExperimentFormatVideo;
+  j["format"] = kExperimentFormat2;
   return j.dump(2) + "\n";
 }
 
@@ -290,13 +280,13 @@ Row ValidateRow(const json& j, const ExperimentState& state) {
 ordered_json ValidateMetadata(const json& j) {
   if (!j.is_object()) throw InputError("experiment", "must be a JSON object");
   for (const auto& [key, value] : j.items())
-    if (!ExperimentKeys().count(key) && !VideoExperimentKeys().count(key))
+    if (!ExperimentKeys().count(key))
       throw InputError("experiment." + key.substr(0, 32), "unknown key");
   ordered_json out;
   out["format"] = kExperimentFormat;
-  if (j.contains("format") && j.at("format") != kExperimentFormat && j.at("format") != kExperimentFormatVideo)
+  if (j.contains("format") && j.at("format") != kExperimentFormat && j.at("format") != kExperimentFormat2)
     throw InputError("experiment.format", std::string("must be \"") + kExperimentFormat + "\" or \"" +
-                                              kExperimentFormatVideo + "\"");
+                                              kExperimentFormat2 + "\"");
   for (const char* key : {"title", "operator", "date"})
     if (j.contains(key)) {
       const std::string s = CheckText(j.at(key), std::string("experiment.") + key, kMaxNoteLength);

@@ -23,7 +23,6 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -41,11 +40,9 @@ inline constexpr std::size_t kMaxNumberLength = 32;
 // The quantities a row may carry: the crossbar measurements, Y, and per-row uncertainties.
 const std::vector<std::string>& RowQuantities();  // L, H, D, Y, u_L, u_H, u_D, u_Y
 
-// experiment.json's keys of format uphill-experiment/2 (ISSUE 13: the videos of the trials), and
-// the format a folder is written in once it uses one of them or a row's video or scene.
-inline constexpr const char* kExperimentFormatVideo = "uphill-experiment/2";
-const std::set<std::string>& VideoExperimentKeys();  // camera scenes video_analysis
-inline constexpr std::size_t kMaxPathLength = 240;     // a video's or calibration file's path
+// A folder is written as uphill-experiment/1 until it uses a feature of version 2 (io's
+// ExperimentKeysOfVersion2, a row's video or scene), then as kExperimentFormat2.
+inline constexpr std::size_t kMaxPathLength = 240;  // a video's or calibration file's path
 
 // A path relative to the experiment folder, as experiment.json and measurements.csv name files:
 // '/'-separated, no empty, "." or ".." component, not absolute, no control characters or
