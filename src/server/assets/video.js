@@ -14,6 +14,7 @@ const V = {
   solution: null,   // the server's last answer to /api/scene/solve
   track: null,      // the server's last answer to /api/rows/<id>/track
   seq: 0,           // answers to older solves are ignored
+  pointsSeq: 0,     // and to older requests for the points
 };
 const rowOf = (id) => (S ? S.rows.find((r) => r.id === id) : null);
 const clicksKey = () => `uphill-clicks:${S ? S.directory : ''}:${V.video}`;
@@ -183,7 +184,9 @@ async function loadPoints() {
   const q = new URLSearchParams({ row: String(V.rowId), table_z: String(Number($('s-table').value) || 0) });
   const marks = marksList();
   if (marks.length) q.set('marks', marks.join(','));
+  const seq = ++V.pointsSeq;
   const { status, data } = await api('GET', '/api/scene/points?' + q.toString());
+  if (seq !== V.pointsSeq) return;  // a newer request (the table or the marks changed meanwhile)
   if (status !== 200) { $('s-result').replaceChildren(el('span', { class: 'error' }, data.error)); return; }
   let saved = [];
   try { saved = JSON.parse(localStorage.getItem(clicksKey()) || '[]'); } catch (e) { saved = []; }
