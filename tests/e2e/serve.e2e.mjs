@@ -5,30 +5,20 @@
 //   UPHILL_E2E_SCREENSHOTS  optional folder for screenshots (empty, rows and flags, plot)
 // A technician creates an experiment, types rows with the keyboard, sees the flags and the plot
 // update, deletes and undoes, reloads and finds the rows; the CSV on disk has them.
-import { chromium } from 'playwright-core';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
+import { launchBrowser, openPage } from './browser.mjs';
 
 const url = process.env.UPHILL_URL;
 const dir = process.env.UPHILL_EXP_DIR;
 const shots = process.env.UPHILL_E2E_SCREENSHOTS || '';
 assert.ok(url && dir, 'UPHILL_URL and UPHILL_EXP_DIR must be set (use run.sh)');
 
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-});
+const browser = await launchBrowser();
 let failed = false;
 try {
-  const context = await browser.newContext({ viewport: { width: 1280, height: 900 } });
-  const page = await context.newPage();
-  page.setDefaultTimeout(10000);
-  const problems = [];
-  page.on('pageerror', (e) => problems.push('page error: ' + e.message));
-  page.on('console', (m) => { if (m.type() === 'error') problems.push('console: ' + m.text()); });
-  page.on('request', (r) => { if (!r.url().startsWith(url)) problems.push('request off the server: ' + r.url()); });
+  const { page, problems } = await openPage(browser, url, 10000);
   const shot = async (name) => { if (shots) await page.screenshot({ path: path.join(shots, name), fullPage: true }); };
 
   await page.goto(url);
