@@ -87,7 +87,7 @@
 // 12.5 px/frame with a 180° shutter (1/500 s: no growth). Footage with a longer shutter, or a
 // tracker measured worse on it, needs larger values (measure them with uphill bench track).
 // Accuracy (tests/vision_povray_analysis_test.cpp, tests/vision_analysis_test.cpp,
-// docs/analyse-track.md "Accuracy"): on 8 independent POV-Ray clips, |fitted − truth| ≤ 2.7 u for
+// docs/analyse-track.md "Accuracy"): on 9 independent POV-Ray clips, |fitted − truth| ≤ 2.7 u for
 // x0, t0, g (pulls 0.2–0.7 on the 720p lab clips, up to 2.2 on the isoluminant ball, 1.4–2.7 on
 // the spheroid main's tracker loses half of, < 0.25 on 320 × 180 clips where the tracker beats
 // the floor: there u is 5–20× the real error); on synthetic tracks with an injected bias of the
