@@ -26,7 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // Bump when the renderer or the clip settings change, so that cached clips are not reused.
-constexpr const char* kClipVersion = "v3";
+constexpr const char* kClipVersion = "v4";
 constexpr int kFrames = 120;
 constexpr double kReleaseTime = 1.8;  // s: at rest until then, as a lab clip starts
 

@@ -1,372 +1,467 @@
 #include "vision/ball_tracker.hpp"
 
-#include <ceres/ceres.h>
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <map>
 #include <opencv2/imgproc.hpp>
 
 #include "model/input_error.hpp"
+#include "internal/background_model.hpp"
+#include "internal/outline_fit.hpp"
 
 namespace uphill {
 namespace {
 
 using Eigen::Vector2d;
 using Eigen::Vector3d;
+using internal::FitOutcome;
+using internal::FitRequest;
 
-constexpr double kStep = 0.5;              // px between profile samples
-constexpr double kNarrowHalfWidth = 2.5;   // px, second pass around the first fit
-constexpr double kInlierPx = 1.0;          // |residual| below this: inlier
-constexpr double kLossScalePx = 0.5;       // Cauchy scale
-constexpr double kBiasPriorPx = 0.5;       // the edge-bias parameter's prior width
+constexpr double kNarrowHalfWidthPx = 1.5;  // second pass, around the first fit
+constexpr int kHistoryGap = 5;              // frames without the body after which we predict no more
+constexpr size_t kHistory = 6;              // samples the prediction is fitted to
+constexpr double kSceneChangeFactor = 4;    // scene residual jump (times its usual level)
+constexpr int kConfirmFrames = 3;           // frames that confirm a scene or exposure change
 
-// Residual of one edge point, in pixels: angle between its viewing ray and the centre's
-// direction minus the outline's half angle, minus the edge bias (all in the space where the body
-// is a sphere of radius a).
-struct OutlineResidual {
-  Vector3d ray;  // scaled-space direction of the edge point's viewing ray (unit)
-  Vector3d eye;  // scaled-space camera centre
-  double a, s, px_per_rad;
-  template <typename T>
-  bool operator()(const T* p, T* residual) const {
-    const T c[3] = {p[0] - eye.x(), T(-eye.y()), p[1] - eye.z()};  // C has y = 0, unchanged by scaling
-    const T norm = ceres::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    const T cross[3] = {ray.y() * c[2] - ray.z() * c[1], ray.z() * c[0] - ray.x() * c[2],
-                        ray.x() * c[1] - ray.y() * c[0]};
-    const T sin_part = ceres::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
-    const T cos_part = ray.x() * c[0] + ray.y() * c[1] + ray.z() * c[2];
-    const T angle = ceres::atan2(sin_part, cos_part);
-    residual[0] = (angle - ceres::asin(T(a) / norm)) * px_per_rad - p[2];
-    return true;
-  }
-};
-
-struct BiasPrior {
-  template <typename T>
-  bool operator()(const T* p, T* residual) const {
-    residual[0] = p[2] / kBiasPriorPx;
-    return true;
-  }
-};
-
-double Bilinear(const cv::Mat& img, double x, double y) {
-  const int i = static_cast<int>(std::floor(x)), j = static_cast<int>(std::floor(y));
-  const double fx = x - i, fy = y - j;
-  const float* r0 = img.ptr<float>(j);
-  const float* r1 = img.ptr<float>(j + 1);
-  const double top = r0[i] + fx * (r0[i + 1] - r0[i]);
-  const double bottom = r1[i] + fx * (r1[i + 1] - r1[i]);
-  return top + fy * (bottom - top);
-}
-
-struct Fit {
-  bool ok = false;
-  double x = 0, z = 0;
-  int edge_points = 0, inliers = 0, attempted = 0;
-  double rms_px = 0, contrast = 0;
+struct Sample {
+  double t, x, z;  // s (clip time of the reported centre), m
 };
 
 }  // namespace
 
 struct BallTracker::Impl {
   Scene scene;
-  SceneCalibration cal;
   TrackerOptions options;
-  double a, s;          // body semi-axis across, scaling of y that makes it a sphere
-  Vector3d eye, eye_s;  // camera centre, and in the scaled space
-  Eigen::Matrix3d to_apparatus;
-  cv::Mat occluder;     // CV_8U: the near rail's band (outline points there are not used)
-  int polarity = 0;     // sign of the grey step from inside to outside the body; 0: unknown
-  std::deque<std::pair<long, Vector2d>> history;  // last found (frame, (x, z))
+  internal::OutlineGeometry geometry;
+  cv::Mat occluder;                                 // CV_8U: the near rail's band
+  std::unique_ptr<internal::BackgroundModel> background;
+  std::deque<std::pair<long, Sample>> history;      // last found (frame, sample)
   long frame_index = -1;
-  double x_lo, x_hi;    // searchable part of the path
+  double x_lo = 0, x_hi = 0;                        // searchable part of the path
+  double noise = 0.01;                              // residual RMS of a sample, linear units
+  std::deque<double> noises;                        // of the last accepted frames
+  double row_delay = 0;                             // s per row
+  std::vector<double> exposures;                    // per-frame measurements |D|/|V|
+  std::vector<double> scene_residuals;              // recent steady levels
+  int scene_suspect = 0;
+  long scene_suspect_from = -1;
+  std::optional<long> scene_changed_at;
+  std::deque<std::pair<long, double>> gains;        // (frame, gain)
+  // Every accepted frame's centre (revised ones included), for the velocity at a past frame.
+  std::map<long, Sample> samples;
+  // Frames measured before the background under the body or its motion was known: a window of
+  // the frame each, fitted again once both are (FitAgain), their revised observations handed out
+  // by TakeRevisions.
+  struct Pending {
+    long frame;
+    double t, gain;
+    cv::Mat window;
+    cv::Point origin;
+    BallObservation observed;
+    Vector2d centre;  // fitted, at the reference time
+  };
+  std::deque<Pending> pending;
+  size_t pending_bytes = 0;
+  std::vector<std::pair<long, BallObservation>> revisions;
+  std::vector<long> exposure_changes;
 
-  Impl(const Scene& sc, const SceneCalibration& c, const TrackerOptions& o) : scene(sc), cal(c), options(o) {}
+  Impl(const Scene& sc, const TrackerOptions& o) : scene(sc), options(o) {}
 
-  // Tangent points of the cone from the eye (scaled space, mapped back), n of them.
-  std::vector<Vector3d> OutlinePoints(double x, double z, int n) const {
+  double Exposure() const {
+    if (options.exposure) return *options.exposure;
+    if (exposures.size() >= 3) {
+      std::vector<double> e = exposures;
+      std::nth_element(e.begin(), e.begin() + e.size() / 2, e.end());
+      return e[e.size() / 2];
+    }
+    return 0.5 / options.fps;  // a 180° shutter, the usual default of video cameras
+  }
+
+  double RadiusPx(double x, double z) const {
     const Vector3d c(x, 0, z);
-    const Vector3d axis = c - eye_s;
-    const double dist = axis.norm();
-    const Vector3d w = axis / dist;
-    // A fixed reference direction keeps point k at the same place on the outline frame to frame.
-    const Vector3d e1 = w.cross(Vector3d::UnitY()).normalized(), e2 = w.cross(e1);
-    const double sin_b = std::min(1.0, a / dist), cos_b = std::sqrt(1 - sin_b * sin_b);
-    std::vector<Vector3d> out;
-    out.reserve(n);
-    for (int k = 0; k < n; ++k) {
-      const double phi = 2 * M_PI * k / n;
-      const Vector3d ts = eye_s + (cos_b * w + sin_b * (std::cos(phi) * e1 + std::sin(phi) * e2)) * (dist * cos_b);
-      out.emplace_back(ts.x(), ts.y() / s, ts.z());
+    return geometry.a * geometry.cal.camera.fx / (c - geometry.eye).norm();
+  }
+  double MetresPerPx(double x, double z) const { return 1.0 / (geometry.cal.camera.fx / (Vector3d(x, 0, z) - geometry.eye).norm()); }
+
+  // The centre and velocity predicted at time t from the history: least squares through the last
+  // samples, a parabola in time from four on (constant acceleration), a line through two or three.
+  bool Predict(long f, double t, Vector2d* centre, Vector2d* velocity) const {
+    if (history.empty() || f - history.back().first > kHistoryGap) return false;
+    const size_t n = history.size();
+    const int degree = n >= 4 ? 2 : n >= 2 ? 1 : 0;
+    const double t_last = history.back().second.t;
+    Eigen::MatrixXd a(n, degree + 1);
+    Eigen::MatrixXd y(n, 2);
+    for (size_t i = 0; i < n; ++i) {
+      const Sample& s = history[i].second;
+      const double dt = s.t - t_last;
+      for (int k = 0; k <= degree; ++k) a(i, k) = std::pow(dt, k);
+      y(i, 0) = s.x;
+      y(i, 1) = s.z;
+    }
+    const Eigen::MatrixXd coef = a.colPivHouseholderQr().solve(y);
+    const double dt = t - t_last;
+    *centre = Vector2d::Zero();
+    *velocity = Vector2d::Zero();
+    for (int k = 0; k <= degree; ++k) {
+      *centre += coef.row(k).transpose() * std::pow(dt, k);
+      if (k >= 1) *velocity += coef.row(k).transpose() * (k * std::pow(dt, k - 1));
+    }
+    return centre->allFinite() && velocity->allFinite();
+  }
+
+  // The body's region (smeared silhouette, a radius around it, and its shadow below it), px.
+  cv::Rect BodyRegion(const Vector2d& centre, const Vector2d& smear) const {
+    const Vector2d a = geometry.Project(centre.x() - 0.5 * smear.x(), centre.y() - 0.5 * smear.y());
+    const Vector2d b = geometry.Project(centre.x() + 0.5 * smear.x(), centre.y() + 0.5 * smear.y());
+    const double r = RadiusPx(centre.x(), centre.y()) * std::max(1.0, 1.0 / geometry.s);
+    const double pad = 2 * r + 4;
+    const int x0 = static_cast<int>(std::floor(std::min(a.x(), b.x()) - pad));
+    const int y0 = static_cast<int>(std::floor(std::min(a.y(), b.y()) - pad));
+    const int x1 = static_cast<int>(std::ceil(std::max(a.x(), b.x()) + pad));
+    const int y1 = static_cast<int>(std::ceil(std::max(a.y(), b.y()) + pad + r));
+    return cv::Rect(cv::Point(x0, y0), cv::Point(x1, y1)) & cv::Rect(0, 0, occluder.cols, occluder.rows);
+  }
+
+  // The path's direction at x (unit, (x, z)).
+  Vector2d PathTangent(double x) const {
+    const double slope = scene.At(std::clamp(x, x_lo, x_hi)).dzdx;
+    return Vector2d(1, slope).normalized();
+  }
+
+  FitRequest Request(const Vector2d& centre, const Vector2d& velocity, bool moving_known, double half_width) const {
+    FitRequest q;
+    q.centre = centre;
+    q.velocity = velocity;
+    q.rays = options.rays;
+    q.noise = noise;
+    q.half_width_px = half_width;
+    q.row_delay = row_delay;
+    q.reference_row = geometry.Project(centre.x(), centre.y()).y();
+    const double m_per_px = MetresPerPx(centre.x(), centre.y());
+    if (moving_known) {
+      q.smear = velocity * Exposure();
+      // How well the exposure is known: given, measured on enough frames, or the guess.
+      const double relative = options.exposure ? 0.1 : exposures.size() >= 5 ? 0.15 : 0.5;
+      q.smear_sigma = relative * q.smear.norm() + 0.5 * m_per_px;
+    } else {
+      // Nothing known of the motion yet (a body found for the first time is taken at rest; the
+      // frames after it give its speed).
+      q.smear = Vector2d::Zero();
+      q.smear_sigma = 0.5 * m_per_px;
+    }
+    if (q.smear.norm() < 0.25 * m_per_px) q.smear = PathTangent(centre.x()) * 0.25 * m_per_px;
+    return q;
+  }
+
+  // A fit is a body when enough rays agree with it, the body stands out of the background by
+  // several noise levels, and its inlier rays fit within a few noise levels. `agreement`: the
+  // share of the fitted rays that must be inliers (less near the prediction, where a painted
+  // body's band or the rails may cost rays, than for a body found anew).
+  bool Accept(const FitOutcome& f, double agreement) const {
+    return f.ok && f.inliers >= std::max(10.0, 0.25 * options.rays) && f.inliers >= agreement * f.rays_fitted &&
+           f.contrast >= options.min_contrast && f.contrast >= 6 * noise && f.misfit < 3;
+  }
+
+  // Two passes: around the guess with the given half width, then narrow around the first fit.
+  FitOutcome Measure(const internal::FrameView& view, FitRequest q) {
+    // First passes with the edge shift held: far from the edges it would rather shrink the
+    // outline onto an inner edge than move it. Again from where it went while it moves more
+    // than a pixel (the windows follow), then a narrow pass around the result.
+    q.fit_edge_shift = false;
+    FitOutcome first;
+    for (int pass = 0; pass < 3; ++pass) {
+      first = internal::FitOutline(geometry, view, *background, q);
+      if (!first.ok) return first;
+      const Vector2d moved = geometry.Project(first.p[internal::kCentreX], first.p[internal::kCentreZ]) -
+                             geometry.Project(q.centre.x(), q.centre.y());
+      q.centre = Vector2d(first.p[internal::kCentreX], first.p[internal::kCentreZ]);
+      q.reference_row = geometry.Project(q.centre.x(), q.centre.y()).y();
+      if (moved.norm() < 1.0) break;
+      q.half_width_px = std::max(kNarrowHalfWidthPx + 1, 0.5 * q.half_width_px);
+    }
+    q.smear = Vector2d(first.p[internal::kSmearX], first.p[internal::kSmearZ]);
+    q.half_width_px = kNarrowHalfWidthPx;
+    FitOutcome second = internal::FitOutline(geometry, view, *background, q);
+    return second.ok ? second : first;
+  }
+
+  // Candidates along the path between x0 and x1, best first: the predicted outline's inside
+  // against its outside (against the background where it is known).
+  std::vector<Vector2d> Candidates(const cv::Mat& frame, double gain, double x0, double x1) const {
+    x0 = std::max(x0, x_lo);
+    x1 = std::min(x1, x_hi);
+    if (!(x1 > x0)) return {};
+    const int n = 32;
+    // Candidates a quarter radius apart in the image.
+    const Vector2d p0 = geometry.Project(x0, scene.At(x0).z), p1 = geometry.Project(x1, scene.At(x1).z);
+    const double r_mid = RadiusPx(0.5 * (x0 + x1), scene.At(0.5 * (x0 + x1)).z);
+    const int count = std::clamp(static_cast<int>((p1 - p0).norm() / std::max(1.0, 0.25 * r_mid)) + 1, 8, 2000);
+    std::vector<std::pair<double, double>> scored;  // (score, x)
+    std::vector<cv::Vec3f> inside(n), outside(n);
+    for (int i = 0; i < count; ++i) {
+      const double xc = x0 + (x1 - x0) * (i + 0.5) / count;
+      const double zc = scene.At(xc).z;
+      std::vector<Vector3d> pts = geometry.OutlinePoints(xc, zc, n);
+      pts.emplace_back(xc, 0, zc);
+      const std::vector<Vector2d> image = ProjectApparatusPoints(geometry.cal.camera, geometry.cal.pose, pts);
+      const Vector2d q = image[n];
+      int used = 0;
+      std::vector<double> bg_in, bg_out;
+      for (int k = 0; k < n; ++k) {
+        const Vector2d dir = (image[k] - q).normalized();
+        const double r = (image[k] - q).norm();
+        const Vector2d pin = image[k] - 0.4 * r * dir, pout = image[k] + 3.0 * dir;
+        bool ok = std::min({pin.x(), pin.y(), pout.x(), pout.y()}) >= 1 && std::max(pin.x(), pout.x()) < frame.cols - 2 &&
+                  std::max(pin.y(), pout.y()) < frame.rows - 2;
+        ok = ok && !occluder.at<std::uint8_t>(static_cast<int>(pout.y() + 0.5), static_cast<int>(pout.x() + 0.5));
+        if (!ok) continue;
+        inside[used] = internal::SampleLinear(frame, background->table(), pin.x(), pin.y());
+        outside[used] = internal::SampleLinear(frame, background->table(), pout.x(), pout.y());
+        if (background->Known(pin.x(), pin.y()) && background->Known(pout.x(), pout.y())) {
+          bg_in.push_back(cv::norm(inside[used] - background->At(pin.x(), pin.y()) * gain));
+          bg_out.push_back(cv::norm(outside[used] - background->At(pout.x(), pout.y()) * gain));
+        }
+        ++used;
+      }
+      if (used < n / 2) continue;
+      double score;
+      if (static_cast<int>(bg_in.size()) >= used * 3 / 4) {
+        // Inside differs from the background, outside does not.
+        std::nth_element(bg_in.begin(), bg_in.begin() + bg_in.size() / 2, bg_in.end());
+        std::nth_element(bg_out.begin(), bg_out.begin() + bg_out.size() / 2, bg_out.end());
+        score = bg_in[bg_in.size() / 2] - bg_out[bg_out.size() / 2];
+      } else {
+        // The inside's median colour against each outside sample: a body of one colour on any
+        // surroundings gives a consistent step.
+        cv::Vec3f median_in;
+        std::vector<float> channel(used);
+        for (int c = 0; c < 3; ++c) {
+          for (int k = 0; k < used; ++k) channel[k] = inside[k][c];
+          std::nth_element(channel.begin(), channel.begin() + used / 2, channel.end());
+          median_in[c] = channel[used / 2];
+        }
+        std::vector<double> steps(used);
+        for (int k = 0; k < used; ++k) steps[k] = cv::norm(median_in - outside[k]);
+        std::nth_element(steps.begin(), steps.begin() + used / 4, steps.end());
+        score = steps[used / 4];  // the lower quartile: the step must hold nearly all round
+      }
+      scored.emplace_back(score, xc);
+    }
+    std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::vector<Vector2d> out;
+    for (const auto& [score, xc] : scored) {
+      if (score < options.min_contrast || out.size() >= 3) break;
+      // Distinct candidates: at least a radius apart.
+      const Vector2d p = geometry.Project(xc, scene.At(xc).z);
+      bool near = false;
+      for (const Vector2d& o : out) near = near || (geometry.Project(o.x(), o.y()) - p).norm() < RadiusPx(xc, scene.At(xc).z);
+      if (!near) out.emplace_back(xc, scene.At(xc).z);
     }
     return out;
   }
 
-  bool InFront(double x, double z) const {
-    return (cal.pose.rotation * Vector3d(x, 0, z) + cal.pose.translation).z() > 2 * a &&
-           (Vector3d(x, 0, z) - eye).norm() > 2 * std::max(a, a / s);
+  // Quality in [0, 1]: the share of the visible outline's rays that agree with the fit, lowered
+  // when those fit worse than the pixel noise allows and when the body stands out of the
+  // background by less than 20 noise levels.
+  double Quality(const FitOutcome& f) const {
+    const double fraction = std::min(1.0, static_cast<double>(f.inliers) / std::max(1, f.rays_tried));
+    const double excess = std::max(0.0, f.misfit - 1.5);
+    const double snr = f.contrast / std::max(noise, 1e-6);
+    return fraction * std::exp(-0.5 * excess * excess) * std::min(1.0, snr / 20);
   }
 
-  // One pass: edges along rays across the outline predicted at (x, z), then the Ceres fit.
-  Fit FitOnce(const cv::Mat& frame, double x, double z, double half_width) {
-    Fit fit;
-    if (!InFront(x, z)) return fit;
-    const int n = options.outline_points;
-    std::vector<Vector3d> points = OutlinePoints(x, z, n);
-    points.emplace_back(x, 0, z);
-    const std::vector<Vector2d> image = ProjectApparatusPoints(cal.camera, cal.pose, points);
-    const Vector2d q = image.back();
-    // Region of interest: all search segments, plus the smoothing kernel's reach.
-    double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
-    for (int k = 0; k < n; ++k) {
-      u0 = std::min(u0, image[k].x()), u1 = std::max(u1, image[k].x());
-      v0 = std::min(v0, image[k].y()), v1 = std::max(v1, image[k].y());
-    }
-    const double pad = half_width + 6;
-    const cv::Rect full(0, 0, frame.cols, frame.rows);
-    const cv::Rect roi = cv::Rect(cv::Point(static_cast<int>(std::floor(u0 - pad)), static_cast<int>(std::floor(v0 - pad))),
-                                  cv::Point(static_cast<int>(std::ceil(u1 + pad)), static_cast<int>(std::ceil(v1 + pad)))) &
-                         full;
-    if (roi.width < 8 || roi.height < 8) return fit;
-    cv::Mat grey, smooth;
-    if (frame.channels() == 3) cv::cvtColor(frame(roi), grey, cv::COLOR_BGR2GRAY);
-    else grey = frame(roi);
-    grey.convertTo(smooth, CV_32F);
-    cv::GaussianBlur(smooth, smooth, cv::Size(7, 7), 1.0);
-
-    const int samples = 2 * static_cast<int>(std::ceil(half_width / kStep)) + 1;
-    const double start = -(samples / 2) * kStep;
-    std::vector<double> profile(samples);
-    std::vector<Vector2d> edges;
-    std::vector<double> contrasts;
-    std::vector<int> signs;
-    for (int k = 0; k < n; ++k) {
-      const Vector2d radial = image[k] - q;
-      if (radial.norm() < 1) continue;
-      const Vector2d dir = radial.normalized();
-      const Vector2d first = image[k] + start * dir, last = image[k] - start * dir;
-      // Inside the region (with one pixel for the interpolation) and the frame.
-      auto inside = [&](const Vector2d& p) {
-        return p.x() >= roi.x + 3 && p.y() >= roi.y + 3 && p.x() <= roi.x + roi.width - 4 &&
-               p.y() <= roi.y + roi.height - 4;
-      };
-      if (!inside(first) || !inside(last)) continue;
-      bool hidden = false;
-      for (int m = 0; m <= 4 && !hidden; ++m) {
-        const Vector2d p = first + (last - first) * (m / 4.0);
-        hidden = occluder.at<std::uint8_t>(static_cast<int>(std::lround(p.y())), static_cast<int>(std::lround(p.x()))) != 0;
-      }
-      if (hidden) continue;
-      ++fit.attempted;
-      for (int i = 0; i < samples; ++i) {
-        const Vector2d p = first + (i * kStep) * dir;
-        profile[i] = Bilinear(smooth, p.x() - roi.x, p.y() - roi.y);
-      }
-      // Gradient (outward) and its strongest peak of the expected polarity.
-      int best = -1;
-      double best_g = 0;
-      std::vector<double> g(samples, 0.0);
-      for (int i = 1; i + 1 < samples; ++i) {
-        g[i] = (profile[i + 1] - profile[i - 1]) / (2 * kStep);
-        const double signed_g = polarity == 0 ? std::abs(g[i]) : polarity * g[i];
-        if (i >= 2 && i + 2 < samples && signed_g > best_g) best_g = signed_g, best = i;
-      }
-      if (best < 0 || best_g < 2.0) continue;
-      // Centroid of the gradient above half its peak: the middle of the edge's ramp. For a sharp
-      // edge that is the peak; for a motion-blurred one (a ramp as long as the blur, with a flat
-      // gradient) it is the edge at mid-exposure, where a peak finder would wander.
-      const int sign = g[best] > 0 ? 1 : -1;
-      const double half = 0.5 * std::abs(g[best]);
-      int lo = best, hi = best;
-      while (lo > 1 && sign * g[lo - 1] > half) --lo;
-      while (hi + 2 < samples && sign * g[hi + 1] > half) ++hi;
-      double weight = 0, moment = 0;
-      for (int i = lo; i <= hi; ++i) {
-        const double w = sign * g[i] - half;
-        weight += w;
-        moment += w * i;
-      }
-      const double along = start + (moment / weight) * kStep;
-      edges.push_back(image[k] + along * dir);
-      contrasts.push_back(profile[std::min(samples - 1, hi + 3)] - profile[std::max(0, lo - 3)]);
-      signs.push_back(g[best] > 0 ? 1 : -1);
-    }
-    fit.edge_points = static_cast<int>(edges.size());
-    if (fit.edge_points < 8) return fit;
-    {
-      std::vector<double> c = contrasts;
-      for (double& v : c) v = std::abs(v);
-      std::nth_element(c.begin(), c.begin() + c.size() / 2, c.end());
-      fit.contrast = c[c.size() / 2];
-    }
-
-    // Viewing rays of the edge points, in the scaled space.
-    const std::vector<Vector2d> normalised = UndistortPixels(cal.camera, edges);
-    const double px_per_rad =
-        cal.camera.fx * (Vector3d(x, 0, z) - eye_s).norm() / (Vector3d(x, 0, z) - eye).norm();
-    double p[3] = {x, z, 0.0};
-    ceres::CauchyLoss loss(kLossScalePx);  // one loss for all residuals, owned here
-    ceres::Problem::Options problem_options;
-    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    ceres::Problem problem(problem_options);
-    for (const Vector2d& m : normalised) {
-      Vector3d r = to_apparatus * Vector3d(m.x(), m.y(), 1.0);
-      r.y() *= s;
-      auto* cost = new ceres::AutoDiffCostFunction<OutlineResidual, 1, 3>(
-          new OutlineResidual{r.normalized(), eye_s, a, s, px_per_rad});
-      problem.AddResidualBlock(cost, &loss, p);
-    }
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BiasPrior, 1, 3>(new BiasPrior), nullptr, p);
-    ceres::Solver::Options solver;
-    solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-    solver.max_num_iterations = 30;
-    solver.num_threads = 1;
-    solver.logging_type = ceres::SILENT;
-    solver.function_tolerance = 1e-12;
-    solver.parameter_tolerance = 1e-12;
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver, &problem, &summary);
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !InFront(p[0], p[1])) return fit;
-
-    double sum2 = 0;
-    int votes = 0;
-    OutlineResidual check{Vector3d::Zero(), eye_s, a, s, px_per_rad};
-    for (size_t k = 0; k < normalised.size(); ++k) {
-      Vector3d r = to_apparatus * Vector3d(normalised[k].x(), normalised[k].y(), 1.0);
-      r.y() *= s;
-      check.ray = r.normalized();
-      double res = 0;
-      check(p, &res);
-      if (std::abs(res) < kInlierPx) {
-        ++fit.inliers;
-        sum2 += res * res;
-        votes += signs[k];
-      }
-    }
-    fit.ok = fit.inliers >= 3;
-    fit.x = p[0];
-    fit.z = p[1];
-    fit.rms_px = fit.inliers ? std::sqrt(sum2 / fit.inliers) : 0;
-    if (polarity == 0 && fit.inliers > 0) polarity = votes >= 0 ? 1 : -1;
-    return fit;
-  }
-
-  bool Accept(const Fit& f) const {
-    return f.ok && f.inliers >= options.min_inlier_fraction * options.outline_points &&
-           f.contrast >= options.min_contrast;
-  }
-
-  // Wide search around the guess; a second, narrow one around the first fit when the guess was
-  // off by more than a pixel or many edges were outliers (a wide window may have caught an edge
-  // that is not the body's). Any point of the outline constrains the fit, so rays cast from a
-  // centre a fraction of a pixel off do not need casting again.
-  Fit Measure(const cv::Mat& frame, double x, double z, double half_width) {
-    Fit first = FitOnce(frame, x, z, half_width);
-    if (!first.ok) return first;
-    const Vector2d moved = ProjectApparatusPoint(cal.camera, cal.pose, Vector3d(first.x, 0, first.z)) -
-                           ProjectApparatusPoint(cal.camera, cal.pose, Vector3d(x, 0, z));
-    if (moved.norm() < 1.0 && first.inliers >= 0.9 * first.edge_points) return first;
-    Fit second = FitOnce(frame, first.x, first.z, kNarrowHalfWidth);
-    return second.ok ? second : first;
-  }
-
-  // Search along the centre path: the candidate whose predicted outline shows the strongest
-  // consistent step (median over the outline, so partial occlusion does not matter).
-  std::optional<Vector2d> Acquire(const cv::Mat& frame) {
-    cv::Mat grey, smooth;
-    if (frame.channels() == 3) cv::cvtColor(frame, grey, cv::COLOR_BGR2GRAY);
-    else grey = frame;
-    grey.convertTo(smooth, CV_32F);
-    cv::GaussianBlur(smooth, smooth, cv::Size(5, 5), 1.0);
-    const int n = 32;
-    const int candidates = 600;
-    double best_score = 0, best_x = 0;
-    std::vector<Vector3d> points;
-    std::vector<double> xs;
-    for (int i = 0; i < candidates; ++i) {
-      const double xc = x_lo + (x_hi - x_lo) * (i + 0.5) / candidates;
-      const double zc = scene.At(xc).z;
-      if (!InFront(xc, zc)) continue;
-      const std::vector<Vector3d> outline = OutlinePoints(xc, zc, n);
-      points.insert(points.end(), outline.begin(), outline.end());
-      points.emplace_back(xc, 0, zc);
-      xs.push_back(xc);
-    }
-    if (xs.empty()) return std::nullopt;
-    const std::vector<Vector2d> image = ProjectApparatusPoints(cal.camera, cal.pose, points);
-    std::vector<double> steps(n);
-    for (size_t c = 0; c < xs.size(); ++c) {
-      const Vector2d* pts = &image[c * (n + 1)];
-      const Vector2d q = pts[n];
-      int used = 0;
-      for (int k = 0; k < n; ++k) {
-        const Vector2d dir = (pts[k] - q).normalized();
-        const Vector2d out = pts[k] + 2.0 * dir, in = pts[k] - 2.0 * dir;
-        const bool ok = std::min({out.x(), in.x(), out.y(), in.y()}) >= 1 && std::max(out.x(), in.x()) < smooth.cols - 2 &&
-                        std::max(out.y(), in.y()) < smooth.rows - 2;
-        if (!ok) continue;
-        const double step = Bilinear(smooth, out.x(), out.y()) - Bilinear(smooth, in.x(), in.y());
-        steps[used++] = polarity == 0 ? step : polarity * step;
-      }
-      if (used < n / 2) continue;
-      // Both polarities allowed while unknown: the median of the signed steps must be strong.
-      std::nth_element(steps.begin(), steps.begin() + used / 2, steps.begin() + used);
-      const double median = steps[used / 2];
-      const double score = polarity == 0 ? std::abs(median) : median;
-      if (score > best_score) best_score = score, best_x = xs[c];
-    }
-    if (best_score < options.min_contrast) return std::nullopt;
-    return Vector2d(best_x, scene.At(best_x).z);
-  }
-
-  BallObservation Observe(const Fit& f, double quality_scale = 1.0) const {
+  BallObservation Observe(const FitOutcome& f, const FitRequest& q) {
     BallObservation o;
     o.found = true;
-    o.x = f.x;
-    o.z = f.z;
-    const Vector2d uv = ProjectApparatusPoint(cal.camera, cal.pose, Vector3d(f.x, 0, f.z));
+    const Vector2d c_ref(f.p[internal::kCentreX], f.p[internal::kCentreZ]);
+    // The reference time is the mid-exposure of row q.reference_row; report at the row where the
+    // centre lies (fixed point: the row moves by |dv/dt|·delay ≪ 1 row per iteration).
+    Vector2d c = c_ref;
+    double offset = 0;
+    if (row_delay > 0) {
+      for (int it = 0; it < 3; ++it) {
+        const double row = geometry.Project(c.x(), c.y()).y();
+        offset = row * row_delay;
+        c = c_ref + q.velocity * ((row - q.reference_row) * row_delay);
+      }
+    }
+    o.x = c.x();
+    o.z = c.y();
+    o.time_offset = offset;
+    const Vector2d uv = geometry.Project(o.x, o.z);
     o.u = uv.x();
     o.v = uv.y();
-    const std::vector<Vector3d> outline = OutlinePoints(f.x, f.z, 32);
     double sum = 0;
-    for (const Vector2d& p : ProjectApparatusPoints(cal.camera, cal.pose, outline)) sum += (p - uv).norm();
+    for (const Vector2d& p : ProjectApparatusPoints(geometry.cal.camera, geometry.cal.pose, geometry.OutlinePoints(o.x, o.z, 32)))
+      sum += (p - uv).norm();
     o.radius_px = sum / 32;
-    o.edge_points = f.edge_points;
+    const Vector2d smear(f.p[internal::kSmearX], f.p[internal::kSmearZ]);
+    o.smear_px = (geometry.Project(c_ref.x() + 0.5 * smear.x(), c_ref.y() + 0.5 * smear.y()) -
+                  geometry.Project(c_ref.x() - 0.5 * smear.x(), c_ref.y() - 0.5 * smear.y()))
+                     .norm();
+    o.rays = f.rays_fitted;
     o.inliers = f.inliers;
-    o.rms_px = f.rms_px;
-    const double fraction = std::min(1.0, static_cast<double>(f.inliers) / options.outline_points);
-    o.quality = quality_scale * fraction * std::exp(-f.rms_px * f.rms_px / (2 * 0.25));
+    o.misfit = f.misfit;
+    o.quality = Quality(f);
     return o;
+  }
+
+  void Remember(long f, double t, const BallObservation& o) {
+    samples[f] = Sample{t + o.time_offset, o.x, o.z};
+    history.emplace_back(f, Sample{t + o.time_offset, o.x, o.z});
+    if (history.size() > kHistory) history.pop_front();
+  }
+
+  // The velocity at time t of frame f from the accepted centres of the frames around it (a
+  // parabola in time through up to four on each side); false with fewer than two on each side.
+  bool VelocityAround(long f, double t, Vector2d* velocity) const {
+    std::vector<Sample> near;
+    int before = 0, after = 0;
+    for (auto it = samples.lower_bound(f - 4); it != samples.end() && it->first <= f + 4; ++it) {
+      if (it->first == f) continue;
+      near.push_back(it->second);
+      (it->first < f ? before : after)++;
+    }
+    if (before < 2 || after < 2) return false;
+    Eigen::MatrixXd a(near.size(), 3), y(near.size(), 2);
+    for (size_t i = 0; i < near.size(); ++i) {
+      const double dt = near[i].t - t;
+      a(i, 0) = 1, a(i, 1) = dt, a(i, 2) = dt * dt;
+      y(i, 0) = near[i].x, y(i, 1) = near[i].z;
+    }
+    const Eigen::MatrixXd coef = a.colPivHouseholderQr().solve(y);
+    *velocity = coef.row(1).transpose();
+    return velocity->allFinite();
+  }
+
+  // Whether the background is known everywhere around the body centred at `centre` (its region,
+  // on a 12 × 12 lattice of the band's pixels).
+  bool BackgroundKnownAround(const Vector2d& centre) const {
+    const Vector2d q = geometry.Project(centre.x(), centre.y());
+    const double r = RadiusPx(centre.x(), centre.y()) * std::max(1.0, 1.0 / geometry.s) + 8;
+    for (int i = 0; i < 12; ++i)
+      for (int j = 0; j < 12; ++j) {
+        const double x = q.x() + r * (2.0 * i / 11 - 1), y = q.y() + r * (2.0 * j / 11 - 1);
+        if (x < 1 || y < 1 || x > occluder.cols - 3 || y > occluder.rows - 3) continue;
+        if (background->InBand(x, y) && !background->Known(x, y)) return false;
+      }
+    return true;
+  }
+
+  // Keeps a window of the frame for a refit when the fit lacked the background or the motion.
+  void KeepForRefit(long f, double t, const cv::Mat& frame, double gain, const FitOutcome& fit,
+                    const BallObservation& o, bool motion_known) {
+    if (fit.rays_without_background == 0 && motion_known) return;
+    const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
+    const Vector2d smear(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]);
+    cv::Rect box = BodyRegion(c, smear * 2);
+    box = cv::Rect(box.x - 24, box.y - 24, box.width + 48, box.height + 48) & cv::Rect(0, 0, frame.cols, frame.rows);
+    if (box.empty()) return;
+    constexpr size_t kPendingBytes = 256u << 20;  // enough for minutes of a body at rest
+    const size_t bytes = box.area() * 3u;
+    if (pending_bytes + bytes > kPendingBytes) return;
+    pending.push_back({f, t, gain, frame(box).clone(), box.tl(), o, c});
+    pending_bytes += bytes;
+  }
+
+  // Fits kept frames again whose background and motion are now known (all of them when `all`,
+  // with whatever is known by then).
+  void FitAgain(bool all) {
+    for (auto it = pending.begin(); it != pending.end();) {
+      Vector2d velocity;
+      const bool motion = VelocityAround(it->frame, it->t, &velocity);
+      const bool ready = (motion || all) && (all || BackgroundKnownAround(it->centre));
+      if (!ready) {
+        ++it;
+        continue;
+      }
+      if (!motion) velocity = Vector2d::Zero();
+      FitRequest q = Request(it->centre, velocity, motion, kNarrowHalfWidthPx + 1.5);
+      const FitOutcome fit = Measure({it->window, it->origin, it->gain}, q);
+      if (Accept(fit, 0.45)) {
+        BallObservation o = Observe(fit, q);
+        const double moved = std::hypot(o.u - it->observed.u, o.v - it->observed.v);
+        if (moved < 0.5 * RadiusPx(o.x, o.z)) {
+          revisions.emplace_back(it->frame, o);
+          samples[it->frame] = Sample{it->t + o.time_offset, o.x, o.z};
+        }
+      }
+      pending_bytes -= it->window.total() * it->window.elemSize();
+      it = pending.erase(it);
+    }
+  }
+
+  // Scene residual and gain bookkeeping (SceneChangedAt, ExposureChanges).
+  void WatchScene(long f) {
+    const double residual = background->SceneResidual();
+    if (residual >= 0) {
+      double usual = -1;
+      if (scene_residuals.size() >= 5) {
+        std::vector<double> r = scene_residuals;
+        std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
+        usual = r[r.size() / 2];
+      }
+      if (usual > 0 && residual > kSceneChangeFactor * usual + 0.02) {
+        if (scene_suspect++ == 0) scene_suspect_from = f;
+        if (scene_suspect >= kConfirmFrames && !scene_changed_at) scene_changed_at = scene_suspect_from;
+      } else {
+        scene_suspect = 0;
+        scene_residuals.push_back(residual);
+        if (scene_residuals.size() > 30) scene_residuals.erase(scene_residuals.begin());
+      }
+    }
+    gains.emplace_back(f, background->Gain());
+    if (gains.size() > kConfirmFrames + 2) gains.pop_front();
+    // A step between frames k−1 and k that the next frames keep.
+    if (gains.size() == kConfirmFrames + 2) {
+      const double before = gains[0].second, step_from = gains[1].second;
+      bool holds = std::abs(std::log(step_from / before)) > std::log(1.25);
+      for (size_t k = 2; k < gains.size() && holds; ++k) holds = std::abs(std::log(gains[k].second / step_from)) < std::log(1.1);
+      if (holds && (exposure_changes.empty() || exposure_changes.back() < gains[1].first - kConfirmFrames))
+        exposure_changes.push_back(gains[1].first);
+    }
   }
 };
 
 BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration, const TrackerOptions& options)
-    : impl_(std::make_unique<Impl>(scene, calibration, options)) {
+    : impl_(std::make_unique<Impl>(scene, options)) {
   ValidateIntrinsics(calibration.camera, "camera");
   const Body& body = scene.body();
   if (body.kind == BodyKind::kDoubleCone)
     throw InputError("--body", "tracking supports a sphere or a spheroid, not a double cone");
-  if (options.outline_points < 16 || options.outline_points > 1024)
-    throw InputError("outline_points", "must be in 16..1024");
+  if (options.rays < 16 || options.rays > 1024) throw InputError("rays", "must be in 16..1024");
   if (!(options.search_half_width_px >= 2 && options.search_half_width_px <= 200))
     throw InputError("search_half_width_px", "must be in [2, 200] px");
+  if (!(options.fps > 0 && std::isfinite(options.fps))) throw InputError("fps", "must be > 0");
+  if (options.exposure && !(*options.exposure > 0 && *options.exposure <= 1.0 / options.fps * 1.0001))
+    throw InputError("--exposure", "must be > 0 and at most the frame time 1/fps");
+  if (!(options.readout >= 0 && options.readout < 1.0 / options.fps))
+    throw InputError("--readout", "must be >= 0 and below the frame time 1/fps");
+  if (!(options.point_spread_px >= 0.2 && options.point_spread_px <= 5))
+    throw InputError("point_spread_px", "must be in [0.2, 5] px");
   Impl& m = *impl_;
-  m.a = body.across;
-  m.s = body.across / body.along;
-  m.eye = CameraCentre(calibration.pose);
-  m.eye_s = Vector3d(m.eye.x(), m.s * m.eye.y(), m.eye.z());
-  m.to_apparatus = calibration.pose.rotation.transpose();
+  internal::OutlineGeometry& g = m.geometry;
+  g.cal = calibration;
+  g.a = body.across;
+  g.s = body.across / body.along;
+  g.eye = CameraCentre(calibration.pose);
+  g.eye_s = Vector3d(g.eye.x(), g.s * g.eye.y(), g.eye.z());
+  g.to_apparatus = calibration.pose.rotation.transpose();
+  g.sigma_px = options.point_spread_px;
+  m.row_delay = options.readout / calibration.camera.height;
   const double span = scene.x_max() - scene.x_low();
   m.x_lo = scene.x_low() + 1e-6 * span;
   m.x_hi = scene.x_max() - 1e-6 * span;
 
   // The near rail (on the camera's side) in front of the body: its band in the image, widened
-  // by 2.5 px for the smoothing and the edge search.
-  m.occluder = cv::Mat::zeros(calibration.camera.height, calibration.camera.width, CV_8U);
+  // by 2.5 px for the point spread and the sampling.
+  const int width = calibration.camera.width, height = calibration.camera.height;
+  m.occluder = cv::Mat::zeros(height, width, CV_8U);
   const double rod = scene.rod_radius() > 0 ? scene.rod_radius() : options.rail_radius;
-  const double side = m.eye.y() < 0 ? -1.0 : 1.0;
+  const double side = g.eye.y() < 0 ? -1.0 : 1.0;
   const Rails& rails = scene.rails();
   const Vector3d axis(1, side * rails.tan_half_alpha, rails.tan_theta);
   std::vector<cv::Point> polyline;
@@ -384,69 +479,146 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
   if (polyline.size() >= 2)
     cv::polylines(m.occluder, polyline, false, cv::Scalar(1),
                   std::max(1, static_cast<int>(std::ceil(2 * (max_halfwidth + 2.5)))), cv::LINE_8, 4);
+  g.occluder = &m.occluder;
+
+  // The band the body can sweep: discs along the centre path, a radius and a margin wider than
+  // the body (the rays reach beyond the outline), for the background model.
+  cv::Mat band = cv::Mat::zeros(height, width, CV_8U);
+  const int steps = 2000;
+  for (int i = 0; i <= steps; ++i) {
+    const double x = m.x_lo + (m.x_hi - m.x_lo) * i / steps;
+    const double z = scene.At(x).z;
+    const Vector3d cam = calibration.pose.rotation * Vector3d(x, 0, z) + calibration.pose.translation;
+    if (cam.z() <= 2 * g.a) continue;
+    const Vector2d q = g.Project(x, z);
+    if (std::abs(q.x()) > 4 * width || std::abs(q.y()) > 4 * height) continue;
+    const double r = m.RadiusPx(x, z) * std::max(1.0, 1.0 / g.s);
+    cv::circle(band, cv::Point(static_cast<int>(std::lround(q.x())), static_cast<int>(std::lround(q.y()))),
+               static_cast<int>(std::ceil(1.6 * r + 16)), cv::Scalar(255), cv::FILLED);
+  }
+  m.background = std::make_unique<internal::BackgroundModel>(
+      band, options.transfer == VideoTransfer::kLinear ? internal::Transfer::kLinear : internal::Transfer::kSrgb);
 }
 
 BallTracker::~BallTracker() = default;
 BallTracker::BallTracker(BallTracker&&) noexcept = default;
 
 std::vector<Vector2d> BallTracker::Outline(double x, double z, int n) const {
-  return ProjectApparatusPoints(impl_->cal.camera, impl_->cal.pose, impl_->OutlinePoints(x, z, n));
+  return ProjectApparatusPoints(impl_->geometry.cal.camera, impl_->geometry.cal.pose, impl_->geometry.OutlinePoints(x, z, n));
 }
 
-BallObservation BallTracker::Track(const cv::Mat& frame) {
-  Impl& m = *impl_;
-  if (frame.empty() || frame.depth() != CV_8U || (frame.channels() != 1 && frame.channels() != 3))
-    throw InputError("frame", "must be an 8-bit grey or BGR image");
-  if (frame.cols != m.cal.camera.width || frame.rows != m.cal.camera.height)
-    throw InputError("frame", "is " + std::to_string(frame.cols) + "x" + std::to_string(frame.rows) +
-                                  " px but the camera calibration is for " + std::to_string(m.cal.camera.width) + "x" +
-                                  std::to_string(m.cal.camera.height));
-  const long f = ++m.frame_index;
-  // Drop history that is too old to predict from.
-  while (!m.history.empty() && f - m.history.back().first > 5) m.history.clear();
+std::optional<BallTracker::Exposure> BallTracker::ExposureEstimate() const {
+  if (impl_->exposures.empty()) return std::nullopt;
+  return Exposure{impl_->Exposure(), static_cast<int>(impl_->exposures.size())};
+}
 
-  if (!m.history.empty()) {
-    const auto& h = m.history;
-    const size_t n = h.size();
-    Vector2d pred = h[n - 1].second;
-    double step_px = 0;
-    if (n >= 3 && h[n - 1].first - h[n - 3].first == 2 && f - h[n - 1].first == 1) {
-      pred = 3 * h[n - 1].second - 3 * h[n - 2].second + h[n - 3].second;
-    } else if (n >= 2) {
-      const double k = static_cast<double>(f - h[n - 1].first) / (h[n - 1].first - h[n - 2].first);
-      pred = h[n - 1].second + k * (h[n - 1].second - h[n - 2].second);
-    }
-    if (n >= 2) {
-      const Vector3d c(h[n - 1].second.x(), 0, h[n - 1].second.y());
-      step_px = (h[n - 1].second - h[n - 2].second).norm() * m.cal.camera.fx / (c - m.eye).norm();
-    }
-    const double half_width = m.options.search_half_width_px + 0.3 * step_px;
-    const Fit fit = m.Measure(frame, pred.x(), pred.y(), half_width);
-    if (m.Accept(fit)) {
-      m.history.emplace_back(f, Vector2d(fit.x, fit.z));
-      if (m.history.size() > 3) m.history.pop_front();
-      return m.Observe(fit);
-    }
-    m.history.clear();
+std::optional<long> BallTracker::SceneChangedAt() const { return impl_->scene_changed_at; }
+
+std::vector<std::pair<long, BallObservation>> BallTracker::TakeRevisions() {
+  std::vector<std::pair<long, BallObservation>> out;
+  out.swap(impl_->revisions);
+  return out;
+}
+
+void BallTracker::Finish() {
+  impl_->FitAgain(true);
+}
+const std::vector<long>& BallTracker::ExposureChanges() const { return impl_->exposure_changes; }
+
+BallObservation BallTracker::Track(const cv::Mat& input) {
+  Impl& m = *impl_;
+  if (input.empty() || input.depth() != CV_8U || (input.channels() != 1 && input.channels() != 3))
+    throw InputError("frame", "must be an 8-bit grey or BGR image");
+  const CameraIntrinsics& camera = m.geometry.cal.camera;
+  if (input.cols != camera.width || input.rows != camera.height)
+    throw InputError("frame", "is " + std::to_string(input.cols) + "x" + std::to_string(input.rows) +
+                                  " px but the camera calibration is for " + std::to_string(camera.width) + "x" +
+                                  std::to_string(camera.height));
+  cv::Mat converted;
+  if (input.channels() == 1) cv::cvtColor(input, converted, cv::COLOR_GRAY2BGR);
+  const cv::Mat& frame = input.channels() == 1 ? converted : input;
+  const long f = ++m.frame_index;
+  const double t = f / m.options.fps;
+
+  Vector2d centre, velocity;
+  const bool predicted = m.Predict(f, t, &centre, &velocity);
+  if (predicted && m.row_delay > 0) {
+    // The reference time: the mid-exposure of the predicted centre's row.
+    const double row = m.geometry.Project(centre.x(), centre.y()).y();
+    centre += velocity * (row * m.row_delay);
   }
-  // (Re)acquire: the initial guess in the first frame, else the search along the path.
-  std::optional<Vector2d> guess;
+  cv::Rect region;
+  if (predicted) region = m.BodyRegion(centre, velocity * m.Exposure());
+  m.background->Measure(frame, region);
+  m.WatchScene(f);
+  const double gain = m.background->Gain();
+  if (m.scene_changed_at) return {};
+
+  auto finish = [&](const FitOutcome& fit, const FitRequest& q) {
+    BallObservation o = m.Observe(fit, q);
+    m.noises.push_back(std::clamp(fit.noise, 1e-3, 0.2));
+    if (m.noises.size() > 15) m.noises.pop_front();
+    std::vector<double> sorted(m.noises.begin(), m.noises.end());
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    m.noise = sorted[sorted.size() / 2];
+    const bool confident = fit.misfit < 1.5 && fit.inliers >= 0.75 * fit.rays_fitted;
+    const Vector2d fitted_velocity = q.velocity;
+    const Vector2d smear(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]);
+    // The exposure, from the smear against the track's speed (where the body moved > 3 px).
+    const double step_px = fitted_velocity.norm() / m.options.fps / m.MetresPerPx(o.x, o.z);
+    if (!m.options.exposure && confident && m.history.size() >= 3 && step_px > 3) {
+      const double e = smear.dot(fitted_velocity) / fitted_velocity.squaredNorm();
+      if (e > 0 && e < 1.5 / m.options.fps) m.exposures.push_back(e);
+    }
+    const bool motion_known = q.smear_sigma > 0.5 * m.MetresPerPx(o.x, o.z) * 1.01 || m.history.size() >= 2;
+    m.Remember(f, t, o);
+    m.KeepForRefit(f, t, frame, gain, fit, o, motion_known);
+    m.background->Learn(frame, m.BodyRegion(Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]), smear));
+    m.FitAgain(false);
+    return o;
+  };
+
+  if (predicted) {
+    const double step_px = velocity.norm() / m.options.fps / m.MetresPerPx(centre.x(), centre.y());
+    const FitRequest q = m.Request(centre, velocity, m.history.size() >= 2,
+                                   m.options.search_half_width_px + 0.3 * step_px);
+    const FitOutcome fit = m.Measure({frame, {0, 0}, gain}, q);
+    // Far from the prediction is a jump to something else unless the search confirms it.
+    const double off = (m.geometry.Project(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]) -
+                        m.geometry.Project(centre.x(), centre.y())).norm();
+    if (m.Accept(fit, 0.45) && off < std::max(4.0, 0.5 * m.RadiusPx(centre.x(), centre.y()) + step_px)) return finish(fit, q);
+  }
+  // (Re)acquire: the initial guess in the first frame, else along the path near the prediction,
+  // then along the whole path.
+  std::vector<Vector2d> guesses;
   if (f == 0 && m.options.init_uv) {
-    const Vector2d nrm = UndistortPixel(m.cal.camera, *m.options.init_uv);
-    const Vector3d ray = m.to_apparatus * Vector3d(nrm.x(), nrm.y(), 1.0);
+    const Vector2d nrm = UndistortPixel(camera, *m.options.init_uv);
+    const Vector3d ray = m.geometry.to_apparatus * Vector3d(nrm.x(), nrm.y(), 1.0);
     if (std::abs(ray.y()) > 1e-12) {
-      const double t = -m.eye.y() / ray.y();
-      if (t > 0) guess = Vector2d(m.eye.x() + t * ray.x(), m.eye.z() + t * ray.z());
+      const double s = -m.geometry.eye.y() / ray.y();
+      if (s > 0) guesses.emplace_back(m.geometry.eye.x() + s * ray.x(), m.geometry.eye.z() + s * ray.z());
     }
   }
-  if (!guess) guess = m.Acquire(frame);
-  if (!guess) return {};
-  m.polarity = 0;
-  const Fit fit = m.Measure(frame, guess->x(), guess->y(), 2 * m.options.search_half_width_px);
-  if (!m.Accept(fit)) return {};
-  m.history.clear();
-  m.history.emplace_back(f, Vector2d(fit.x, fit.z));
-  return m.Observe(fit);
+  if (predicted) {
+    const double reach = 4 * m.geometry.a + 3 * velocity.norm() / m.options.fps;
+    for (const Vector2d& c : m.Candidates(frame, gain, centre.x() - reach, centre.x() + reach)) guesses.push_back(c);
+  }
+  if (guesses.empty() || !predicted)
+    for (const Vector2d& c : m.Candidates(frame, gain, m.x_lo, m.x_hi)) guesses.push_back(c);
+  for (const Vector2d& guess : guesses) {
+    const Vector2d v = predicted ? velocity : Vector2d::Zero();
+    const FitRequest q = m.Request(guess, v, predicted && m.history.size() >= 2, 2 * m.options.search_half_width_px);
+    const FitOutcome fit = m.Measure({frame, {0, 0}, gain}, q);
+    if (m.Accept(fit, 0.6)) {
+      const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
+      if (!predicted || (m.geometry.Project(c.x(), c.y()) - m.geometry.Project(centre.x(), centre.y())).norm() >
+                            2 * m.RadiusPx(c.x(), c.y()) + 3 * velocity.norm() / m.options.fps / m.MetresPerPx(c.x(), c.y()))
+        m.history.clear();
+      return finish(fit, q);
+    }
+  }
+  if (!predicted) m.history.clear();
+  return {};
 }
 
 }  // namespace uphill

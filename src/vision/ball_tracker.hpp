@@ -1,43 +1,62 @@
 // BallTracker: finds the body (sphere or spheroid) in the frames of a calibrated video, without
-// clicks, and measures its centre to a small fraction of a pixel.
+// clicks, and measures its centre to a small fraction of a pixel, also when it is smeared by a
+// long exposure, sheared by a rolling shutter, painted, or seen against wood grain or cloth.
 //
-// Where it looks: only where the body can be. The first frame (and any frame after the body was
-// lost) is searched along the projection of the scene's centre path x ↦ (x, 0, z(x)) for the
-// predicted outline with the strongest, most consistent edge (TrackerOptions::init_uv, a raw pixel
-// near the centre, replaces that search for the first frame). Then frame by frame near the
-// prediction from the last positions (constant acceleration in the frame index).
+// What it uses (the camera and the apparatus stand still, only the body moves):
+//  - linear light: each 8-bit value is decoded through the camera's transfer curve (sRGB unless
+//    TrackerOptions::transfer says the video is linear) before anything else, since only there
+//    is a blurred or anti-aliased edge a blend of body and background;
+//  - the background: a per-pixel model of the band the body can sweep, learnt online from the
+//    frames where the body is elsewhere, scaled by each frame's exposure gain
+//    (internal/background_model.hpp);
+//  - the body's own colours: the limb colour of each ray, solved in every fit, so that the
+//    channel in which an edge is located is, ray by ray, the colour difference between the body
+//    and what lies behind it (internal/outline_fit.hpp).
 //
-// How it measures: the outline. Under perspective a sphere of radius R centred at C projects to
-// the boundary of the cone of rays at the angle asin(R/|C − O|) about the direction of C − O (O the
-// camera centre); its image is (nearly) an ellipse whose centre is not the projection of C. The
-// tracker samples the grey values (of the region of interest only, lightly smoothed) along
-// rays from the predicted centre across the predicted outline, locates each edge to sub-pixel
-// (centroid of the gradient of the expected polarity above half its peak: the mid-exposure edge
-// of a motion-blurred ball), undistorts the edge points to
-// viewing rays, and fits with Ceres the centre C = (x, 0, z) in the plane y = 0: residual per edge
-// point = angle between its ray and C − O minus the half angle, in pixels, under a Cauchy loss
-// (highlights, the shadow, compression blocks and the crossbar give outliers that it ignores).
-// A third, regularised parameter absorbs a uniform inward/outward bias of the edge detector
-// (blur, limb darkening), so that the bias does not move the centre when part of the outline is
-// hidden. The spheroid (symmetry axis along y): the same in the space where y is scaled by a/b,
-// which maps it to a sphere of radius a and keeps tangency. Outline points behind the near
-// rail's projected band are not used at all. (u, v) is the projection of the fitted C, which
-// corrects the perspective shift of the ellipse centre for free.
+// Where it looks: only where the body can be. The first frame, and any frame after the body was
+// lost, is searched along the projection of the scene's centre path x ↦ (x, 0, z(x)) for the
+// predicted outline whose inside differs most from its outside (from the background, once that is
+// known); TrackerOptions::init_uv, a raw pixel near the centre, replaces that search for the first
+// frame. Then frame by frame near the prediction from the last positions (constant acceleration in
+// time). When a fit fails it re-acquires at once, in the same frame: along the path near the
+// prediction, then along the whole path.
 //
-// Accuracy (tests/vision_track_test.cpp, `uphill bench track`): on the synthetic clips of
-// synthetic_clip.hpp (1280×720 view of a 1 m apparatus, ball radius ~25 px) RMS (u, v) error
-// 0.03 px without blur and noise (tested ≤ 0.1 px), 0.06–0.08 px with motion blur, noise, flicker
-// and H.264 (tested ≤ 0.3 px); (x, z) 0.03–0.09 mm (tested ≤ 0.5 mm). Cost per frame: measured by
-// `uphill bench track` (docs/benchmarks.md). The camera and scene calibration's own errors add to these on real video.
+// How it measures: the outline, smeared over the exposure. Under perspective a sphere of radius
+// R centred at C projects to the boundary of the cone of rays at the angle asin(R/|C − O|) about
+// the direction of C − O (O the camera centre); the spheroid (symmetry axis along y) is the same
+// in the space where y is scaled by a/b. During the exposure the centre moves by D (fitted, with
+// the prediction V·E as prior), so a pixel sees the body for a fraction of its exposure: the
+// coverage of internal/smeared_outline.hpp, blurred by the optics' point spread. Rays from the
+// predicted centre across the predicted smeared outline are sampled in linear light and the
+// model I = (1 − c)·g·B + c·F is fitted with Ceres to all of them at once (centre, smear, a
+// uniform edge shift under a prior; per-ray Cauchy loss: a painted band's edges, highlights, the
+// shadow and the crossbar do not fit one limb colour and drop out). Rays through the near rail's
+// band are not used. (u, v) is the projection of the fitted C, not the centre of the outline's
+// ellipse, which perspective shifts.
+//
+// Time: the reported centre is at the mid-exposure of its frame (the container's timestamp for a
+// global shutter). A rolling shutter (TrackerOptions::readout > 0: row r is exposed r·readout/H
+// after row 0) shears the body: each ray's rows have their own window, and the centre is reported
+// at the mid-exposure of the row where it lies, BallObservation::time_offset after the frame's
+// timestamp. The exposure time is a camera setting (TrackerOptions::exposure); when unknown it is
+// measured from the fitted smear against the track's speed (ExposureEstimate()).
+//
+// Accuracy (tests/vision_track_test.cpp, tests/vision_povray_test.cpp, `uphill bench track`):
+// see docs/track.md for the measured table; the camera and scene calibration's own errors add to
+// these on real video.
 //
 // Hard cases: the near rail hides the lower edge (masked); the body leaves the frame or drops
-// between the rails (lost: found = false, quality 0; the next frames search the whole path
-// again); a frame with no ball anywhere (not found, never invented); a double cone (refused).
+// between the rails (lost: found = false, quality 0; the next frames search the path again); a
+// frame with no body anywhere (not found, never invented); a double cone (refused). Where the
+// body rested since the first frame the background under it is unknown until it leaves: those
+// rays use a background constant along the ray, solved in the fit.
 #pragma once
 
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
+#include <utility>
+#include <vector>
 #include <opencv2/core.hpp>
 
 #include "model/scene.hpp"
@@ -45,13 +64,21 @@
 
 namespace uphill {
 
+enum class VideoTransfer { kSrgb, kLinear };
+
 struct TrackerOptions {
   std::optional<Eigen::Vector2d> init_uv;  // raw pixel near the centre in the first frame
-  int outline_points = 96;                 // edge searches per frame
-  double search_half_width_px = 6;         // along each ray, either side of the predicted outline
-  double min_inlier_fraction = 0.35;       // of the outline points; below: lost
+  int rays = 64;                           // rays across the outline per frame
+  double search_half_width_px = 6;         // uncertainty of the prediction along each ray
+  double min_inlier_fraction = 0.35;       // of the rays; below: not accepted
   double rail_radius = 0.003;              // m: drawn width of line rails (scene without rods)
-  double min_contrast = 12;                // grey levels across the outline to accept a body
+  double min_contrast = 0.03;              // body against background, linear light (0..1 per channel)
+  // The camera (settings; see "Time" above).
+  double fps = 30;                         // frames per second (the video's)
+  std::optional<double> exposure;          // s; unset: measured from the smear
+  double readout = 0;                      // s from the first to the last row; 0: global shutter
+  VideoTransfer transfer = VideoTransfer::kSrgb;
+  double point_spread_px = 0.7;            // σ of the optics' blur across an edge
 };
 
 struct BallObservation {
@@ -59,14 +86,16 @@ struct BallObservation {
   double u = 0, v = 0;       // raw pixel of the fitted centre
   double radius_px = 0;      // mean distance of the outline from (u, v)
   double x = 0, z = 0;       // centre, m, apparatus frame
-  double quality = 0;        // [0, 1]: inlier fraction × exp(−rms² / 2(0.5 px)²); 0 when not found
-  int edge_points = 0, inliers = 0;
-  double rms_px = 0;         // RMS residual of the inliers
+  double time_offset = 0;    // s after the frame's timestamp of the reported centre (rolling shutter)
+  double smear_px = 0;       // length of the fitted smear over the exposure, px
+  double quality = 0;        // [0, 1], 0 when not found (see ball_tracker.cpp, Quality)
+  int rays = 0, inliers = 0; // rays fitted, rays that agree with the fit
+  double misfit = 0;         // RMS residual of the inlier rays in units of the pixel noise
 };
 
 class BallTracker {
  public:
-  // Throws InputError for a double cone or unusable intrinsics.
+  // Throws InputError for a double cone or unusable intrinsics or options.
   BallTracker(const Scene& scene, const SceneCalibration& calibration, const TrackerOptions& options = {});
   ~BallTracker();
   BallTracker(BallTracker&&) noexcept;
@@ -74,8 +103,31 @@ class BallTracker {
   // The next frame of the video (8-bit BGR or grey, the calibration's size; InputError otherwise).
   BallObservation Track(const cv::Mat& frame);
 
+  // Frames measured before the background under the body was known (it rested there from the
+  // first frame) or before its motion was (the first frames found) are measured again once they
+  // are, from a window of the frame kept for that (a second pass over those windows only, not
+  // over the video). The revised observations since the last call, by frame index; Finish()
+  // measures the rest with what is known at the end of the video.
+  std::vector<std::pair<long, BallObservation>> TakeRevisions();
+  void Finish();
+
   // The raw-pixel outline of a body centred at (x, 0, z) (n points), e.g. to draw it.
   std::vector<Eigen::Vector2d> Outline(double x, double z, int n) const;
+
+  // The exposure time measured so far from the smear against the speed (median over the frames
+  // where the body moved more than 3 px), and how many frames it rests on; nullopt before any.
+  struct Exposure {
+    double seconds = 0;
+    int frames = 0;
+  };
+  std::optional<Exposure> ExposureEstimate() const;
+
+  // Set when the picture outside the body changed beyond noise, lighting and exposure (the camera
+  // moved, or the scene was disturbed) at this frame: the calibration no longer holds. The tracker
+  // reports no positions from that frame on.
+  std::optional<long> SceneChangedAt() const;
+  // Frames where the exposure gain jumped (a step > 25 % between frames that stays).
+  const std::vector<long>& ExposureChanges() const;
 
   struct Impl;
 

@@ -11,6 +11,7 @@
 
 #include "io/atomic_file.hpp"
 #include "model/input_error.hpp"
+#include "vision/sensor_model.hpp"
 
 namespace uphill {
 namespace {
@@ -401,8 +402,23 @@ double ClipRenderer::Visibility(double x, double z) const {
 }
 
 cv::Mat ToFrame8(const cv::Mat& linear, double gain, double noise_sigma, cv::RNG& rng) {
-  cv::Mat scaled;
-  linear.convertTo(scaled, CV_32FC3, 255.0 * gain);
+  // The sRGB curve, tabulated on 2^16 steps of the linear value (its largest step, at the dark
+  // end, is 0.05 of an 8-bit level).
+  static const std::vector<float> encode = [] {
+    std::vector<float> t(65536);
+    for (size_t k = 0; k < t.size(); ++k) t[k] = static_cast<float>(255.0 * SrgbEncode(k / 65535.0));
+    return t;
+  }();
+  cv::Mat scaled(linear.size(), CV_32FC3);
+  for (int y = 0; y < linear.rows; ++y) {
+    const cv::Vec3f* in = linear.ptr<cv::Vec3f>(y);
+    cv::Vec3f* out = scaled.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < linear.cols; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double v = std::clamp(static_cast<double>(in[x][c]) * gain, 0.0, 1.0);
+        out[x][c] = encode[static_cast<size_t>(std::lround(v * 65535))];
+      }
+  }
   if (noise_sigma > 0) {
     cv::Mat noise(scaled.size(), CV_32FC3);
     rng.fill(noise, cv::RNG::NORMAL, 0.0, noise_sigma);

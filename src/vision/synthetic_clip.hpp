@@ -117,8 +117,9 @@ class ClipRenderer {
 std::vector<ClipTruth> RenderClip(const ClipRenderer& renderer, const Motion& motion, const ClipSettings& settings,
                                   const std::string& video_path);
 
-// The 8-bit frame of a linear render: gain, then Gaussian noise, then rounding (what RenderClip
-// writes).
+// The 8-bit frame of a linear render as a camera writes it: gain, the sRGB transfer curve
+// (sensor_model.hpp's SrgbEncode), then Gaussian noise of noise_sigma 8-bit levels, then rounding
+// (what RenderClip writes).
 cv::Mat ToFrame8(const cv::Mat& linear, double gain, double noise_sigma, cv::RNG& rng);
 
 // Ground-truth CSV, header `frame,t,x,z,u,v,visibility` (t s, x z mm, u v raw px; x..v empty

@@ -98,6 +98,15 @@ void DrawOverlay(cv::Mat& frame, const BallTracker& tracker, const std::vector<c
   cv::putText(frame, text, cv::Point(20, 40), cv::FONT_HERSHEY_SIMPLEX, 0.8, cv::Scalar(0, 255, 0), 2);
 }
 
+// A frame measured again (BallTracker::TakeRevisions): its row takes the new observation, the
+// time offset moving with it.
+void Revise(std::vector<TrackRow>& rows, long frame, const BallObservation& revised) {
+  if (frame < 0 || frame >= static_cast<long>(rows.size())) return;
+  TrackRow& row = rows[frame];
+  row.t += revised.time_offset - row.ball.time_offset;
+  row.ball = revised;
+}
+
 }  // namespace
 
 TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const SceneCalibration& calibration,
@@ -120,7 +129,9 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
     throw InputError(options.calibration_name, "is for " + Size(calibration.camera.width, calibration.camera.height) +
                                                    " px images but " + video_path + " has " + Size(width, height) +
                                                    " px frames (calibrate the camera at the video's resolution)");
-  BallTracker tracker(scene, calibration, options.tracker);
+  TrackerOptions tracker_options = options.tracker;
+  if (result.fps > 0 && std::isfinite(result.fps)) tracker_options.fps = result.fps;
+  BallTracker tracker(scene, calibration, tracker_options);
 
   std::optional<PendingFile> overlay_file;  // destroyed after the writer: it closes first
   std::optional<cv::VideoWriter> overlay;
@@ -168,6 +179,8 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
     const double cpu0 = ThreadCpuSeconds();
     row.ball = tracker.Track(frame);
     result.tracker_cpu_seconds += ThreadCpuSeconds() - cpu0;
+    row.t += row.ball.time_offset;
+    for (auto& [k, revised] : tracker.TakeRevisions()) Revise(result.rows, k, revised);
     if (overlay) {
       DrawOverlay(frame, tracker, path, row.ball);
       overlay->write(frame);
@@ -175,19 +188,52 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
     result.rows.push_back(row);
     if (options.progress) options.progress(static_cast<int>(result.rows.size()), result.declared_frames);
   }
+  tracker.Finish();
+  for (auto& [k, revised] : tracker.TakeRevisions()) Revise(result.rows, k, revised);
   if (result.rows.empty())
     throw InputError(video_path, "has no frame that can be decoded (not a video, or corrupt from the start)");
+  result.exposure = tracker_options.exposure;
+  if (const auto e = tracker.ExposureEstimate()) {
+    result.measured_exposure = e->seconds;
+    result.measured_exposure_frames = e->frames;
+  }
+  result.readout = tracker_options.readout;
+  result.transfer = tracker_options.transfer;
+  const long read = static_cast<long>(result.rows.size());
+  // A scene change (the camera moved): no position from that frame on, the calibration no longer
+  // holds there.
+  if (const auto changed = tracker.SceneChangedAt()) {
+    for (TrackRow& r : result.rows)
+      if (r.frame >= *changed) r.ball = BallObservation{};
+  }
   int found = 0, last_found = -1;
   for (const TrackRow& r : result.rows)
     if (r.ball.found) ++found, last_found = r.frame;
-  if (found == 0)
-    throw InputError(video_path, "no ball found in any of its " + std::to_string(result.rows.size()) +
-                                     " frames along the rails' path (check the scene file and the body flags)");
-  const long read = static_cast<long>(result.rows.size());
   if (read_error || (result.declared_frames > 0 && read < result.declared_frames - 1)) {
     result.partial = true;
+    result.input_problem = true;
     result.partial_reason = "the video ends after " + std::to_string(read) + " of the " +
                             std::to_string(result.declared_frames) + " frames its container declares (truncated or corrupt)";
+  } else if (const auto changed = tracker.SceneChangedAt()) {
+    result.partial = true;
+    result.input_problem = true;
+    result.partial_reason = "the picture outside the body changed at frame " + std::to_string(*changed) +
+                            " beyond noise and lighting (the camera moved, or the scene was disturbed): the scene "
+                            "calibration no longer holds, so no positions are reported from that frame on";
+  } else if (found == 0) {
+    result.partial = true;
+    result.input_problem = true;
+    result.partial_reason = "the body was found in none of the " + std::to_string(read) +
+                            " frames along the rails' path (is it in the picture? check the scene file and the body flags)";
+  } else if (!tracker.ExposureChanges().empty()) {
+    result.partial = true;
+    result.input_problem = true;
+    std::string frames;
+    for (long k : tracker.ExposureChanges()) frames += (frames.empty() ? "" : ", ") + std::to_string(k);
+    result.exposure_changes = tracker.ExposureChanges();
+    result.partial_reason = "the exposure changed at frame " + frames +
+                            " (the brightness of the whole picture jumped and stayed): the positions after it are "
+                            "measured with the new exposure, but a clip for analysis should keep one exposure";
   } else if (last_found + 1 < read) {
     result.partial = true;
     result.partial_reason = "the ball was lost after frame " + std::to_string(last_found) + " and not found again in the last " +
@@ -224,7 +270,21 @@ void WriteTrack(const std::string& csv_path, const TrackResult& result, const Tr
                                  {"frames_with_ball", found},
                                  {"fps", result.fps},
                                  {"extrapolated_timestamps", result.extrapolated_times},
+                                 {"time", result.readout > 0
+                                              ? "the container's timestamp of the frame plus the rolling shutter's "
+                                                "delay of the row where the centre lies: its mid-exposure"
+                                              : "the container's timestamp of the frame: the mid-exposure"},
+                                 {"transfer", result.transfer == VideoTransfer::kLinear ? "linear" : "sRGB"},
+                                 {"readout_s", result.readout},
                                  {"partial", result.partial}};
+  if (result.exposure) side["exposure_s"] = *result.exposure;
+  else if (result.measured_exposure) {
+    side["exposure_s"] = *result.measured_exposure;
+    side["exposure_measured_frames"] = result.measured_exposure_frames;
+  } else {
+    side["exposure_s"] = nullptr;
+  }
+  if (!result.exposure_changes.empty()) side["exposure_changes_at_frames"] = result.exposure_changes;
   if (result.partial) side["partial_reason"] = result.partial_reason;
   OutputPaths::CreateFolders(std::filesystem::path(csv_path).parent_path().string());
   WriteFileAtomically(csv_path, csv.str());

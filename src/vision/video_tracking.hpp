@@ -7,14 +7,22 @@
 // decoder at the end of some files; a timestamp that does not increase is replaced by the
 // previous one + 1/fps (and counted in TrackResult::extrapolated_times).
 //
+// Time: see ball_tracker.hpp: each row's t is the frame's timestamp plus the rolling shutter's
+// delay of the row where the centre lies (0 for a global shutter): the centre's mid-exposure.
+//
 // Bad input (InputError naming the file): a file that is not a video OpenCV can read; a video
-// whose frame size differs from the calibration's; a video in which the ball is found in no
-// frame. Partial results: a video that ends before the frame count its container declares
-// (truncated or corrupt), or a ball that is lost and never found again, give partial = true
-// with the reason; the rows read are kept.
+// whose frame size differs from the calibration's. Partial results (partial = true with the
+// reason; every row read is kept, never a position invented):
+//  - input_problem = true (the input's fault, `uphill track` exits 2): a video that ends before
+//    the frame count its container declares (truncated or corrupt); a picture that changed
+//    outside the body (the camera moved: no positions from that frame on); a video in which the
+//    body is found in no frame; an exposure that changed during the clip (positions kept);
+//  - input_problem = false: a ball that is lost and never found again (it dropped out of view:
+//    how runs end).
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,7 +43,15 @@ struct TrackResult {
   int extrapolated_times = 0;   // timestamps replaced (see above)
   double tracker_cpu_seconds = 0;  // CPU time of the tracker itself (this thread, decoding excluded)
   bool partial = false;
+  bool input_problem = false;   // partial because of the input (exit status 2), not a ball lost at the end
   std::string partial_reason;
+  // The camera's settings as used: the exposure given (TrackerOptions::exposure) or measured from
+  // the smear, the rolling shutter's readout, the transfer curve.
+  std::optional<double> exposure, measured_exposure;
+  int measured_exposure_frames = 0;
+  double readout = 0;
+  VideoTransfer transfer = VideoTransfer::kSrgb;
+  std::vector<long> exposure_changes;  // frames where the exposure jumped
 };
 
 struct TrackVideoOptions {

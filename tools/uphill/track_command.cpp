@@ -21,6 +21,7 @@
 #include "app/tracking_inputs.hpp"
 #include "io/configuration.hpp"
 #include "io/output_paths.hpp"
+#include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "vision/camera.hpp"
 #include "vision/track_analysis.hpp"
@@ -34,7 +35,7 @@ namespace {
 
 struct TrackFlags {
   SceneFlags scene;
-  std::string video, camera, scene_file, out, init, overlay;
+  std::string video, camera, scene_file, out, init, overlay, exposure, readout, transfer = "srgb";
   bool analyse = false, quiet = false;
 };
 
@@ -84,6 +85,10 @@ void Run(const TrackFlags& f) {
   options.calibration_name = f.scene_file;
   options.overlay_path = f.overlay;
   if (!f.init.empty()) options.tracker.init_uv = ParsePixel(f.init);
+  if (!f.exposure.empty()) options.tracker.exposure = ParseQuantity(f.exposure, Dimension::kTime, "--exposure");
+  if (!f.readout.empty()) options.tracker.readout = ParseQuantity(f.readout, Dimension::kTime, "--readout");
+  if (f.transfer == "linear") options.tracker.transfer = VideoTransfer::kLinear;
+  else if (f.transfer != "srgb") throw InputError("--transfer", "must be srgb or linear (got '" + f.transfer + "')");
   const bool bar = !f.quiet && isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
   if (bar)
@@ -114,8 +119,9 @@ void Run(const TrackFlags& f) {
   std::cout << "\n";
   if (result.partial) {
     std::cerr << "uphill: " << f.video << ": partial track: " << result.partial_reason << "\n";
-    // A cut video is bad input; a ball that drops out of view at the end is how runs end.
-    if (result.partial_reason.find("truncated") != std::string::npos) ExitStatus() = 2;
+    // A cut video, a camera that moved, no body, a changed exposure are bad input; a ball that
+    // drops out of view at the end is how runs end.
+    if (result.input_problem) ExitStatus() = 2;
   }
   if (f.analyse) {
     // The same analysis as `uphill analyse-track OUT [scene flags] -o <OUT's folder>`, default options.
@@ -143,6 +149,11 @@ void AddTrackCommand(CLI::App& app) {
   AddSceneFlags(cmd, &flags->scene);
   cmd->add_option("-o,--out", flags->out, "track CSV to write (and <csv>.json beside it)");
   cmd->add_option("--init", flags->init, "u,v: raw pixel near the ball's centre in the first frame (optional)");
+  cmd->add_option("--exposure", flags->exposure,
+                  "exposure time per frame, with unit (e.g. 8.33ms); default: measured from the motion blur");
+  cmd->add_option("--readout", flags->readout,
+                  "rolling shutter: time from the first to the last row, with unit (e.g. 25ms); default 0 (global shutter)");
+  cmd->add_option("--transfer", flags->transfer, "the video's transfer curve: srgb (cameras, default) or linear");
   cmd->add_option("--overlay", flags->overlay, "write the video with the fitted outline drawn (.mp4)");
   cmd->add_flag("--analyse", flags->analyse, "then analyse the track (release, rest, fall-off, model fit)");
   cmd->add_flag("--quiet", flags->quiet, "no progress bar");

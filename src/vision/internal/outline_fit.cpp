@@ -1,0 +1,370 @@
+#include "outline_fit.hpp"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+
+namespace uphill::internal {
+namespace {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+constexpr double kEdgeShiftPriorPx = 0.3;
+constexpr double kShadowPrior = 0.05;    // σ of the background's factor along a ray
+constexpr double kRayLossFactor = 1.5;  // Cauchy scale: this many times a good ray's χ²
+
+struct RaySamples {
+  Vector2d offset = Vector2d::Zero();  // centre shift of this ray's rows, m
+  int pieces = 1;
+  std::vector<Vector3d> dirs;          // unit, scaled space
+  std::vector<double> along;           // position along the window, −1 … 1
+  std::vector<cv::Vec3f> image, back;  // linear light; back empty: unknown (solved per ray)
+};
+
+// Per-ray linear least squares for what is not geometry, given the coverages c_i:
+//   known background:  I_i = (1 − c_i)·(σ0 + σ1·t_i)·B_i + c_i·F   (σ: the body's shadow and
+//                      the light's unevenness on this ray, weakly held at 1; F the limb colour)
+//   unknown:           I_i = (1 − c_i)·(B0 + B1·t_i) + c_i·F         (per channel)
+// t_i the sample's position along the window. Returns the background term of each sample and F.
+struct RayColours {
+  std::vector<cv::Vec3d> back;  // (σ0 + σ1·t)·B, or B0 + B1·t, per sample
+  cv::Vec3d body;
+  bool ok = false;
+};
+
+RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, double noise) {
+  RayColours out;
+  const size_t n = c.size();
+  out.back.resize(n);
+  if (!ray.back.empty()) {
+    Eigen::Matrix<double, 5, 5> a = Eigen::Matrix<double, 5, 5>::Zero();
+    Eigen::Matrix<double, 5, 1> y = Eigen::Matrix<double, 5, 1>::Zero();
+    for (size_t i = 0; i < n; ++i) {
+      const double u = 1 - c[i], t = ray.along[i];
+      for (int ch = 0; ch < 3; ++ch) {
+        Eigen::Matrix<double, 5, 1> row = Eigen::Matrix<double, 5, 1>::Zero();
+        row(0) = u * ray.back[i][ch];
+        row(1) = u * t * ray.back[i][ch];
+        row(2 + ch) = c[i];
+        a += row * row.transpose();
+        y += row * static_cast<double>(ray.image[i][ch]);
+      }
+    }
+    // σ = 1 ± 5 %: a soft shadow or uneven light, not a dark pattern taken for a shadowed table.
+    const double w = (noise / kShadowPrior) * (noise / kShadowPrior);
+    a(0, 0) += w, y(0) += w, a(1, 1) += w;
+    const Eigen::Matrix<double, 5, 1> x = a.ldlt().solve(y);
+    if (!x.allFinite() || a.diagonal().tail<3>().minCoeff() < 1e-9) {
+      for (size_t i = 0; i < n; ++i) out.back[i] = ray.back[i];
+      return out;
+    }
+    for (size_t i = 0; i < n; ++i) out.back[i] = (x(0) + x(1) * ray.along[i]) * cv::Vec3d(ray.back[i]);
+    out.body = cv::Vec3d(x(2), x(3), x(4));
+    out.ok = true;
+    return out;
+  }
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d y = Eigen::Matrix3d::Zero();  // column per channel
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d row(1 - c[i], (1 - c[i]) * ray.along[i], c[i]);
+    a += row * row.transpose();
+    for (int ch = 0; ch < 3; ++ch) y.col(ch) += row * static_cast<double>(ray.image[i][ch]);
+  }
+  a(1, 1) += 1e-6 * (a(0, 0) + 1e-12);
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(a);
+  const Eigen::Matrix3d x = ldlt.solve(y);
+  if (!x.allFinite() || a(2, 2) < 1e-9 || ldlt.rcond() < 1e-9) {
+    cv::Vec3d mean(0, 0, 0);
+    for (size_t i = 0; i < n; ++i) mean += cv::Vec3d(ray.image[i]);
+    for (size_t i = 0; i < n; ++i) out.back[i] = mean / static_cast<double>(n);
+    return out;
+  }
+  for (size_t i = 0; i < n; ++i)
+    for (int ch = 0; ch < 3; ++ch) out.back[i][ch] = x(0, ch) + x(1, ch) * ray.along[i];
+  out.body = cv::Vec3d(x(2, 0), x(2, 1), x(2, 2));
+  out.ok = true;
+  return out;
+}
+
+class RayCost : public ceres::CostFunction {
+ public:
+  RayCost(const SmearedBody& body, RaySamples ray, double inv_noise)
+      : body_(body), ray_(std::move(ray)), inv_noise_(inv_noise) {
+    set_num_residuals(static_cast<int>(3 * ray_.dirs.size()));
+    mutable_parameter_block_sizes()->push_back(kSmearParameters);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const size_t n = ray_.dirs.size();
+    const SmearNodes nodes(body_, parameters[0], ray_.offset, ray_.pieces);
+    std::vector<double> c(n);
+    std::vector<SmearGradient> grad(jacobians && jacobians[0] ? n : 0);
+    for (size_t i = 0; i < n; ++i) c[i] = nodes.Coverage(ray_.dirs[i], grad.empty() ? nullptr : &grad[i]);
+    const RayColours colours = SolveColours(ray_, c, 1.0 / inv_noise_);
+    for (size_t i = 0; i < n; ++i) {
+      const cv::Vec3d I = ray_.image[i];
+      const cv::Vec3d& B = colours.back[i];
+      const cv::Vec3d F = colours.ok ? colours.body : B;
+      for (int ch = 0; ch < 3; ++ch) {
+        residuals[3 * i + ch] = (I[ch] - B[ch] - c[i] * (F[ch] - B[ch])) * inv_noise_;
+        if (!grad.empty()) {
+          double* row = jacobians[0] + (3 * i + ch) * kSmearParameters;
+          const double k = -(F[ch] - B[ch]) * inv_noise_;
+          for (int q = 0; q < kSmearParameters; ++q) row[q] = k * grad[i][q];
+        }
+      }
+    }
+    return true;
+  }
+
+  // |F − B| (linear units) and the ray's mean squared residual (units of the noise²) at p.
+  void Assess(const double* p, double* contrast, double* mean_square) const {
+    const size_t n = ray_.dirs.size();
+    std::vector<double> r(3 * n);
+    const double* params[] = {p};
+    Evaluate(params, r.data(), nullptr);
+    double sum = 0;
+    for (double v : r) sum += v * v;
+    *mean_square = sum / static_cast<double>(r.size());
+    const SmearNodes nodes(body_, p, ray_.offset, ray_.pieces);
+    std::vector<double> c(n);
+    for (size_t i = 0; i < n; ++i) c[i] = nodes.Coverage(ray_.dirs[i], nullptr);
+    const RayColours colours = SolveColours(ray_, c, 1.0 / inv_noise_);
+    cv::Vec3d mean_back(0, 0, 0);
+    for (const cv::Vec3d& b : colours.back) mean_back += b;
+    *contrast = colours.ok ? cv::norm(colours.body - mean_back / static_cast<double>(n)) : 0.0;
+  }
+
+  size_t samples() const { return ray_.dirs.size(); }
+
+ private:
+  const SmearedBody& body_;
+  RaySamples ray_;
+  double inv_noise_;
+};
+
+// The priors: b ~ N(0, 0.3 px), D ~ N(D_pred, σ_D).
+struct PriorCost {
+  Vector2d smear;
+  double inv_smear_sigma;
+  template <typename T>
+  bool operator()(const T* p, T* r) const {
+    r[0] = p[kEdgeShift] / kEdgeShiftPriorPx;
+    r[1] = (p[kSmearX] - smear.x()) * inv_smear_sigma;
+    r[2] = (p[kSmearZ] - smear.y()) * inv_smear_sigma;
+    return true;
+  }
+};
+
+bool InFront(const OutlineGeometry& g, double x, double z) {
+  return (g.cal.pose.rotation * Vector3d(x, 0, z) + g.cal.pose.translation).z() > 2 * g.a &&
+         (Vector3d(x, 0, z) - g.eye).norm() > 2 * std::max(g.a, g.a / g.s);
+}
+
+}  // namespace
+
+std::vector<Vector3d> OutlineGeometry::OutlinePoints(double x, double z, int n) const {
+  const Vector3d c(x, 0, z);
+  const Vector3d axis = c - eye_s;
+  const double dist = axis.norm();
+  const Vector3d w = axis / dist;
+  // A fixed reference direction keeps point k at the same place on the outline frame to frame.
+  const Vector3d e1 = w.cross(Vector3d::UnitY()).normalized(), e2 = w.cross(e1);
+  const double sin_b = std::min(1.0, a / dist), cos_b = std::sqrt(1 - sin_b * sin_b);
+  std::vector<Vector3d> out;
+  out.reserve(n);
+  for (int k = 0; k < n; ++k) {
+    const double phi = 2 * M_PI * k / n;
+    const Vector3d ts = eye_s + (cos_b * w + sin_b * (std::cos(phi) * e1 + std::sin(phi) * e2)) * (dist * cos_b);
+    out.emplace_back(ts.x(), ts.y() / s, ts.z());
+  }
+  return out;
+}
+
+Vector2d OutlineGeometry::Project(double x, double z) const {
+  return ProjectApparatusPoint(cal.camera, cal.pose, Vector3d(x, 0, z));
+}
+
+double OutlineGeometry::PxPerRad(double x, double z) const {
+  return cal.camera.fx * (Vector3d(x, 0, z) - eye_s).norm() / (Vector3d(x, 0, z) - eye).norm();
+}
+
+FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const BackgroundModel& background,
+                      const FitRequest& q) {
+  const cv::Mat& bgr = view.bgr;
+  const double gain = view.gain;
+  // Where samples may be read: inside the frame and the view, a pixel in for the interpolation.
+  const double left = std::max(1.0, view.origin.x + 1.0), top = std::max(1.0, view.origin.y + 1.0);
+  const double right = std::min(g.cal.camera.width - 2.0, view.origin.x + bgr.cols - 2.0);
+  const double bottom = std::min(g.cal.camera.height - 2.0, view.origin.y + bgr.rows - 2.0);
+  FitOutcome out;
+  const double x = q.centre.x(), z = q.centre.y();
+  if (!InFront(g, x, z)) return out;
+  const int n = q.rays;
+  std::vector<Vector3d> points = g.OutlinePoints(x, z, n);
+  points.emplace_back(x, 0, z);
+  points.emplace_back(x - 0.5 * q.smear.x(), 0, z - 0.5 * q.smear.y());
+  points.emplace_back(x + 0.5 * q.smear.x(), 0, z + 0.5 * q.smear.y());
+  const std::vector<Vector2d> image = ProjectApparatusPoints(g.cal.camera, g.cal.pose, points);
+  const Vector2d centre = image[n], smear_px = image[n + 2] - image[n + 1];
+  double radius_px = 0;
+  for (int k = 0; k < n; ++k) radius_px += (image[k] - centre).norm() / n;
+  const int pieces = SmearPieces(smear_px.norm(), radius_px);
+
+  SmearedBody body;
+  body.a = g.a;
+  body.eye = g.eye_s;
+  body.px_per_rad = g.PxPerRad(x, z);
+  body.sigma_px = g.sigma_px;
+
+  // Rays: windows and their three undistorted anchors (start, middle, end).
+  struct Ray {
+    Vector2d origin, dir, offset;
+    double s0, s1;
+    double limb;  // a point surely inside the body (if the prediction holds), px along the ray
+  };
+  std::vector<Ray> rays;
+  std::vector<Vector2d> anchors;
+  const double margin_in = 1.5 + 2 * g.sigma_px, margin_out = 3.0 + 2 * g.sigma_px;
+  for (int k = 0; k < n; ++k) {
+    const Vector2d radial = image[k] - centre;
+    const double r = radial.norm();
+    if (r < 2) continue;
+    Ray ray;
+    ray.dir = radial / r;
+    // The rolling shutter: this ray's rows are exposed (row − reference)·delay later.
+    const double delay = (image[k].y() - q.reference_row) * q.row_delay;
+    ray.offset = q.velocity * delay;
+    double shift = 0;
+    if (delay != 0) shift = (g.Project(x + ray.offset.x(), z + ray.offset.y()) - centre).dot(ray.dir);
+    const double along = 0.5 * std::abs(smear_px.dot(ray.dir));
+    const double across = 0.5 * std::abs(smear_px.x() * ray.dir.y() - smear_px.y() * ray.dir.x());
+    const double inward = std::min(0.85 * r, along + r - std::sqrt(std::max(0.0, r * r - across * across)));
+    ray.s0 = std::max(-0.9 * r, -(inward + q.half_width_px + margin_in)) + shift;
+    ray.s1 = along + q.half_width_px + margin_out + shift;
+    ray.limb = -(inward + q.half_width_px + 1.5 * g.sigma_px + 0.3) + shift;
+    ray.origin = image[k];
+    // Inside the picture (with a pixel for the interpolation) and clear of the occluder.
+    bool usable = true;
+    for (double s : {ray.s0, 0.5 * (ray.s0 + ray.s1), ray.s1}) {
+      const Vector2d p = ray.origin + s * ray.dir;
+      usable = usable && p.x() >= left && p.y() >= top && p.x() < right && p.y() < bottom;
+    }
+    if (!usable) continue;
+    rays.push_back(ray);
+    for (double s : {ray.s0, 0.5 * (ray.s0 + ray.s1), ray.s1}) anchors.push_back(ray.origin + s * ray.dir);
+  }
+  out.rays_tried = static_cast<int>(rays.size());
+  if (rays.size() < 8) return out;
+  const std::vector<Vector2d> normalised = UndistortPixels(g.cal.camera, anchors);
+
+  double params[kSmearParameters] = {x, z, q.smear.x(), q.smear.y(), 0.0};
+  ceres::Problem problem;
+  std::vector<RayCost*> costs;
+  int without_background = 0;
+  const double inv_noise = 1.0 / std::max(q.noise, 1e-4);
+  const cv::Mat& occluder = *g.occluder;
+  for (size_t k = 0; k < rays.size(); ++k) {
+    const Ray& ray = rays[k];
+    RaySamples samples;
+    samples.offset = ray.offset;
+    samples.pieces = pieces;
+    const double length = ray.s1 - ray.s0;
+    const double step = std::clamp(length / 40, 0.5, 3.0);
+    const int count = static_cast<int>(std::ceil(length / step)) + 1;
+    const Vector2d& na = normalised[3 * k];
+    const Vector2d& nm = normalised[3 * k + 1];
+    const Vector2d& nb = normalised[3 * k + 2];
+    bool hidden = false, known = true;
+    for (int i = 0; i < count && !hidden; ++i) {
+      const double t = static_cast<double>(i) / (count - 1);
+      const Vector2d p = ray.origin + (ray.s0 + t * length) * ray.dir;
+      hidden = occluder.at<std::uint8_t>(static_cast<int>(p.y() + 0.5), static_cast<int>(p.x() + 0.5)) != 0;
+      // Quadratic through the three undistorted anchors (the lens bends a 40 px segment by far
+      // less than its curvature can show).
+      const Vector2d m = na * ((1 - t) * (1 - 2 * t)) + nm * (4 * t * (1 - t)) + nb * (t * (2 * t - 1));
+      Vector3d d = g.to_apparatus * Vector3d(m.x(), m.y(), 1.0);
+      d.y() *= g.s;
+      samples.dirs.push_back(d.normalized());
+      samples.along.push_back(2 * t - 1);
+      samples.image.push_back(SampleLinear(bgr, background.table(), p.x() - view.origin.x, p.y() - view.origin.y));
+      if (known && background.Known(p.x(), p.y())) samples.back.push_back(background.At(p.x(), p.y()) * gain);
+      else known = false;
+    }
+    if (hidden) {
+      --out.rays_tried;  // hidden by a rail: not part of the visible outline
+      continue;
+    }
+    if (!known) samples.back.clear(), ++without_background;
+    // Inner edges are not outline edges: where the body's colour changes inside the limb (a
+    // painted band, a dot, a seam), the window ends, so that the limb's colour is one colour.
+    const int limb = static_cast<int>(std::lround((ray.limb - ray.s0) / step));
+    if (step <= 1.0 && limb >= 1 && limb + 1 < count) {
+      const cv::Vec3f colour = 0.5f * (samples.image[limb] + samples.image[limb + 1]);
+      const double threshold = std::max(0.25 * cv::norm(colour - samples.image.back()), 5 * q.noise);
+      for (int j = limb - 1; j >= 0; --j)
+        if (cv::norm(samples.image[j] - colour) > threshold) {
+          const auto cut = [j](auto& v) {
+            if (!v.empty()) v.erase(v.begin(), v.begin() + j + 1);
+          };
+          cut(samples.dirs), cut(samples.along), cut(samples.image), cut(samples.back);
+          break;
+        }
+    }
+    const double loss_scale = std::sqrt(kRayLossFactor * 3.0 * samples.dirs.size());
+    auto* cost = new RayCost(body, std::move(samples), inv_noise);
+    costs.push_back(cost);
+    problem.AddResidualBlock(cost, new ceres::CauchyLoss(loss_scale), params);
+  }
+  out.rays_fitted = static_cast<int>(costs.size());
+  out.rays_without_background = without_background;
+  if (costs.size() < 8) return out;
+  const double sigma_d = q.smear_sigma > 0 ? q.smear_sigma : 1e-9;
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, kSmearParameters>(
+                               new PriorCost{q.smear, 1.0 / sigma_d}),
+                           nullptr, params);
+  if (!q.fit_edge_shift) problem.SetManifold(params, new ceres::SubsetManifold(kSmearParameters, {kEdgeShift}));
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.max_num_iterations = 25;
+  solver.num_threads = 1;
+  solver.logging_type = ceres::SILENT;
+  solver.function_tolerance = 1e-9;
+  solver.parameter_tolerance = 1e-9;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+  for (double v : params)
+    if (!std::isfinite(v)) return out;
+  if (!InFront(g, params[kCentreX], params[kCentreZ])) return out;
+
+  std::vector<double> squares(costs.size()), contrasts(costs.size());
+  for (size_t k = 0; k < costs.size(); ++k) costs[k]->Assess(params, &contrasts[k], &squares[k]);
+  std::vector<double> sorted = squares;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  const double limit = kRayLossFactor * std::max(1.0, median);
+  double sum = 0;
+  std::vector<double> inlier_contrasts;
+  for (size_t k = 0; k < costs.size(); ++k)
+    if (squares[k] < limit) {
+      ++out.inliers;
+      sum += squares[k];
+      inlier_contrasts.push_back(contrasts[k]);
+    }
+  if (out.inliers == 0) return out;
+  std::nth_element(inlier_contrasts.begin(), inlier_contrasts.begin() + inlier_contrasts.size() / 2,
+                   inlier_contrasts.end());
+  out.contrast = inlier_contrasts[inlier_contrasts.size() / 2];
+  out.misfit = std::sqrt(sum / out.inliers);
+  out.noise = q.noise * std::sqrt(median);
+  std::copy(std::begin(params), std::end(params), out.p.begin());
+  out.ok = true;
+  return out;
+}
+
+}  // namespace uphill::internal

@@ -1,0 +1,88 @@
+// One frame's measurement of the body: the smeared outline (smeared_outline.hpp) fitted with Ceres
+// to the pixels across it, in linear light, against the background.
+//
+// Rays: from the predicted centre's image through `rays` points of the predicted outline (the
+// cone's tangent points), each sampled over a window that holds the edge's whole sweep during the
+// exposure (the predicted smear projected on the ray, the inward reach of the smear's sides) plus
+// the prediction's uncertainty and the point spread. A ray that leaves the picture or crosses the
+// near rail's band (the occluder) is not used: hidden edges are not edges.
+//
+// Model of a ray's samples i (linear RGB, 3 residuals each):
+//   I_i = (1 − c_i)·g·B_i + c_i·F_k
+// c_i the coverage of the sample's viewing ray, g·B_i the background at the sample (the
+// background model times this frame's gain) and F_k the body's colour at this ray's limb, a
+// nuisance solved in closed form for every evaluation (variable projection; Kaufman's Jacobian,
+// which drops ∂F/∂c). So the channel in which the fit sees the edge is, ray by ray, the colour
+// difference between the body's limb and what lies behind it: a body as grey as the table but of
+// another hue, or a table with grain, costs nothing. Where the background is not yet known at
+// every sample of a ray (the body rested there since the first frame) the ray's background is a
+// constant B_k solved the same way. A painted band, a highlight, a seam, the shadow: such a ray's
+// samples do not follow one limb colour, its misfit is large, and a Cauchy loss per ray (scale:
+// 4 times the expected χ² of a good ray) gives it no say.
+//
+// Parameters (smeared_outline.hpp's order): the centre (x, z) at the reference time, the smear D
+// over the exposure, a uniform edge shift b. Priors: b ~ N(0, 0.3 px), D ~ N(D_pred, σ_D).
+//
+// Accuracy: see ball_tracker.hpp. Cost: rays × samples × (pieces + 1) outline evaluations per
+// Jacobian; about 1–4 Ceres iterations per pass, two passes.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <opencv2/core.hpp>
+
+#include "vision/camera.hpp"
+#include "background_model.hpp"
+#include "smeared_outline.hpp"
+
+namespace uphill::internal {
+
+struct OutlineGeometry {
+  SceneCalibration cal;
+  Eigen::Matrix3d to_apparatus;  // camera -> apparatus rotation
+  double a = 0, s = 1;           // body radius across, y scaling
+  Eigen::Vector3d eye, eye_s;    // camera centre, and scaled
+  double sigma_px = 0.7;         // point spread
+  const cv::Mat* occluder = nullptr;  // CV_8U frame-size mask of hidden pixels
+
+  // Tangent points of the body centred at (x, 0, z), apparatus frame (n of them).
+  std::vector<Eigen::Vector3d> OutlinePoints(double x, double z, int n) const;
+  Eigen::Vector2d Project(double x, double z) const;
+  double PxPerRad(double x, double z) const;
+};
+
+struct FitRequest {
+  Eigen::Vector2d centre;               // (x, z) at the reference time, m
+  Eigen::Vector2d smear = {0, 0};        // D predicted, m
+  double smear_sigma = 0;               // σ_D, m (per component)
+  Eigen::Vector2d velocity = {0, 0};    // m/s, for the rolling shutter's row delays
+  double row_delay = 0;                 // s per row (readout / rows); 0: global shutter
+  double reference_row = 0;             // the row whose time is the reference
+  double half_width_px = 6;             // uncertainty of the prediction along each ray
+  int rays = 64;
+  double noise = 0.01;                  // expected RMS of a sample's residual, linear units
+  bool fit_edge_shift = true;           // false: b held at 0 (a first pass far from the edges)
+};
+
+// The picture a fit reads: a whole frame (origin 0, 0) or a window of one kept for a later refit,
+// and that frame's exposure gain (background_model.hpp).
+struct FrameView {
+  const cv::Mat& bgr;  // 8-bit BGR
+  cv::Point origin;    // frame pixel of bgr's (0, 0)
+  double gain = 1;
+};
+
+struct FitOutcome {
+  bool ok = false;
+  std::array<double, kSmearParameters> p{};  // as SmearParameter
+  int rays_tried = 0, rays_fitted = 0, inliers = 0;
+  int rays_without_background = 0;  // rays where the background was not yet known
+  double misfit = 0;    // RMS of the inlier rays' residuals in units of `noise`
+  double contrast = 0;  // median |F − B| of the inliers, linear units
+  double noise = 0;     // RMS residual of the inlier rays, linear units (for the next frame)
+};
+
+FitOutcome FitOutline(const OutlineGeometry& geometry, const FrameView& view, const BackgroundModel& background,
+                      const FitRequest& request);
+
+}  // namespace uphill::internal
