@@ -6,8 +6,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "model/input_error.hpp"
@@ -219,6 +221,70 @@ TEST_F(DefaultView, VideoWithoutBallIsPartialWithoutPositions) {
   EXPECT_TRUE(track.partial);
   EXPECT_TRUE(track.input_problem);
   EXPECT_NE(track.partial_reason.find("found in none"), std::string::npos) << track.partial_reason;
+}
+
+// A rolling ball, frames written by hand so that the picture can be changed from frame `from` on
+// by `change` (the linear-light picture, in place, before the camera's encoding). Truth: the renderer's centres (ClipRenderer) and the
+// frame where the change was made.
+std::vector<Eigen::Vector2d> WriteChangedClip(const ClipRenderer& renderer, const ClipSetup& setup, const std::string& video,
+                                              int frames, int from, const std::function<void(cv::Mat&)>& change) {
+  const Motion motion(setup.scene, setup.x0);
+  cv::VideoWriter w(video, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30, cv::Size(1280, 720));
+  cv::RNG rng(3);
+  std::vector<Eigen::Vector2d> uv;
+  for (int i = 0; i < frames; ++i) {
+    const MotionSample m = motion.At(i / 30.0);
+    const double x = m.x, z = m.z;
+    cv::Mat linear = renderer.RenderLinear({Eigen::Vector2d(x, z)});
+    if (i >= from) change(linear);
+    w.write(ToFrame8(linear, 1.0, 1.0, rng));
+    uv.push_back(ProjectApparatusPoint(setup.calibration.camera, setup.calibration.pose, Eigen::Vector3d(x, 0, z)));
+  }
+  return uv;
+}
+
+TEST_F(DefaultView, CameraThatMovedIsPartialWithoutPositionsAfterIt) {
+  // From frame 12 the whole picture is shifted by (9, -6) px: the camera moved. Truth: that frame.
+  const std::string video = (TempDir() / "moved.avi").string();
+  const std::vector<Eigen::Vector2d> uv = WriteChangedClip(*renderer_, *setup_, video, 24, 12, [](cv::Mat& f) {
+    const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 9, 0, 1, -6);
+    cv::warpAffine(f.clone(), f, shift, f.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  });
+  const TrackResult track = TrackVideo(video, setup_->scene, setup_->calibration);
+  ASSERT_EQ(track.rows.size(), 24u);
+  EXPECT_TRUE(track.partial);
+  EXPECT_TRUE(track.input_problem);
+  EXPECT_NE(track.partial_reason.find("changed at frame 12"), std::string::npos) << track.partial_reason;
+  EXPECT_NE(track.partial_reason.find("camera moved"), std::string::npos) << track.partial_reason;
+  for (int i = 0; i < 24; ++i) {
+    const BallObservation& b = track.rows[i].ball;
+    if (i >= 12) {
+      EXPECT_FALSE(b.found) << "frame " << i << ": a position after the camera moved is invented";
+    } else {
+      ASSERT_TRUE(b.found) << "frame " << i;
+      EXPECT_LT(std::hypot(b.u - uv[i].x(), b.v - uv[i].y()), 0.3) << "frame " << i;
+    }
+  }
+}
+
+TEST_F(DefaultView, ExposureThatChangedIsPartialAndKeepsPositions) {
+  // From frame 10 the exposure is 1.6 times longer (auto-exposure stepped). Truth: that frame,
+  // and the renderer's centres (the positions stay measurable).
+  const std::string video = (TempDir() / "exposure.avi").string();
+  const std::vector<Eigen::Vector2d> uv =
+      WriteChangedClip(*renderer_, *setup_, video, 20, 10, [](cv::Mat& f) { f *= 1.6; });
+  const TrackResult track = TrackVideo(video, setup_->scene, setup_->calibration);
+  ASSERT_EQ(track.rows.size(), 20u);
+  EXPECT_TRUE(track.partial);
+  EXPECT_TRUE(track.input_problem);
+  EXPECT_NE(track.partial_reason.find("exposure changed at frame 10"), std::string::npos) << track.partial_reason;
+  ASSERT_EQ(track.exposure_changes.size(), 1u);
+  EXPECT_EQ(track.exposure_changes[0], 10);
+  for (int i = 0; i < 20; ++i) {
+    const BallObservation& b = track.rows[i].ball;
+    ASSERT_TRUE(b.found) << "frame " << i;
+    EXPECT_LT(std::hypot(b.u - uv[i].x(), b.v - uv[i].y()), 0.5) << "frame " << i;
+  }
 }
 
 TEST(VisionTrack, SpheroidCleanClip) {

@@ -8,6 +8,8 @@
 #include <map>
 #include <sstream>
 
+#include <opencv2/videoio.hpp>
+
 #include "bench/support.hpp"
 #include "io/csv_table.hpp"
 #include "model/input_error.hpp"
@@ -114,7 +116,9 @@ struct Run {
   std::string calibration_note;
   Score uphill;
   std::string uphill_says;  // error / partial / complete
-  double ms_per_frame = 0;
+  double ms_per_frame = 0;         // the tracker alone (its thread's CPU time)
+  double decode_ms_per_frame = 0;  // VideoCapture::read alone (process CPU time)
+  double model_share = 0;          // frames measured by the full model, of those found
   std::map<std::string, Score> peers;
 };
 
@@ -129,7 +133,10 @@ const char* const kTrackMatrixMethod =
     "camera -> calibrate camera; the apparatus points -> calibrate scene) and tracked with that calibration. RMS "
     "of (u, v), px, and (x, z), mm, over the frames where the body is at least half visible; found: of those "
     "frames. Peers start from the true first box; their (x, z) is their pixel's calibrated ray on the plane "
-    "y = 0. render: wall time to ray-trace the clip on this machine (CPU seconds in brackets).";
+    "y = 0. render: wall time to ray-trace the clip on this machine (CPU seconds in brackets). ms/frame: uphill's "
+    "tracker alone (its thread's CPU time); vs decode: frames per CPU-second of decoding and tracking against "
+    "decoding alone (VideoCapture::read, process CPU time; goal >= 80%); model: share of the frames found that the "
+    "full model (background, colours, smear) measured rather than the fast edge fit.";
 
 std::unique_ptr<TrackMatrixRecord> RunTrackMatrix(const TrackMatrixOptions& o, std::ostream& out) {
   auto record = std::make_unique<TrackMatrixRecord>();
@@ -174,6 +181,17 @@ std::unique_ptr<TrackMatrixRecord> RunTrackMatrix(const TrackMatrixOptions& o, s
       }
       run.uphill_says = track.partial ? "partial: " + track.partial_reason : "complete";
       run.ms_per_frame = track.rows.empty() ? 0 : 1e3 * track.tracker_cpu_seconds / track.rows.size();
+      int found = 0, modelled = 0;
+      for (const TrackRow& r : track.rows) found += r.ball.found, modelled += r.ball.found && r.ball.full_model;
+      run.model_share = found ? static_cast<double>(modelled) / found : 0;
+      const double cpu0 = ProcessCpuSeconds();
+      long decoded = 0;
+      {
+        cv::VideoCapture capture(run.files.video, cv::CAP_FFMPEG);
+        cv::Mat frame;
+        while (capture.read(frame)) ++decoded;
+      }
+      if (decoded > 0) run.decode_ms_per_frame = 1e3 * (ProcessCpuSeconds() - cpu0) / decoded;
     } catch (const InputError& e) {
       run.uphill_says = std::string("error: ") + e.what();
     }
@@ -217,6 +235,9 @@ std::unique_ptr<TrackMatrixRecord> RunTrackMatrix(const TrackMatrixOptions& o, s
                               {"uphill px", 9},
                               {"mm", 7},
                               {"found", 7},
+                              {"ms/frame", 8},
+                              {"vs decode", 9},
+                              {"model", 6},
                               {"CSRT px", 8},
                               {"mm", 7},
                               {"found", 7},
@@ -230,8 +251,11 @@ std::unique_ptr<TrackMatrixRecord> RunTrackMatrix(const TrackMatrixOptions& o, s
   record->robustness.Start(out);
   for (const Run& run : runs) {
     if (run.named.expectation != FootageExpectation::kTrack) continue;
+    const double total = run.decode_ms_per_frame + run.ms_per_frame;
     std::vector<std::string> cells = {run.named.condition.name, RenderTime(run.files), Cell(run.uphill, true),
-                                      Cell(run.uphill, false), Found(run.uphill)};
+                                      Cell(run.uphill, false), Found(run.uphill), Fixed("%.1f", run.ms_per_frame),
+                                      total > 0 ? Fixed("%.0f%%", 100 * run.decode_ms_per_frame / total) : "n/a",
+                                      Fixed("%.0f%%", 100 * run.model_share)};
     for (const std::string& peer : kPeers) {
       const auto it = run.peers.find(peer);
       if (it == run.peers.end()) cells.insert(cells.end(), {"n/a", "n/a", "n/a"});

@@ -9,6 +9,7 @@
 
 #include "model/input_error.hpp"
 #include "internal/background_model.hpp"
+#include "internal/edge_fit.hpp"
 #include "internal/outline_fit.hpp"
 
 namespace uphill {
@@ -22,8 +23,17 @@ using internal::FitRequest;
 constexpr double kNarrowHalfWidthPx = 1.5;  // second pass, around the first fit
 constexpr int kHistoryGap = 5;              // frames without the body after which we predict no more
 constexpr size_t kHistory = 6;              // samples the prediction is fitted to
-constexpr double kSceneChangeFactor = 4;    // scene residual jump (times its usual level)
+constexpr double kSceneChangeFactor = 3;    // scene residual jump (times its usual level, plus 0.01)
 constexpr int kConfirmFrames = 3;           // frames that confirm a scene or exposure change
+// The fast path (internal/edge_fit.hpp) and when it is trusted.
+constexpr int kEdgePoints = 96;             // edge searches per frame
+constexpr double kFastMaxBlur = 0.25;       // predicted smear over the exposure, in radii
+constexpr double kFastMinContrast = 20;     // grey levels across the outline
+constexpr double kFastMaxRmsPx = 0.3;       // RMS of the edge points about the fitted outline
+constexpr double kFastMinAgreement = 0.85;  // share of the searched rays that are inliers
+constexpr double kFastMaxDisagreementPx = 0.5;  // edge fit against the model, at acquisition
+constexpr int kFastDistrust = 3;            // untrusted fast fits in a row: the clip needs the model
+constexpr int kLearnEvery = 4;              // on the fast path, frames between background updates
 
 struct Sample {
   double t, x, z;  // s (clip time of the reported centre), m
@@ -61,11 +71,17 @@ struct BallTracker::Impl {
     cv::Point origin;
     BallObservation observed;
     Vector2d centre;  // fitted, at the reference time
+    bool edge_fallback = false;  // observed by the edge fit: keep it unless the background becomes known
   };
   std::deque<Pending> pending;
   size_t pending_bytes = 0;
   std::vector<std::pair<long, BallObservation>> revisions;
   std::vector<long> exposure_changes;
+  // Fast path: the edge fit; whether this clip needs the full model on every frame (its grey
+  // contrast is low, its body patterned, or the edge fit keeps failing), and why.
+  std::unique_ptr<internal::EdgeFit> edges;
+  bool needs_model = false;
+  int distrusted = 0;
 
   Impl(const Scene& sc, const TrackerOptions& o) : scene(sc), options(o) {}
 
@@ -306,6 +322,35 @@ struct BallTracker::Impl {
     o.inliers = f.inliers;
     o.misfit = f.misfit;
     o.quality = Quality(f);
+    o.full_model = true;
+    return o;
+  }
+
+  // The fast path's fit is trusted when it saw the outline nearly all round, in grey-level
+  // contrast well above the noise, and its edge points lie on the fitted outline.
+  bool Trusted(const internal::EdgeFitOutcome& e) const {
+    return e.ok && e.inliers >= 0.35 * kEdgePoints && e.inliers >= kFastMinAgreement * e.attempted &&
+           e.contrast >= kFastMinContrast && e.rms_px <= kFastMaxRmsPx;
+  }
+
+  BallObservation ObserveEdges(const internal::EdgeFitOutcome& e) const {
+    BallObservation o;
+    o.found = true;
+    o.x = e.x;
+    o.z = e.z;
+    const Vector2d uv = geometry.Project(o.x, o.z);
+    o.u = uv.x();
+    o.v = uv.y();
+    double sum = 0;
+    for (const Vector2d& p : ProjectApparatusPoints(geometry.cal.camera, geometry.cal.pose, geometry.OutlinePoints(o.x, o.z, 32)))
+      sum += (p - uv).norm();
+    o.radius_px = sum / 32;
+    o.rays = e.edge_points;
+    o.inliers = e.inliers;
+    o.misfit = e.rms_px / 0.1;  // in units of a good edge fit's scatter
+    const double fraction = std::min(1.0, static_cast<double>(e.inliers) / std::max(1, e.attempted));
+    o.quality = fraction * std::exp(-e.rms_px * e.rms_px / (2 * 0.25));
+    o.full_model = false;
     return o;
   }
 
@@ -353,7 +398,7 @@ struct BallTracker::Impl {
 
   // Keeps a window of the frame for a refit when the fit lacked the background or the motion.
   void KeepForRefit(long f, double t, const cv::Mat& frame, double gain, const FitOutcome& fit,
-                    const BallObservation& o, bool motion_known) {
+                    const BallObservation& o, bool motion_known, bool edge_fallback) {
     if (fit.rays_without_background == 0 && motion_known) return;
     const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
     const Vector2d smear(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]);
@@ -363,7 +408,7 @@ struct BallTracker::Impl {
     constexpr size_t kPendingBytes = 256u << 20;  // enough for minutes of a body at rest
     const size_t bytes = box.area() * 3u;
     if (pending_bytes + bytes > kPendingBytes) return;
-    pending.push_back({f, t, gain, frame(box).clone(), box.tl(), o, c});
+    pending.push_back({f, t, gain, frame(box).clone(), box.tl(), o, c, edge_fallback});
     pending_bytes += bytes;
   }
 
@@ -373,9 +418,17 @@ struct BallTracker::Impl {
     for (auto it = pending.begin(); it != pending.end();) {
       Vector2d velocity;
       const bool motion = VelocityAround(it->frame, it->t, &velocity);
-      const bool ready = (motion || all) && (all || BackgroundKnownAround(it->centre));
+      const bool background_known = BackgroundKnownAround(it->centre);
+      const bool ready = (motion || all) && (all || background_known);
       if (!ready) {
         ++it;
+        continue;
+      }
+      // Where the background under the body was never seen the model's per-ray background is
+      // less sure than the edge fit that stood in for it.
+      if (it->edge_fallback && !background_known) {
+        pending_bytes -= it->window.total() * it->window.elemSize();
+        it = pending.erase(it);
         continue;
       }
       if (!motion) velocity = Vector2d::Zero();
@@ -404,7 +457,7 @@ struct BallTracker::Impl {
         std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
         usual = r[r.size() / 2];
       }
-      if (usual > 0 && residual > kSceneChangeFactor * usual + 0.02) {
+      if (usual > 0 && residual > kSceneChangeFactor * usual + 0.01) {
         if (scene_suspect++ == 0) scene_suspect_from = f;
         if (scene_suspect >= kConfirmFrames && !scene_changed_at) scene_changed_at = scene_suspect_from;
       } else {
@@ -480,6 +533,7 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
     cv::polylines(m.occluder, polyline, false, cv::Scalar(1),
                   std::max(1, static_cast<int>(std::ceil(2 * (max_halfwidth + 2.5)))), cv::LINE_8, 4);
   g.occluder = &m.occluder;
+  m.edges = std::make_unique<internal::EdgeFit>(m.geometry, kEdgePoints);
 
   // The band the body can sweep: discs along the centre path, a radius and a margin wider than
   // the body (the rays reach beyond the outline), for the background model.
@@ -554,7 +608,8 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
   const double gain = m.background->Gain();
   if (m.scene_changed_at) return {};
 
-  auto finish = [&](const FitOutcome& fit, const FitRequest& q) {
+  // A frame the model measured. `acquired`: the body was found anew (not near the prediction).
+  auto finish = [&](const FitOutcome& fit, const FitRequest& q, bool acquired) {
     BallObservation o = m.Observe(fit, q);
     m.noises.push_back(std::clamp(fit.noise, 1e-3, 0.2));
     if (m.noises.size() > 15) m.noises.pop_front();
@@ -571,13 +626,53 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
       if (e > 0 && e < 1.5 / m.options.fps) m.exposures.push_back(e);
     }
     const bool motion_known = q.smear_sigma > 0.5 * m.MetresPerPx(o.x, o.z) * 1.01 || m.history.size() >= 2;
+    // The edge fit at the model's centre: at acquisition it says whether this clip can take the
+    // fast path (grey contrast, no pattern near the outline: it agrees with the model); where the
+    // background under the body was never seen it stands in for the model until it is.
+    bool edge_fallback = false;
+    if (acquired || fit.rays_without_background > 0) {
+      if (acquired) m.edges->Reset();
+      const internal::EdgeFitOutcome e = m.edges->Measure(frame, o.x, o.z, kNarrowHalfWidthPx + 1);
+      const double apart = e.ok ? (m.geometry.Project(e.x, e.z) - Vector2d(o.u, o.v)).norm() : 1e9;
+      const bool agrees = m.Trusted(e) && apart < kFastMaxDisagreementPx + (fit.rays_without_background > 0 ? 0.5 : 0);
+      if (acquired && !agrees) m.needs_model = true;
+      if (fit.rays_without_background > 0 && agrees) {
+        const double offset = o.time_offset;
+        o = m.ObserveEdges(e);
+        o.time_offset = offset;
+        edge_fallback = true;
+      }
+    }
     m.Remember(f, t, o);
-    m.KeepForRefit(f, t, frame, gain, fit, o, motion_known);
-    m.background->Learn(frame, m.BodyRegion(Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]), smear));
+    m.KeepForRefit(f, t, frame, gain, fit, o, motion_known, edge_fallback);
+    // Not while a scene change is being confirmed: the changed picture is not the background.
+    if (m.scene_suspect == 0)
+      m.background->Learn(frame, m.BodyRegion(Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]), smear));
     m.FitAgain(false);
     return o;
   };
 
+  // The fast path: the edge fit, where the scene does not need the model (see the header).
+  if (predicted && !m.needs_model && m.row_delay == 0) {
+    const double px = 1 / m.MetresPerPx(centre.x(), centre.y());
+    const double blur_px = velocity.norm() * m.Exposure() * px, step_px = velocity.norm() / m.options.fps * px;
+    // With the exposure a guess (180°) the edge fit's own checks decide up to twice the limit.
+    const bool exposure_known = m.options.exposure || m.exposures.size() >= 3;
+    if (blur_px <= (exposure_known ? 1 : 2) * kFastMaxBlur * m.RadiusPx(centre.x(), centre.y())) {
+      const internal::EdgeFitOutcome e =
+          m.edges->Measure(frame, centre.x(), centre.y(), m.options.search_half_width_px + 0.3 * step_px);
+      const double off = e.ok ? (m.geometry.Project(e.x, e.z) - m.geometry.Project(centre.x(), centre.y())).norm() : 1e9;
+      if (m.Trusted(e) && off < std::max(4.0, 0.5 * m.RadiusPx(centre.x(), centre.y()) + step_px)) {
+        m.distrusted = 0;
+        const BallObservation o = m.ObserveEdges(e);
+        m.Remember(f, t, o);
+        if (f % kLearnEvery == 0 && m.scene_suspect == 0) m.background->Learn(frame, m.BodyRegion(Vector2d(e.x, e.z), velocity * m.Exposure()));
+        m.FitAgain(false);
+        return o;
+      }
+      if (++m.distrusted >= kFastDistrust) m.needs_model = true;
+    }
+  }
   if (predicted) {
     const double step_px = velocity.norm() / m.options.fps / m.MetresPerPx(centre.x(), centre.y());
     const FitRequest q = m.Request(centre, velocity, m.history.size() >= 2,
@@ -586,7 +681,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
     // Far from the prediction is a jump to something else unless the search confirms it.
     const double off = (m.geometry.Project(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]) -
                         m.geometry.Project(centre.x(), centre.y())).norm();
-    if (m.Accept(fit, 0.45) && off < std::max(4.0, 0.5 * m.RadiusPx(centre.x(), centre.y()) + step_px)) return finish(fit, q);
+    if (m.Accept(fit, 0.45) && off < std::max(4.0, 0.5 * m.RadiusPx(centre.x(), centre.y()) + step_px)) return finish(fit, q, false);
   }
   // (Re)acquire: the initial guess in the first frame, else along the path near the prediction,
   // then along the whole path.
@@ -614,7 +709,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
       if (!predicted || (m.geometry.Project(c.x(), c.y()) - m.geometry.Project(centre.x(), centre.y())).norm() >
                             2 * m.RadiusPx(c.x(), c.y()) + 3 * velocity.norm() / m.options.fps / m.MetresPerPx(c.x(), c.y()))
         m.history.clear();
-      return finish(fit, q);
+      return finish(fit, q, !predicted);
     }
   }
   if (!predicted) m.history.clear();

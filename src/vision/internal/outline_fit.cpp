@@ -44,17 +44,28 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, dou
   if (!ray.back.empty()) {
     Eigen::Matrix<double, 5, 5> a = Eigen::Matrix<double, 5, 5>::Zero();
     Eigen::Matrix<double, 5, 1> y = Eigen::Matrix<double, 5, 1>::Zero();
+    // The normal equations of the rows (u·B_ch, u·t·B_ch, c at 2 + ch) of every sample and
+    // channel, summed by their structure (u = 1 − c, t the position along the ray).
     for (size_t i = 0; i < n; ++i) {
-      const double u = 1 - c[i], t = ray.along[i];
+      const double u = 1 - c[i], t = ray.along[i], ci = c[i];
+      double bb = 0, bi = 0;
       for (int ch = 0; ch < 3; ++ch) {
-        Eigen::Matrix<double, 5, 1> row = Eigen::Matrix<double, 5, 1>::Zero();
-        row(0) = u * ray.back[i][ch];
-        row(1) = u * t * ray.back[i][ch];
-        row(2 + ch) = c[i];
-        a += row * row.transpose();
-        y += row * static_cast<double>(ray.image[i][ch]);
+        const double b = ray.back[i][ch], image = ray.image[i][ch];
+        bb += b * b;
+        bi += b * image;
+        a(0, 2 + ch) += u * b * ci;
+        a(1, 2 + ch) += u * t * b * ci;
+        y(2 + ch) += ci * image;
       }
+      a(0, 0) += u * u * bb;
+      a(0, 1) += u * u * t * bb;
+      a(1, 1) += u * u * t * t * bb;
+      a(2, 2) += ci * ci, a(3, 3) += ci * ci, a(4, 4) += ci * ci;
+      y(0) += u * bi;
+      y(1) += u * t * bi;
     }
+    a(1, 0) = a(0, 1);
+    for (int k = 2; k < 5; ++k) a(k, 0) = a(0, k), a(k, 1) = a(1, k);
     // σ = 1 ± 5 %: a soft shadow or uneven light, not a dark pattern taken for a shadowed table.
     const double w = (noise / kShadowPrior) * (noise / kShadowPrior);
     a(0, 0) += w, y(0) += w, a(1, 1) += w;

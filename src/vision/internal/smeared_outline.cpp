@@ -19,6 +19,13 @@ double IntegratedCdf(double u) { return u * NormalCdf(u) + NormalPdf(u); }
 
 // Mean of Φ over u linear from u0 to u1, and its derivatives with respect to u0 and u1.
 double MeanCdf(double u0, double u1, double* d0, double* d1) {
+  // Beyond 8.3 standard deviations Φ is 0 or 1 and φ is below 1e-15 in binary64: no erfc, no exp
+  // (most samples of a ray lie there, away from the edge).
+  constexpr double kSaturated = 8.3;
+  if ((u0 > kSaturated && u1 > kSaturated) || (u0 < -kSaturated && u1 < -kSaturated)) {
+    *d0 = *d1 = 0;
+    return u0 > 0 ? 1.0 : 0.0;
+  }
   const double h = u1 - u0;
   if (std::abs(h) < 1e-4) {
     const double m = 0.5 * (u0 + u1), pdf = NormalPdf(m);

@@ -1,0 +1,220 @@
+#include "edge_fit.hpp"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+namespace uphill::internal {
+namespace {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+constexpr double kStep = 0.5;             // px between profile samples
+constexpr double kNarrowHalfWidth = 2.5;  // px, second pass around the first fit
+constexpr double kInlierPx = 1.0;         // |residual| below this: inlier
+constexpr double kLossScalePx = 0.5;      // Cauchy scale
+constexpr double kBiasPriorPx = 0.5;      // the edge-bias parameter's prior width
+constexpr double kMinGradient = 2.0;      // grey levels per px: weaker is no edge
+
+// Residual of one edge point, in pixels: angle between its viewing ray and the centre's
+// direction minus the outline's half angle, minus the edge bias (all in the space where the body
+// is a sphere of radius a).
+struct EdgeResidual {
+  Vector3d ray;  // scaled-space direction of the edge point's viewing ray (unit)
+  Vector3d eye;  // scaled-space camera centre
+  double a, px_per_rad;
+  template <typename T>
+  bool operator()(const T* p, T* residual) const {
+    const T c[3] = {p[0] - eye.x(), T(-eye.y()), p[1] - eye.z()};  // C has y = 0, unchanged by scaling
+    const T norm = ceres::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    const T cross[3] = {ray.y() * c[2] - ray.z() * c[1], ray.z() * c[0] - ray.x() * c[2],
+                        ray.x() * c[1] - ray.y() * c[0]};
+    const T sin_part = ceres::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
+    const T cos_part = ray.x() * c[0] + ray.y() * c[1] + ray.z() * c[2];
+    residual[0] = (ceres::atan2(sin_part, cos_part) - ceres::asin(T(a) / norm)) * px_per_rad - p[2];
+    return true;
+  }
+};
+
+struct BiasPrior {
+  template <typename T>
+  bool operator()(const T* p, T* residual) const {
+    residual[0] = p[2] / kBiasPriorPx;
+    return true;
+  }
+};
+
+double Bilinear(const cv::Mat& img, double x, double y) {
+  const int i = static_cast<int>(std::floor(x)), j = static_cast<int>(std::floor(y));
+  const double fx = x - i, fy = y - j;
+  const float* r0 = img.ptr<float>(j);
+  const float* r1 = img.ptr<float>(j + 1);
+  const double top = r0[i] + fx * (r0[i + 1] - r0[i]);
+  const double bottom = r1[i] + fx * (r1[i + 1] - r1[i]);
+  return top + fy * (bottom - top);
+}
+
+}  // namespace
+
+bool EdgeFit::InFront(double x, double z) const {
+  const OutlineGeometry& g = geometry_;
+  return (g.cal.pose.rotation * Vector3d(x, 0, z) + g.cal.pose.translation).z() > 2 * g.a &&
+         (Vector3d(x, 0, z) - g.eye).norm() > 2 * std::max(g.a, g.a / g.s);
+}
+
+EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double half_width) {
+  const OutlineGeometry& g = geometry_;
+  EdgeFitOutcome fit;
+  if (!InFront(x, z)) return fit;
+  const int n = points_;
+  std::vector<Vector3d> points = g.OutlinePoints(x, z, n);
+  points.emplace_back(x, 0, z);
+  const std::vector<Vector2d> image = ProjectApparatusPoints(g.cal.camera, g.cal.pose, points);
+  const Vector2d q = image.back();
+  // Region of interest: all search segments, plus the smoothing kernel's reach.
+  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+  for (int k = 0; k < n; ++k) {
+    u0 = std::min(u0, image[k].x()), u1 = std::max(u1, image[k].x());
+    v0 = std::min(v0, image[k].y()), v1 = std::max(v1, image[k].y());
+  }
+  const double pad = half_width + 6;
+  if (!(u1 - u0 < 4 * bgr.cols && v1 - v0 < 4 * bgr.rows)) return fit;
+  const cv::Rect full(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect roi = cv::Rect(cv::Point(static_cast<int>(std::floor(u0 - pad)), static_cast<int>(std::floor(v0 - pad))),
+                                cv::Point(static_cast<int>(std::ceil(u1 + pad)), static_cast<int>(std::ceil(v1 + pad)))) &
+                       full;
+  if (roi.width < 8 || roi.height < 8) return fit;
+  cv::Mat grey, smooth;
+  if (bgr.channels() == 3) cv::cvtColor(bgr(roi), grey, cv::COLOR_BGR2GRAY);
+  else grey = bgr(roi);
+  grey.convertTo(smooth, CV_32F);
+  cv::GaussianBlur(smooth, smooth, cv::Size(7, 7), 1.0);
+
+  const int samples = 2 * static_cast<int>(std::ceil(half_width / kStep)) + 1;
+  const double start = -(samples / 2) * kStep;
+  std::vector<double> profile(samples), gradient(samples);
+  std::vector<Vector2d> edges;
+  std::vector<double> contrasts;
+  std::vector<int> signs;
+  const cv::Mat& occluder = *g.occluder;
+  for (int k = 0; k < n; ++k) {
+    const Vector2d radial = image[k] - q;
+    if (radial.norm() < 1) continue;
+    const Vector2d dir = radial.normalized();
+    const Vector2d first = image[k] + start * dir, last = image[k] - start * dir;
+    // Inside the region (with one pixel for the interpolation) and the frame.
+    auto inside = [&](const Vector2d& p) {
+      return p.x() >= roi.x + 3 && p.y() >= roi.y + 3 && p.x() <= roi.x + roi.width - 4 && p.y() <= roi.y + roi.height - 4;
+    };
+    if (!inside(first) || !inside(last)) continue;
+    bool hidden = false;
+    for (int m = 0; m <= 4 && !hidden; ++m) {
+      const Vector2d p = first + (last - first) * (m / 4.0);
+      hidden = occluder.at<std::uint8_t>(static_cast<int>(std::lround(p.y())), static_cast<int>(std::lround(p.x()))) != 0;
+    }
+    if (hidden) continue;
+    ++fit.attempted;
+    for (int i = 0; i < samples; ++i) {
+      const Vector2d p = first + (i * kStep) * dir;
+      profile[i] = Bilinear(smooth, p.x() - roi.x, p.y() - roi.y);
+    }
+    // Gradient (outward) and its strongest peak of the expected polarity.
+    int best = -1;
+    double best_g = 0;
+    std::fill(gradient.begin(), gradient.end(), 0.0);
+    for (int i = 1; i + 1 < samples; ++i) {
+      gradient[i] = (profile[i + 1] - profile[i - 1]) / (2 * kStep);
+      const double signed_g = polarity_ == 0 ? std::abs(gradient[i]) : polarity_ * gradient[i];
+      if (i >= 2 && i + 2 < samples && signed_g > best_g) best_g = signed_g, best = i;
+    }
+    if (best < 0 || best_g < kMinGradient) continue;
+    // Centroid of the gradient above half its peak: the middle of the edge's ramp. For a sharp
+    // edge that is the peak; for a motion-blurred one (a ramp as long as the blur, with a flat
+    // gradient) it is the edge at mid-exposure, where a peak finder would wander.
+    const int sign = gradient[best] > 0 ? 1 : -1;
+    const double half = 0.5 * std::abs(gradient[best]);
+    int lo = best, hi = best;
+    while (lo > 1 && sign * gradient[lo - 1] > half) --lo;
+    while (hi + 2 < samples && sign * gradient[hi + 1] > half) ++hi;
+    double weight = 0, moment = 0;
+    for (int i = lo; i <= hi; ++i) {
+      const double w = sign * gradient[i] - half;
+      weight += w;
+      moment += w * i;
+    }
+    const double along = start + (moment / weight) * kStep;
+    edges.push_back(image[k] + along * dir);
+    contrasts.push_back(profile[std::min(samples - 1, hi + 3)] - profile[std::max(0, lo - 3)]);
+    signs.push_back(sign);
+  }
+  fit.edge_points = static_cast<int>(edges.size());
+  if (fit.edge_points < 8) return fit;
+  {
+    std::vector<double> c = contrasts;
+    for (double& v : c) v = std::abs(v);
+    std::nth_element(c.begin(), c.begin() + c.size() / 2, c.end());
+    fit.contrast = c[c.size() / 2];
+  }
+
+  // Viewing rays of the edge points, in the scaled space.
+  const std::vector<Vector2d> normalised = UndistortPixels(g.cal.camera, edges);
+  std::vector<Vector3d> rays;
+  rays.reserve(normalised.size());
+  for (const Vector2d& m : normalised) {
+    Vector3d r = g.to_apparatus * Vector3d(m.x(), m.y(), 1.0);
+    r.y() *= g.s;
+    rays.push_back(r.normalized());
+  }
+  const double px_per_rad = g.PxPerRad(x, z);
+  double p[3] = {x, z, 0.0};
+  ceres::CauchyLoss loss(kLossScalePx);  // one loss for all residuals, owned here
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  for (const Vector3d& r : rays)
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<EdgeResidual, 1, 3>(new EdgeResidual{r, g.eye_s, g.a, px_per_rad}), &loss, p);
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BiasPrior, 1, 3>(new BiasPrior), nullptr, p);
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  solver.max_num_iterations = 30;
+  solver.num_threads = 1;
+  solver.logging_type = ceres::SILENT;
+  solver.function_tolerance = 1e-12;
+  solver.parameter_tolerance = 1e-12;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !InFront(p[0], p[1])) return fit;
+
+  double sum2 = 0;
+  int votes = 0;
+  for (size_t k = 0; k < rays.size(); ++k) {
+    double res = 0;
+    EdgeResidual{rays[k], g.eye_s, g.a, px_per_rad}(p, &res);
+    if (std::abs(res) < kInlierPx) {
+      ++fit.inliers;
+      sum2 += res * res;
+      votes += signs[k];
+    }
+  }
+  fit.ok = fit.inliers >= 3;
+  fit.x = p[0];
+  fit.z = p[1];
+  fit.rms_px = fit.inliers ? std::sqrt(sum2 / fit.inliers) : 0;
+  if (polarity_ == 0 && fit.inliers > 0) polarity_ = votes >= 0 ? 1 : -1;
+  return fit;
+}
+
+EdgeFitOutcome EdgeFit::Measure(const cv::Mat& bgr, double x, double z, double half_width) {
+  EdgeFitOutcome first = FitOnce(bgr, x, z, half_width);
+  if (!first.ok) return first;
+  const Vector2d moved = geometry_.Project(first.x, first.z) - geometry_.Project(x, z);
+  if (moved.norm() < 1.0 && first.inliers >= 0.9 * first.edge_points) return first;
+  EdgeFitOutcome second = FitOnce(bgr, first.x, first.z, kNarrowHalfWidth);
+  return second.ok ? second : first;
+}
+
+}  // namespace uphill::internal
