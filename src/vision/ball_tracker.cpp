@@ -82,6 +82,7 @@ struct BallTracker::Impl {
   std::unique_ptr<internal::EdgeFit> edges;
   bool needs_model = false;
   int distrusted = 0;
+  long confident_model_frame = -1;  // the last frame the model measured, its background known
 
   Impl(const Scene& sc, const TrackerOptions& o) : scene(sc), options(o) {}
 
@@ -204,6 +205,20 @@ struct BallTracker::Impl {
     return second.ok ? second : first;
   }
 
+  // One narrow pass with every parameter free, where the prediction is good (the model measured
+  // the previous frame, its background known): one Ceres solve instead of two or more. Measure() when
+  // the fit moves more than half a pixel from the prediction or fails.
+  FitOutcome MeasureNear(const internal::FrameView& view, FitRequest q) {
+    const FitRequest wide = q;
+    q.half_width_px = kNarrowHalfWidthPx + 1;
+    q.fit_edge_shift = true;
+    const FitOutcome one = internal::FitOutline(geometry, view, *background, q);
+    if (one.ok && (geometry.Project(one.p[internal::kCentreX], one.p[internal::kCentreZ]) -
+                   geometry.Project(q.centre.x(), q.centre.y())).norm() < 0.5)
+      return one;
+    return Measure(view, wide);
+  }
+
   // Candidates along the path between x0 and x1, best first: the predicted outline's inside
   // against its outside (against the background where it is known).
   std::vector<Vector2d> Candidates(const cv::Mat& frame, double gain, double x0, double x1) const {
@@ -289,6 +304,19 @@ struct BallTracker::Impl {
     return fraction * std::exp(-0.5 * excess * excess) * std::min(1.0, snr / 20);
   }
 
+  // The centre (x, z), its pixel and the outline's mean radius about it.
+  void Place(const Vector2d& centre, BallObservation* o) const {
+    o->x = centre.x();
+    o->z = centre.y();
+    const Vector2d uv = geometry.Project(o->x, o->z);
+    o->u = uv.x();
+    o->v = uv.y();
+    double sum = 0;
+    for (const Vector2d& p : ProjectApparatusPoints(geometry.cal.camera, geometry.cal.pose, geometry.OutlinePoints(o->x, o->z, 32)))
+      sum += (p - uv).norm();
+    o->radius_px = sum / 32;
+  }
+
   BallObservation Observe(const FitOutcome& f, const FitRequest& q) {
     BallObservation o;
     o.found = true;
@@ -304,16 +332,8 @@ struct BallTracker::Impl {
         c = c_ref + q.velocity * ((row - q.reference_row) * row_delay);
       }
     }
-    o.x = c.x();
-    o.z = c.y();
+    Place(c, &o);
     o.time_offset = offset;
-    const Vector2d uv = geometry.Project(o.x, o.z);
-    o.u = uv.x();
-    o.v = uv.y();
-    double sum = 0;
-    for (const Vector2d& p : ProjectApparatusPoints(geometry.cal.camera, geometry.cal.pose, geometry.OutlinePoints(o.x, o.z, 32)))
-      sum += (p - uv).norm();
-    o.radius_px = sum / 32;
     const Vector2d smear(f.p[internal::kSmearX], f.p[internal::kSmearZ]);
     o.smear_px = (geometry.Project(c_ref.x() + 0.5 * smear.x(), c_ref.y() + 0.5 * smear.y()) -
                   geometry.Project(c_ref.x() - 0.5 * smear.x(), c_ref.y() - 0.5 * smear.y()))
@@ -336,15 +356,7 @@ struct BallTracker::Impl {
   BallObservation ObserveEdges(const internal::EdgeFitOutcome& e) const {
     BallObservation o;
     o.found = true;
-    o.x = e.x;
-    o.z = e.z;
-    const Vector2d uv = geometry.Project(o.x, o.z);
-    o.u = uv.x();
-    o.v = uv.y();
-    double sum = 0;
-    for (const Vector2d& p : ProjectApparatusPoints(geometry.cal.camera, geometry.cal.pose, geometry.OutlinePoints(o.x, o.z, 32)))
-      sum += (p - uv).norm();
-    o.radius_px = sum / 32;
+    Place(Vector2d(e.x, e.z), &o);
     o.rays = e.edge_points;
     o.inliers = e.inliers;
     o.misfit = e.rms_px / 0.1;  // in units of a good edge fit's scatter
@@ -617,6 +629,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
     std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
     m.noise = sorted[sorted.size() / 2];
     const bool confident = fit.misfit < 1.5 && fit.inliers >= 0.75 * fit.rays_fitted;
+    if (fit.rays_without_background == 0) m.confident_model_frame = f;
     const Vector2d fitted_velocity = q.velocity;
     const Vector2d smear(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]);
     // The exposure, from the smear against the track's speed (where the body moved > 3 px).
@@ -677,7 +690,9 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
     const double step_px = velocity.norm() / m.options.fps / m.MetresPerPx(centre.x(), centre.y());
     const FitRequest q = m.Request(centre, velocity, m.history.size() >= 2,
                                    m.options.search_half_width_px + 0.3 * step_px);
-    const FitOutcome fit = m.Measure({frame, {0, 0}, gain}, q);
+    const FitOutcome fit = m.confident_model_frame == f - 1 && m.history.size() >= 3
+                               ? m.MeasureNear({frame, {0, 0}, gain}, q)
+                               : m.Measure({frame, {0, 0}, gain}, q);
     // Far from the prediction is a jump to something else unless the search confirms it.
     const double off = (m.geometry.Project(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]) -
                         m.geometry.Project(centre.x(), centre.y())).norm();
