@@ -23,7 +23,10 @@ using internal::FitRequest;
 constexpr double kNarrowHalfWidthPx = 1.5;  // second pass, around the first fit
 constexpr int kHistoryGap = 5;              // frames without the body after which we predict no more
 constexpr size_t kHistory = 6;              // samples the prediction is fitted to
-constexpr double kSceneChangeFactor = 3;    // scene residual jump (times its usual level, plus 0.01)
+constexpr double kSceneChangeFactor = 4;    // scene residual jump (times its usual level, plus 0.01)
+// The usual level is never taken below this: H.264 copies static blocks exactly, so the first
+// frames of a clip can show no residual at all, and the first key frame would look like a change.
+constexpr double kUsualResidualFloor = 0.005;
 constexpr int kConfirmFrames = 3;           // frames that confirm a scene or exposure change
 // The fast path (internal/edge_fit.hpp) and when it is trusted.
 constexpr int kEdgePoints = 96;             // edge searches per frame
@@ -467,7 +470,7 @@ struct BallTracker::Impl {
       if (scene_residuals.size() >= 5) {
         std::vector<double> r = scene_residuals;
         std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
-        usual = r[r.size() / 2];
+        usual = std::max(r[r.size() / 2], kUsualResidualFloor);
       }
       if (usual > 0 && residual > kSceneChangeFactor * usual + 0.01) {
         if (scene_suspect++ == 0) scene_suspect_from = f;

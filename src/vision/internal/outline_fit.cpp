@@ -342,11 +342,16 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   if (!q.fit_edge_shift) problem.SetManifold(params, new ceres::SubsetManifold(kSmearParameters, {kEdgeShift}));
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;
-  solver.max_num_iterations = 25;
+  // Capped at 6 from a prediction inside the windows: on the painted spheroid's POV-Ray clip the
+  // centre is no better after more (RMS 0.30 px with 6, 0.33 px with 25), and each costs a
+  // Jacobian of every sample.
+  solver.max_num_iterations = 6;
   solver.num_threads = 1;
   solver.logging_type = ceres::SILENT;
-  solver.function_tolerance = 1e-9;
-  solver.parameter_tolerance = 1e-9;
+  // Parameters are metres near 0.5 and pixels: 1e-7 of the centre is below 1e-4 px; the cost's
+  // relative change 1e-7 is far below what the noise moves it.
+  solver.function_tolerance = 1e-7;
+  solver.parameter_tolerance = 1e-7;
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
   for (double v : params)

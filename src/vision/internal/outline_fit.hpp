@@ -24,7 +24,8 @@
 // over the exposure, a uniform edge shift b. Priors: b ~ N(0, 0.3 px), D ~ N(D_pred, σ_D).
 //
 // Accuracy: see ball_tracker.hpp. Cost: rays × samples × (pieces + 1) outline evaluations per
-// Jacobian; about 1–4 Ceres iterations per pass, two passes.
+// Jacobian; at most 6 Ceres iterations per pass; one pass where the model measured the previous
+// frame (ball_tracker.cpp, MeasureNear), else two or more.
 #pragma once
 
 #include <Eigen/Core>

@@ -14,28 +14,36 @@ constexpr double kInvSqrt2Pi = 0.39894228040143267794;
 
 double NormalCdf(double u) { return 0.5 * std::erfc(-u * kInvSqrt2); }
 double NormalPdf(double u) { return kInvSqrt2Pi * std::exp(-0.5 * u * u); }
-// Ψ(u) = ∫_{−∞}^{u} Φ = u·Φ(u) + φ(u).
-double IntegratedCdf(double u) { return u * NormalCdf(u) + NormalPdf(u); }
 
-// Mean of Φ over u linear from u0 to u1, and its derivatives with respect to u0 and u1.
-double MeanCdf(double u0, double u1, double* d0, double* d1) {
-  // Beyond 8.3 standard deviations Φ is 0 or 1 and φ is below 1e-15 in binary64: no erfc, no exp
-  // (most samples of a ray lie there, away from the edge).
-  constexpr double kSaturated = 8.3;
-  if ((u0 > kSaturated && u1 > kSaturated) || (u0 < -kSaturated && u1 < -kSaturated)) {
+// Φ, φ and Ψ at one node. Beyond 8.3 standard deviations Φ is 0 or 1 and φ is below 1e-15 in
+// binary64: no erfc, no exp there (most samples of a ray lie there, away from the edge).
+struct NodeCdf {
+  double u, cdf, pdf, integrated;
+  explicit NodeCdf(double x) : u(x) {
+    constexpr double kSaturated = 8.3;
+    if (x > kSaturated) cdf = 1, pdf = 0;
+    else if (x < -kSaturated) cdf = 0, pdf = 0;
+    else cdf = NormalCdf(x), pdf = NormalPdf(x);
+    integrated = x * cdf + pdf;  // Ψ(u) = ∫_{−∞}^{u} Φ = u·Φ(u) + φ(u)
+  }
+};
+
+// Mean of Φ over u linear from a.u to b.u, and its derivatives with respect to a.u and b.u (each
+// node's Φ and Ψ computed once, shared by the pieces either side of it).
+double MeanCdf(const NodeCdf& a, const NodeCdf& b, double* d0, double* d1) {
+  if (a.pdf == 0 && b.pdf == 0 && a.cdf == b.cdf) {
     *d0 = *d1 = 0;
-    return u0 > 0 ? 1.0 : 0.0;
+    return a.cdf;
   }
-  const double h = u1 - u0;
+  const double h = b.u - a.u;
   if (std::abs(h) < 1e-4) {
-    const double m = 0.5 * (u0 + u1), pdf = NormalPdf(m);
-    // Ψ' = Φ, Ψ''' = −u·φ: the mean is Φ(m) − m·φ(m)·h²/24 to O(h⁴).
-    *d0 = *d1 = 0.5 * pdf;
-    return NormalCdf(m) - m * pdf * h * h / 24;
+    // The mean is Φ(a) + φ(a)·h/2 to O(h²·|u|·φ) < 1e-8 (a body at rest: h = 0, exact).
+    *d0 = *d1 = 0.5 * a.pdf;
+    return a.cdf + 0.5 * a.pdf * h;
   }
-  const double mean = (IntegratedCdf(u1) - IntegratedCdf(u0)) / h;
-  *d1 = (NormalCdf(u1) - mean) / h;
-  *d0 = (mean - NormalCdf(u0)) / h;
+  const double mean = (b.integrated - a.integrated) / h;
+  *d1 = (b.cdf - mean) / h;
+  *d0 = (mean - a.cdf) / h;
   return mean;
 }
 
@@ -97,11 +105,14 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad) const {
   const size_t pieces = count - 1;
   double coverage = 0;
   double du[33] = {0};
+  NodeCdf left(u[0]);
   for (size_t j = 0; j < pieces; ++j) {
+    const NodeCdf right(u[j + 1]);
     double d0, d1;
-    coverage += MeanCdf(u[j], u[j + 1], &d0, &d1);
+    coverage += MeanCdf(left, right, &d0, &d1);
     du[j] += d0;
     du[j + 1] += d1;
+    left = right;
   }
   coverage /= static_cast<double>(pieces);
   if (grad) {
