@@ -12,6 +12,7 @@
 #include "report/analysis_figures.hpp"
 #include "report/fit_json.hpp"
 #include "report/gnuplot_figure.hpp"
+#include "report/video_report.hpp"
 #include "model/number_text.hpp"
 
 namespace uphill {
@@ -167,6 +168,7 @@ Document FitDocument(const ExperimentAnalysis& a, bool with_figures) {
       for (const auto& note : f.report->notes) d.List({f.method + ": " + note});
   d.Heading("Trials");
   d.AddTable(RowTable(a));
+  AddVideoSections(a, with_figures, &d);
   if (!a.row_errors.empty()) {
     d.Heading("Rows left out");
     d.List(a.row_errors);
@@ -219,6 +221,7 @@ void WriteFitReport(const ExperimentAnalysis& a, const std::string& directory) {
   fs::create_directories(directory, ec);
   if (ec) throw EnvironmentError(directory + ": cannot create the folder: " + ec.message());
   for (const GnuplotFigure& f : AnalysisFigures(a)) RenderFigure(f, directory);
+  for (const GnuplotFigure& f : VideoTrialFigures(a)) RenderFigure(f, directory);
   const Document d = FitDocument(a, true);
   WriteFileAtomically((fs::path(directory) / "fit.json").string(), AnalysisToJson(a).dump(2) + "\n");
   WriteFileAtomically((fs::path(directory) / "report.md").string(), RenderMarkdown(d));

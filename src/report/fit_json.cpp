@@ -1,4 +1,5 @@
 #include "report/fit_json.hpp"
+#include "report/video_report.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -195,6 +196,7 @@ ordered_json AnalysisToJson(const ExperimentAnalysis& a) {
                              {"delta_aic", c.delta_aic}, {"delta_bic", c.delta_bic},
                              {"akaike_weight_second", c.akaike_weight_second}, {"verdict", c.verdict}};
   }
+  AddVideoJson(a, &j);
   j["notes"] = a.notes;
   return j;
 }

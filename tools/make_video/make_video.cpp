@@ -5,13 +5,22 @@
 //
 // Usage: make_video OUT_DIR [--width 1280 --height 720] [--frames 60] [--fps 30] [--blur 8]
 //        [--noise 2] [--flicker 0.01] [--lossless] [--spheroid] [--boards 12] [--seed 1]
-// Writes OUT_DIR/clip.mp4 (H.264; clip.avi, FFV1, with --lossless), truth.csv, cam.json,
-// scene.json, points.csv (the apparatus points of calibration/README.md in view, O, the rails at
-// the crossbar, the feet on the table, marks at 300/600/900 mm, with their exact pixels: the
-// POINTS.csv of `uphill calibrate scene`, and the clicks of the page's end-to-end test),
-// boards/board_NN.png, and prints the `uphill track` command for the clip.
+//        [--D 150] [--x0 MM | --x0-band F] [--mu 0] [--release-time 0] [--seconds S | --until-end]
+//        [--name clip]
+// Writes OUT_DIR/NAME.mp4 (H.264; NAME.avi, FFV1, with --lossless), NAME.truth.csv (truth.csv
+// for the default name), cam.json, scene.json, points.csv (the apparatus points of
+// calibration/README.md in view, O, the rails at the crossbar, the feet on the table, marks at
+// 300/600/900 mm, with their exact pixels: the POINTS.csv of `uphill calibrate scene`, and the
+// clicks of the page's end-to-end test), boards/board_NN.png, and prints the `uphill track`
+// command for the clip. A trial of an experiment (data/series3-video): the rail separation D, the
+// release position and the rolling resistance μ of the motion (the ODE method when μ > 0), held
+// at rest until --release-time; --x0-band F releases at band.high + F·(band.high − X) of the rest
+// band of μ (F < 0: inside the band, the body stays; F > 0: beyond it, it rolls up and falls off);
+// --until-end makes the clip last until the motion has ended (+0.3 s), or 1 s at rest.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
+#include <optional>
 #include <filesystem>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
@@ -31,8 +40,11 @@ struct Flags {
   std::string out;
   int width = 1280, height = 720, frames = 60, blur = 1, boards = 12;
   double fps = 30, noise = 0, flicker = 0;
-  bool lossless = false, spheroid = false;
+  bool lossless = false, spheroid = false, until_end = false;
   unsigned seed = 1;
+  double D_mm = 150, mu = 0, release_time = 0, seconds = 0;
+  std::optional<double> x0_mm, x0_band;
+  std::string name = "clip";
 };
 
 void Run(const Flags& f) {
@@ -44,19 +56,43 @@ void Run(const Flags& f) {
     setup.x0 = 0.97 * *setup.scene.x_eq();
     body_flags = "--body spheroid --a 15.875mm --b 25.4mm";
   }
+  if (f.D_mm != 150) {
+    setup.scene = Scene(setup.scene.body(),
+                        Rails::FromApparatus(1.0, 0.1, f.D_mm * 1e-3, LConvention::kHorizontal), setup.scene.rod_radius());
+    setup.x0 = 0.97 * *setup.scene.x_eq();
+  }
+  if (f.x0_mm) setup.x0 = *f.x0_mm * 1e-3;
+  if (f.x0_band) {
+    const std::optional<RestBand> band = setup.scene.Rest(f.mu);
+    if (!band || !setup.scene.x_eq()) throw InputError("--x0-band", "the scene has no rest band for this mu");
+    setup.x0 = band->high + *f.x0_band * (band->high - *setup.scene.x_eq());
+  }
+  MotionOptions motion_options;
+  motion_options.mu = f.mu;
+  if (f.mu > 0) motion_options.method = MotionMethod::kOde;
+  const Motion motion(setup.scene, setup.x0, motion_options);
   fs::create_directories(f.out);
   ClipSettings settings;
   settings.frames = f.frames;
   settings.fps = f.fps;
+  settings.release_time = f.release_time;
+  if (f.seconds > 0) settings.frames = static_cast<int>(std::ceil(f.seconds * f.fps));
+  if (f.until_end) {
+    const double end = std::isfinite(motion.end_time()) ? motion.end_time() + 0.3 : 1.0;
+    settings.frames = static_cast<int>(std::ceil((f.release_time + end) * f.fps));
+  }
   settings.blur_samples = f.blur;
   settings.noise_sigma = f.noise;
   settings.flicker = f.flicker;
   settings.seed = f.seed;
   const ClipRenderer renderer(setup.scene, setup.calibration, setup.apparatus);
-  const Motion motion(setup.scene, setup.x0);
-  const std::string video = (fs::path(f.out) / (f.lossless ? "clip.avi" : "clip.mp4")).string();
+  std::cout << "x0 = " << setup.x0 * 1e3 << " mm";
+  if (const auto band = setup.scene.Rest(f.mu)) std::cout << ", rest band of mu = " << f.mu << ": [" << band->low * 1e3 << ", " << band->high * 1e3 << "] mm";
+  std::cout << ", X = " << setup.scene.x_eq().value_or(0) * 1e3 << " mm\n";
+  const std::string video = (fs::path(f.out) / (f.name + (f.lossless ? ".avi" : ".mp4"))).string();
   const std::vector<ClipTruth> truth = RenderClip(renderer, motion, settings, video);
-  WriteClipTruthCsv((fs::path(f.out) / "truth.csv").string(), truth);
+  const std::string truth_name = f.name == "clip" ? "truth.csv" : f.name + ".truth.csv";
+  WriteClipTruthCsv((fs::path(f.out) / truth_name).string(), truth);
   CalibrationSummary summary;
   summary.method = "synthetic camera of tools/make_video (exact)";
   summary.verdict = "exact";
@@ -88,10 +124,10 @@ void Run(const Flags& f) {
       cv::imwrite((fs::path(f.out) / "boards" / name).string(), boards.Render(pose, options).image);
     }
   }
-  std::cout << "wrote " << video << " (" << truth.size() << " frames), truth.csv, cam.json, scene.json, points.csv";
+  std::cout << "wrote " << video << " (" << truth.size() << " frames), " << truth_name << ", cam.json, scene.json, points.csv";
   if (f.boards > 0) std::cout << ", boards/ (" << f.boards << " chessboard views, 9x6 inner corners, 20 mm)";
   std::cout << "\ntrack it with:\n  uphill track " << video << " --camera " << f.out << "/cam.json --scene " << f.out
-            << "/scene.json " << body_flags << " --L 1000mm --H 100mm --D 150mm --rod-diameter 8mm -o " << f.out
+            << "/scene.json " << body_flags << " --L 1000mm --H 100mm --D " << f.D_mm << "mm --rod-diameter 8mm -o " << f.out
             << "/track.csv\n";
 }
 
@@ -112,6 +148,14 @@ int main(int argc, char** argv) {
   app.add_flag("--spheroid", f.spheroid, "the lab's 2 x 1.25 x 1.25 in spheroid instead of the 2 in ball");
   app.add_option("--boards", f.boards, "chessboard calibration images")->capture_default_str();
   app.add_option("--seed", f.seed)->capture_default_str();
+  app.add_option("--D", f.D_mm, "rail separation at the crossbar, mm (L = 1000 mm, H = 100 mm)")->capture_default_str();
+  app.add_option("--x0", f.x0_mm, "release position, mm (default 0.97 X)");
+  app.add_option("--x0-band", f.x0_band, "release at band.high + F (band.high - X) of mu's rest band");
+  app.add_option("--mu", f.mu, "rolling resistance of the motion")->capture_default_str();
+  app.add_option("--release-time", f.release_time, "s at rest before the release")->capture_default_str();
+  app.add_option("--seconds", f.seconds, "clip length, s (instead of --frames)");
+  app.add_flag("--until-end", f.until_end, "clip lasts until the motion ends (+0.3 s; 1 s when at rest)");
+  app.add_option("--name", f.name, "file stem of the clip")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
     Run(f);

@@ -2,7 +2,13 @@
 //   uphill fit EXP [--json]                       an experiment folder (data/README.md)
 //   uphill fit --xy FILE.csv [--method M] [--json]  arbitrary X-Y data, header X,Y[,uX,uY]
 // `uphill report EXP -o DIR`: the full report (HTML, Markdown, fit.json, figures).
+// An experiment with recordings (format uphill-experiment/2) has its videos tracked and analysed
+// first (app/video_trials.hpp, OpenCV): `uphill` then hands the command to `uphill-vision`
+// (vision_program.hpp), whose build of this file does that work.
+#include <unistd.h>
+
 #include <filesystem>
+#include <optional>
 #include <iostream>
 
 #include "commands.hpp"
@@ -15,6 +21,11 @@
 #include "model/input_error.hpp"
 #include "report/fit_document.hpp"
 #include "report/fit_json.hpp"
+#include "vision_program.hpp"
+#if UPHILL_VISION_PROGRAM
+#include "app/video_trials.hpp"
+#include "video_progress.hpp"
+#endif
 
 namespace uphill::cli {
 namespace {
@@ -28,6 +39,8 @@ struct FitFlags {
   std::int64_t mc_trials = 100000;  // signed: "-1" is refused as -1, not wrapped
   const CLI::App* command = nullptr;  // to ask which flags were given
   std::string output;
+  unsigned jobs = 0;  // videos tracked at once; 0: one per core
+  bool quiet = false;
 };
 
 
@@ -99,7 +112,31 @@ ExperimentAnalysis Analyse(const FitFlags& f, Experiment* keep) {
     throw InputError("--mc-trials", "must be between 100 and 10000000 trials per row (got " +
                                         std::to_string(f.mc_trials) + ")");
   options.mc_trials = static_cast<std::uint64_t>(f.mc_trials);
+#if UPHILL_VISION_PROGRAM
+  ExperimentAnalysis a;
+  if (keep->HasVideos()) {
+    const std::vector<const ExperimentRow*> rows = VideoRows(*keep);
+    std::vector<std::string> labels;
+    for (const ExperimentRow* r : rows) labels.push_back(r->trial + "  " + r->video);
+    OneDecodeThreadPerVideo();
+    std::optional<VideoProgressDisplay> display;
+    if (!f.quiet && isatty(STDERR_FILENO) && !rows.empty()) display.emplace(labels);
+    const std::vector<VideoTrial> trials = TrackExperimentVideos(
+        *keep, f.jobs, [&](const VideoProgress& p) { if (display) display->Update(p); });
+    if (display) display->Finish();
+    for (const VideoTrial& t : trials)
+      if (!t.error.empty()) {
+        std::cerr << "uphill: " << t.error << " (video left out)\n";
+        ExitStatus() = 2;
+      }
+    a = AnalyseExperimentWithVideos(keep, trials, options);
+  } else {
+    a = AnalyseExperiment(*keep, options);
+  }
+#else
+  if (keep->HasVideos()) RunInVisionProgram();  // the videos are tracked with OpenCV
   ExperimentAnalysis a = AnalyseExperiment(*keep, options);
+#endif
   for (const auto& e : a.row_errors) {
     std::cerr << "uphill: " << e << " (row left out)\n";
     ExitStatus() = 2;
@@ -117,6 +154,12 @@ void RunExperiment(const FitFlags& f) {
   }
 }
 
+void AddVideoFlags(CLI::App* command, FitFlags* flags) {
+  command->add_option("--jobs", flags->jobs, "videos tracked at once (experiment with recordings; 0: one per core)")
+      ->capture_default_str();
+  command->add_flag("--quiet", flags->quiet, "no progress bars while the videos are tracked");
+}
+
 }  // namespace
 
 void AddFitCommand(CLI::App& app) {
@@ -128,6 +171,7 @@ void AddFitCommand(CLI::App& app) {
   fit->add_flag("--json", flags->json, "JSON output (stable keys: docs/fit.md)");
   fit->add_flag("--no-rows", flags->no_rows, "with --xy --json: leave the per-row entries out (\"rows\": [])");
   fit->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials per row for u(X)")->capture_default_str();
+  AddVideoFlags(fit, flags.get());
   fit->callback([flags, fit] {
     flags->command = fit;
     RefuseEmpty(fit, "--xy", flags->xy, "a CSV file, or - for stdin");
@@ -144,6 +188,7 @@ void AddFitCommand(CLI::App& app) {
   report->add_option("experiment", flags->experiment, "experiment folder")->required();
   report->add_option("-o,--output", flags->output, "output folder (created if needed)")->required();
   report->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials per row for u(X)")->capture_default_str();
+  AddVideoFlags(report, flags.get());
   report->callback([flags] {
     OutputPaths outputs;  // checked before any work: never over the experiment's own files
     outputs.AddInput((std::filesystem::path(flags->experiment) / "experiment.json").string(), "the experiment's");
@@ -153,7 +198,9 @@ void AddFitCommand(CLI::App& app) {
     const ExperimentAnalysis a = Analyse(*flags, &experiment);
     WriteFitReport(a, flags->output);
     std::cout << "wrote " << flags->output << "/report.html, report.md, fit.json, and the figures "
-              << "fit_y_vs_x, fit_offset, fit_residuals (.svg, .png, .gp script, .dat data)\n";
+              << "fit_y_vs_x, fit_offset, fit_residuals";
+    if (!a.video_trials.empty()) std::cout << ", and each video's video_<n>_x_vs_t, video_<n>_residuals";
+    std::cout << " (.svg, .png, .gp script, .dat data)\n";
   });
 }
 

@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "app/tracking_inputs.hpp"
+#include "progress_bars.hpp"
 #include "io/configuration.hpp"
 #include "io/output_paths.hpp"
 #include "io/units.hpp"
@@ -95,13 +96,7 @@ void Run(const TrackFlags& f) {
     options.progress = [start](int done, long total) {
       if (done % 5 != 0 && done != total) return;
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (total > 0) {
-        const int width = 40, filled = static_cast<int>(width * std::min(1.0, static_cast<double>(done) / total));
-        std::fprintf(stderr, "\r[%s%s] %d/%ld frames, %.0f frames/s ", std::string(filled, '#').c_str(),
-                     std::string(width - filled, '.').c_str(), done, total, done / std::max(elapsed, 1e-9));
-      } else {
-        std::fprintf(stderr, "\r%d frames, %.0f frames/s ", done, done / std::max(elapsed, 1e-9));
-      }
+      std::fprintf(stderr, "\r%s ", FrameProgressText(done, total, elapsed).c_str());
       std::fflush(stderr);
     };
   const TrackResult result = TrackVideo(f.video, scene, calibration, options);

@@ -1,0 +1,373 @@
+#include "app/video_trials.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+#include <xxhash.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <mutex>
+#include <opencv2/core.hpp>
+#include <thread>
+
+#include "app/tracking_inputs.hpp"
+#include "io/atomic_file.hpp"
+#include "io/contained_directory.hpp"
+#include "model/environment_error.hpp"
+#include "model/input_error.hpp"
+#include "model/number_text.hpp"
+#include "vision/track_analysis.hpp"
+#include "vision/track_analysis_output.hpp"
+#include "vision/track_table.hpp"
+#include "vision/video_tracking.hpp"
+
+namespace uphill {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr const char* kCacheFolder = ".uphill-cache/video";
+constexpr const char* kTrialFile = "trial.json";
+constexpr std::size_t kMaxCalibrationBytes = 16u << 20;
+
+std::string Hex16(std::uint64_t h) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+  return text;
+}
+
+// The second half of the cache key: everything besides the video that decides the results.
+std::string CalibrationKey(const std::string& camera_bytes, const std::string& scene_bytes,
+                           const Configuration& c, const VideoAnalysisSettings& v) {
+  std::string text = "uphill-video-trial/" + std::to_string(kVideoTrackerVersion) + "\n";
+  text += std::to_string(camera_bytes.size()) + "\n" + camera_bytes + "\n";
+  text += std::to_string(scene_bytes.size()) + "\n" + scene_bytes + "\n";
+  const auto value = [&](const char* name, const Uncertain& u) { text += std::string(name) + " " + Printf("%.17g", u.value) + "\n"; };
+  text += "body " + std::to_string(static_cast<int>(c.body_kind)) + "\n";
+  value("across", c.across);
+  value("along", c.along);
+  text += c.from_apparatus ? "apparatus\n" : "angles\n";
+  value("L", c.L);
+  value("H", c.H);
+  value("D", c.D);
+  text += "convention " + std::to_string(static_cast<int>(c.convention)) + "\n";
+  value("theta", c.theta);
+  value("alpha", c.alpha);
+  value("rod_radius", c.rod_radius);
+  text += "fit " + v.fit + "\nu_x " + Printf("%.17g", v.u_x) + "\ng " + Printf("%.17g", v.g) + "\n";
+  return Hex16(XXH3_64bits(text.data(), text.size()));
+}
+
+TrackAnalysisOptions AnalysisOptionsOf(const VideoAnalysisSettings& v) {
+  TrackAnalysisOptions o;
+  o.g = v.g;
+  o.u_x = v.u_x;
+  o.fit = v.fit == "mu" ? TrackFitParameter::kMu : TrackFitParameter::kEffectiveG;
+  return o;
+}
+
+MeasuredValue Measured(const Estimate& e) { return {e.value, e.u}; }
+
+VideoTrialEvent EventOf(const TrackEvent& e) { return {e.kind, Measured(e.t), Measured(e.x)}; }
+
+// The report's plain numbers of an analysis.
+void FillFromAnalysis(const TrackAnalysis& a, VideoTrial* t) {
+  t->frames = a.frames;
+  t->found = a.found;
+  if (a.release) {
+    t->release_x = Measured(a.release->x);
+    t->release_t = Measured(a.release->t);
+    t->events.push_back(EventOf(*a.release));
+  }
+  for (const TrackEvent& e : a.turning_points) t->events.push_back(EventOf(e));
+  if (a.rest) {
+    // u(Y) = sqrt(se² + u_x²): the rest's standard error from the frames' scatter, and the stated
+    // uncertainty of a tracked position, which averaging over frames does not reduce (they share
+    // the calibration's and the tracker's systematic error).
+    t->rest = Measured(a.rest->x);
+    t->rest->u = std::hypot(a.rest->x.u.value_or(0.0), a.options.u_x);
+    t->events.push_back(EventOf(*a.rest));
+  } else {
+    t->no_rest = a.fall_off    ? "never at rest: falls off the rails"
+                 : a.reaches_o ? "never at rest: rolls back to O"
+                               : "never at rest in the recording";
+  }
+  if (a.fall_off) t->events.push_back(EventOf(*a.fall_off));
+  if (a.reaches_o) t->events.push_back(EventOf(*a.reaches_o));
+  t->fit_available = a.fit.available;
+  t->fit_unavailable = a.fit.unavailable;
+  t->fitted = a.fit.fitted;
+  if (a.fit.available) {
+    if (const FittedParameter* p = a.fit.Parameter(a.fit.fitted)) {
+      t->fit_value = MeasuredValue{p->value, p->se_scaled ? p->se_scaled : p->se};
+    }
+    // The fit's own x0 and t0 are better than the band's (track_analysis.hpp: release).
+    if (const FittedParameter* x0 = a.fit.Parameter("x0")) t->release_x = MeasuredValue{x0->value, x0->se_scaled ? x0->se_scaled : x0->se};
+    if (const FittedParameter* t0 = a.fit.Parameter("t0")) t->release_t = MeasuredValue{t0->value, t0->se_scaled ? t0->se_scaled : t0->se};
+  }
+  t->reduced_chi2 = a.fit.reduced_chi2;
+  t->dof = a.fit.dof;
+  t->notes = a.notes;
+  for (const std::string& n : a.fit.notes) t->notes.push_back(n);
+  t->figure = TrackFigureDataOf(a);
+}
+
+// Reads the cached trial, or nullopt when it is absent or damaged (then tracked again).
+std::optional<VideoTrial> ReadCached(const ContainedDirectory& root, const std::string& key) {
+  try {
+    const auto text = root.ReadFile(std::string(kCacheFolder) + "/" + key + "/" + kTrialFile, 64u << 20);
+    if (!text) return std::nullopt;
+    VideoTrial t = VideoTrialFromJson(json::parse(*text));
+    t.from_cache = true;
+    return t;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+// Writes the entry into a staging folder and renames it into place whole.
+void WriteCache(const ContainedDirectory& root, const std::string& key, const TrackResult& track,
+                const TrackSources& sources, const TrackAnalysis& analysis, const VideoTrial& trial) {
+  const ContainedDirectory cache = root.Subdirectory(kCacheFolder, true);
+  ContainedDirectory staging = cache.MakeStagingDirectory(".staging-");
+  const std::string staging_name = fs::path(staging.path()).filename().string();
+  try {
+    WriteTrack((fs::path(staging.path()) / "track.csv").string(), track, sources);
+    staging.WriteFileAtomically("track_analysis.json", TrackAnalysisJson(analysis).dump(2) + "\n");
+    staging.WriteFileAtomically(kTrialFile, VideoTrialToJson(trial).dump() + "\n");
+    staging.Sync();
+    if (cache.KindOf(key) != ContainedDirectory::Kind::kAbsent)  // a damaged entry: replaced
+      ContainedDirectory::RemoveStaging(cache, cache.Subdirectory(key, false));
+    cache.RenameNoReplace(staging_name, key);
+    cache.Sync();
+  } catch (...) {
+    ContainedDirectory::RemoveStaging(cache, std::move(staging));
+    throw;
+  }
+}
+
+VideoTrial Failed(VideoTrial t, const std::string& message) {
+  t.error = "trial '" + t.trial + "' (" + t.video + "): " + message;
+  return t;
+}
+
+}  // namespace
+
+std::string HashFileContent(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw EnvironmentError(path + ": cannot open: " + std::strerror(errno));
+  XXH3_state_t* state = XXH3_createState();
+  XXH3_64bits_reset(state);
+  std::vector<char> buffer(1u << 20);
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer.data(), buffer.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int saved = errno;
+      ::close(fd);
+      XXH3_freeState(state);
+      throw EnvironmentError(path + ": cannot read: " + std::strerror(saved));
+    }
+    if (n == 0) break;
+    XXH3_64bits_update(state, buffer.data(), static_cast<std::size_t>(n));
+  }
+  ::close(fd);
+  const std::uint64_t h = XXH3_64bits_digest(state);
+  XXH3_freeState(state);
+  return Hex16(h);
+}
+
+void OneDecodeThreadPerVideo() {
+  ::setenv("OPENCV_FFMPEG_CAPTURE_OPTIONS", "threads;1", 0);
+  cv::setNumThreads(1);
+}
+
+std::vector<const ExperimentRow*> VideoRows(const Experiment& experiment) {
+  std::vector<const ExperimentRow*> out;
+  for (const ExperimentRow& r : experiment.rows)
+    if (!r.video.empty() && r.error.empty()) out.push_back(&r);
+  return out;
+}
+
+namespace {
+
+VideoTrial TrackTrial(const Experiment& experiment, const ExperimentRow& row, std::size_t index,
+                      const VideoProgressCallback& progress, std::string* key_out) {
+  VideoTrial trial;
+  trial.trial = row.trial;
+  trial.row = row.row;
+  trial.video = row.video;
+  VideoProgress p;
+  p.index = index;
+  p.trial = row.trial;
+  const auto tell = [&](VideoProgress::Stage stage) {
+    p.stage = stage;
+    if (progress) progress(p);
+  };
+  try {
+    if (!row.configuration) throw InputError("row " + std::to_string(row.row), "has no usable apparatus values");
+    const Scene scene = row.configuration->MakeScene();
+    if (scene.body().kind == BodyKind::kDoubleCone)
+      throw InputError(experiment.directory, "a double cone cannot be tracked (a sphere or a spheroid can)");
+    const ContainedDirectory root = ContainedDirectory::Open(experiment.directory);
+    const std::string scene_file = experiment.scenes.at(row.scene);
+    const auto camera_bytes = root.ReadFile(experiment.camera, kMaxCalibrationBytes);
+    if (!camera_bytes) throw InputError(experiment.camera, "the camera file is missing");
+    const auto scene_bytes = root.ReadFile(scene_file, kMaxCalibrationBytes);
+    if (!scene_bytes) throw InputError(scene_file, "the scene file '" + row.scene + "' is missing");
+    const ContainedDirectory::Kind kind = root.KindOf(row.video);
+    if (kind == ContainedDirectory::Kind::kAbsent) throw InputError(row.video, "no such file");
+    if (kind != ContainedDirectory::Kind::kFile)
+      throw InputError(row.video, "is not a regular file in the folder (links are not followed)");
+    const std::string video_path = (fs::path(root.path()) / row.video).string();
+    tell(VideoProgress::Stage::kHashing);
+    const std::string key = HashFileContent(video_path) +
+                            CalibrationKey(*camera_bytes, *scene_bytes, *row.configuration, experiment.video_analysis);
+    if (key_out) *key_out = key;
+    if (std::optional<VideoTrial> cached = ReadCached(root, key)) {
+      cached->trial = row.trial;
+      cached->row = row.row;
+      cached->video = row.video;
+      tell(VideoProgress::Stage::kCached);
+      return *cached;
+    }
+    const std::string camera_path = (fs::path(root.path()) / experiment.camera).string();
+    const std::string scene_path = (fs::path(root.path()) / scene_file).string();
+    const SceneCalibration calibration = ReadTrackingCalibration(camera_path, scene_path);
+    TrackVideoOptions options;
+    options.calibration_name = scene_file;
+    options.progress = [&](int done, long total) {
+      p.frames_done = done;
+      p.frames_total = total;
+      tell(VideoProgress::Stage::kTracking);
+    };
+    tell(VideoProgress::Stage::kTracking);
+    const TrackResult track = TrackVideo(video_path, scene, calibration, options);
+    trial.partial = track.partial;
+    trial.partial_reason = track.partial_reason;
+    tell(VideoProgress::Stage::kAnalysing);
+    // The analysis reads the track as the cache keeps it (the CSV's millimetres), so that a
+    // fresh run and a cached one agree: the track is written first, into a private folder.
+    const TrackSources sources{row.video, experiment.camera, scene_file, scene.body().Name()};
+    const ContainedDirectory cache = root.Subdirectory(kCacheFolder, true);
+    ContainedDirectory work = cache.MakeStagingDirectory(".track-");
+    TrackAnalysis analysis;
+    try {
+      const std::string csv = (fs::path(work.path()) / "track.csv").string();
+      WriteTrack(csv, track, sources);
+      Track read = ReadTrackFile(csv);
+      read.source = row.video;
+      analysis = AnalyseTrack(read, scene, AnalysisOptionsOf(experiment.video_analysis));
+    } catch (...) {
+      ContainedDirectory::RemoveStaging(cache, std::move(work));
+      throw;
+    }
+    ContainedDirectory::RemoveStaging(cache, std::move(work));
+    FillFromAnalysis(analysis, &trial);
+    WriteCache(root, key, track, sources, analysis, trial);
+    tell(VideoProgress::Stage::kDone);
+    return trial;
+  } catch (const InputError& e) {
+    tell(VideoProgress::Stage::kFailed);
+    return Failed(trial, e.what());
+  } catch (const EnvironmentError& e) {
+    tell(VideoProgress::Stage::kFailed);
+    return Failed(trial, e.what());
+  }
+}
+
+}  // namespace
+
+VideoTrial TrackTrialVideo(const Experiment& experiment, const ExperimentRow& row, std::size_t index,
+                           const VideoProgressCallback& progress) {
+  return TrackTrial(experiment, row, index, progress, nullptr);
+}
+
+VideoTrialResult TrackTrialVideo(const std::string& folder, std::size_t row_index,
+                                 const VideoProgressCallback& progress) {
+  const Experiment experiment = LoadExperiment(folder);
+  if (row_index >= experiment.rows.size())
+    throw InputError(folder + "/measurements.csv", "has no data row " + std::to_string(row_index + 2));
+  const ExperimentRow& row = experiment.rows[row_index];
+  if (!row.error.empty()) {
+    const std::size_t colon = row.error.find(": ");
+    throw InputError(row.error.substr(0, colon), colon == std::string::npos ? "is not usable" : row.error.substr(colon + 2));
+  }
+  if (row.video.empty()) throw InputError(folder + "/measurements.csv, row " + std::to_string(row.row) + ", column video", "is empty");
+  VideoTrialResult result;
+  std::string key;
+  result.trial = TrackTrial(experiment, row, 0, progress, &key);
+  if (result.trial.error.empty()) {
+    result.cache_folder = std::string(kCacheFolder) + "/" + key;
+    result.track = ReadTrackFile((fs::path(experiment.directory) / result.cache_folder / "track.csv").string());
+  }
+  return result;
+}
+
+std::vector<VideoTrial> TrackExperimentVideos(const Experiment& experiment, unsigned jobs,
+                                              const VideoProgressCallback& progress) {
+  const std::vector<const ExperimentRow*> rows = VideoRows(experiment);
+  std::vector<VideoTrial> out(rows.size());
+  if (rows.empty()) return out;
+  if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
+  jobs = std::min<unsigned>(jobs, static_cast<unsigned>(rows.size()));
+  std::mutex progress_mutex;
+  const VideoProgressCallback serialised = [&](const VideoProgress& p) {
+    if (!progress) return;
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    progress(p);
+  };
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    VideoProgress queued;
+    queued.index = i;
+    queued.trial = rows[i]->trial;
+    serialised(queued);
+  }
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  const auto work = [&] {
+    for (std::size_t i = next++; i < rows.size(); i = next++) {
+      try {
+        out[i] = TrackTrialVideo(experiment, *rows[i], i, serialised);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (unsigned j = 1; j < jobs; ++j) threads.emplace_back(work);
+  work();
+  for (std::thread& t : threads) t.join();
+  if (failure) std::rethrow_exception(failure);
+  return out;
+}
+
+ExperimentAnalysis AnalyseExperimentWithVideos(Experiment* experiment, const std::vector<VideoTrial>& trials,
+                                               const AnalysisOptions& options) {
+  for (const VideoTrial& t : trials) {
+    for (ExperimentRow& row : experiment->rows) {
+      if (row.row != t.row || !row.error.empty() || row.y_typed) continue;
+      if (!t.error.empty()) {
+        row.error = t.error;
+      } else if (!t.rest) {
+        row.error = "trial '" + t.trial + "' (" + t.video + "): Y is empty and the video gives none: " + t.no_rest;
+      } else {
+        row.Y.value = t.rest->value;
+        row.Y.u = t.rest->u.value_or(0.0);
+      }
+    }
+  }
+  ExperimentAnalysis analysis = AnalyseExperiment(*experiment, options);
+  analysis.video_trials = trials;
+  return analysis;
+}
+
+}  // namespace uphill
