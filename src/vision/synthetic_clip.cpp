@@ -529,6 +529,16 @@ SceneCalibration SideViewCamera(int width, int height, double target_x, double t
   return cal;
 }
 
+ClipSetup TrialClipSetup(int width, int height, double D, double mu, double band_fraction) {
+  ClipSetup setup = DefaultClipSetup(width, height);
+  setup.scene = Scene(setup.scene.body(), Rails::FromApparatus(1.0, 0.1, D, LConvention::kHorizontal),
+                      setup.scene.rod_radius());
+  const std::optional<RestBand> band = setup.scene.Rest(mu);
+  if (!band || !setup.scene.x_eq()) throw InputError("mu", "the trial's scene has no rest band for this mu");
+  setup.x0 = band->high + band_fraction * (band->high - *setup.scene.x_eq());
+  return setup;
+}
+
 ClipSetup DefaultClipSetup(int width, int height) {
   const double L = 1.0, H = 0.1, D = 0.15;
   const Scene scene(Body::Sphere(0.0254), Rails::FromApparatus(L, H, D, LConvention::kHorizontal), 0.004);

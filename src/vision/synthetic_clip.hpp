@@ -64,6 +64,12 @@ struct ClipSetup {
 };
 ClipSetup DefaultClipSetup(int width, int height);
 
+// A trial of a video experiment (data/series3-video, `uphill bench report`): DefaultClipSetup with
+// the rail separation D (m; L = 1 m, H = 0.1 m) and the release position x0 = band.high +
+// f·(band.high − X) of the rest band of μ (f < 0: inside the band, the body stays; f > 0: beyond
+// it, it rolls up and falls off). Throws InputError when the scene has no rest band for μ.
+ClipSetup TrialClipSetup(int width, int height, double D, double mu, double band_fraction);
+
 // The side-view camera of DefaultClipSetup for another scene, looking at (target_x, 0, target_z).
 SceneCalibration SideViewCamera(int width, int height, double target_x, double target_z);
 

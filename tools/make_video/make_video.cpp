@@ -56,17 +56,15 @@ void Run(const Flags& f) {
     setup.x0 = 0.97 * *setup.scene.x_eq();
     body_flags = "--body spheroid --a 15.875mm --b 25.4mm";
   }
-  if (f.D_mm != 150) {
+  if (f.x0_band) {
+    if (f.spheroid) throw InputError("--x0-band", "applies to the ball (not --spheroid)");
+    setup = TrialClipSetup(f.width, f.height, f.D_mm * 1e-3, f.mu, *f.x0_band);
+  } else if (f.D_mm != 150) {
     setup.scene = Scene(setup.scene.body(),
                         Rails::FromApparatus(1.0, 0.1, f.D_mm * 1e-3, LConvention::kHorizontal), setup.scene.rod_radius());
     setup.x0 = 0.97 * *setup.scene.x_eq();
   }
   if (f.x0_mm) setup.x0 = *f.x0_mm * 1e-3;
-  if (f.x0_band) {
-    const std::optional<RestBand> band = setup.scene.Rest(f.mu);
-    if (!band || !setup.scene.x_eq()) throw InputError("--x0-band", "the scene has no rest band for this mu");
-    setup.x0 = band->high + *f.x0_band * (band->high - *setup.scene.x_eq());
-  }
   MotionOptions motion_options;
   motion_options.mu = f.mu;
   if (f.mu > 0) motion_options.method = MotionMethod::kOde;

@@ -8,8 +8,10 @@
 #include "bench/io_benchmark.hpp"
 #include "bench/motion_benchmark.hpp"
 #include "bench/python_benchmark.hpp"
+#include "bench/report_benchmark.hpp"
 #include "bench/track_benchmark.hpp"
 #include "commands.hpp"
+#include "model/input_error.hpp"
 #include "vision_program.hpp"
 
 namespace uphill::cli {
@@ -125,6 +127,32 @@ void AddTrack(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& 
   });
 }
 
+void AddReport(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
+  auto o = std::make_shared<bench::ReportBenchmarkOptions>();
+  CLI::App* cmd = bench.add_subcommand(
+      "report", "Fit report of an experiment of trial videos: wall time against decoding them, the cached rerun");
+  cmd->add_option("--cache", o->cache, "folder of the rendered experiment (reused between runs)")->capture_default_str();
+  cmd->add_flag("--fresh", o->fresh, "render the videos again");
+  cmd->add_option("--videos", o->videos, "number of trial videos")->capture_default_str();
+  cmd->add_option("--width", o->width, "video width, px")->capture_default_str();
+  cmd->add_option("--height", o->height, "video height, px")->capture_default_str();
+  cmd->add_option("--seconds", o->seconds, "length of each video, s (>= 3)")->capture_default_str();
+  cmd->add_option("--jobs", o->jobs, "threads (0: every core)")->capture_default_str();
+  AddCommonFlags(cmd, &o->common, "unused (no Python peer: decoding is the baseline)");
+  cmd->callback([o, argv] {
+    o->common.command = CommandLine(*argv);
+    if (o->videos < 2 || o->videos > 200) throw InputError("--videos", "must be between 2 and 200");
+    if (o->seconds < 3 || o->seconds > 120) throw InputError("--seconds", "must be between 3 and 120 s");
+    if (o->width < 320 || o->height < 180 || o->width > 4096 || o->height > 4096)
+      throw InputError("--width/--height", "must be between 320x180 and 4096x4096");
+#if UPHILL_VISION_PROGRAM
+    bench::RunReportBenchmark(*o, std::cout);
+#else
+    RunInVisionProgram();
+#endif
+  });
+}
+
 void AddPython(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
   auto o = std::make_shared<bench::PythonBenchmarkOptions>();
   CLI::App* cmd = bench.add_subcommand(
@@ -152,6 +180,7 @@ void AddBenchCommand(CLI::App& app, const std::vector<std::string>& arguments) {
   AddIo(*bench, argv);
   AddMotion(*bench, argv);
   AddTrack(*bench, argv);
+  AddReport(*bench, argv);
   AddPython(*bench, argv);
 }
 
