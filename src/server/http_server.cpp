@@ -17,6 +17,7 @@
 #include "vision/camera.hpp"
 #include "internal/calibration_api.hpp"
 #include "internal/page_assets.hpp"
+#include "internal/track_api.hpp"
 #include "internal/video_upload.hpp"
 #include "server/row_check.hpp"
 // Last: it includes <httplib.h>, which includes <resolv.h>, whose `_res` macro breaks Eigen.
@@ -516,6 +517,29 @@ struct Server::Impl {
         return ordered_json{{"calibration", calibration}, {"state", StateJson(s)}};
       });
     });
+    // Tracking reads the files as saved, outside the store's lock; one at a time (with reports).
+    http.Post(R"(/api/rows/(\d{1,12})/track)", [this](const httplib::Request& req, httplib::Response& res) {
+      Respond(req, res, [this, &req](const json&) {
+        std::lock_guard lock(report_mutex);
+        return internal::TrackRowVideo(store, store.Get(), std::stoll(req.matches[1].str()));
+      });
+    });
+    http.Post(R"(/api/rows/(\d{1,12})/accept-y)", [this](const httplib::Request& req, httplib::Response& res) {
+      Mutate(req, res, [this, &req](const json& b) {
+        const std::int64_t version = VersionOf(b);
+        const std::int64_t id = std::stoll(req.matches[1].str());
+        const StoreSnapshot s = store.Get();
+        internal::RestAsY rest;
+        {
+          std::lock_guard lock(report_mutex);
+          rest = internal::RowRestAsY(store, s, id);
+        }
+        ordered_json row = ToJson(s.state.rows[s.state.IndexOf(id)]);
+        row["Y"] = rest.y;
+        if (!rest.u_y.empty()) row["u_Y"] = rest.u_y;
+        return store.EditRow(version, id, row);
+      });
+    });
     // A row id, or "new": a new trial (body `trial`: its label) with this video.
     http.Post(R"(/api/rows/(\d{1,12}|new)/video)", [this](const httplib::Request& req, httplib::Response& res) {
       Mutate(req, res, [this, &req](const json& b) {
@@ -601,10 +625,10 @@ struct Server::Impl {
                               "the experiment folder");
       return;
     }
-    const Experiment experiment = LoadExperiment(store.directory());
     AnalysisOptions analysis_options;
     analysis_options.mc_trials = options.report_mc_trials;
-    const ExperimentAnalysis analysis = AnalyseExperiment(experiment, analysis_options);
+    Experiment experiment;
+    const ExperimentAnalysis analysis = internal::AnalyseFolder(store.directory(), analysis_options, &experiment);
     ContainedDirectory staging = folder->MakeStagingDirectory(".report-staging-");
     std::vector<std::string> names;
     try {

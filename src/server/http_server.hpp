@@ -19,6 +19,8 @@
 //   POST   /api/rows/<id>/video           {version, video}: attach a video of the folder to a row
 //   GET    /api/scene/points?row=ID[&table_z=Z&marks=M,M]   the apparatus points to click
 //   POST   /api/scene/solve               {video, row?, clicks}: the pose, residuals, the path
+//   POST   /api/rows/<id>/track           {}: the trial's video tracked and analysed (cached)
+//   POST   /api/rows/<id>/accept-y        {version}: the video's rest position becomes Y ± u_Y
 //   PUT    /api/scenes/<name>             {version, video, row?, clicks}: solve and save the
 //                                         scene file calibration/scene-<name>.json
 //   POST   /api/camera/calibrate          {version, folder, cols, rows, square}: the camera file

@@ -312,7 +312,8 @@ function drawOverlay() {
   layer.replaceChildren();
   if (!V.width) return;
   layer.setAttribute('viewBox', `-0.5 -0.5 ${V.width} ${V.height}`);
-  const scale = V.width / 800;  // marks keep their size on screen at zoom 1
+  // Frame pixels per screen pixel: marks and labels keep their size on screen at every zoom.
+  const scale = V.width / ($('s-stage').getBoundingClientRect().width || V.width);
   const r = 6 * scale;
   if (V.solution) {
     const path = V.solution.path.map(([u, v]) => `${u.toFixed(2)},${v.toFixed(2)}`).join(' ');
@@ -398,7 +399,7 @@ $('v-row').addEventListener('change', () => showRow($('v-row').value === 'new' ?
 $('v-attach').addEventListener('click', () => attach($('v-file').value));
 $('v-upload').addEventListener('change', () => upload($('v-upload').files[0]));
 $('s-img').addEventListener('click', frameClick);
-$('s-zoom').addEventListener('change', applyZoom);
+$('s-zoom').addEventListener('change', () => { applyZoom(); drawOverlay(); });
 $('s-frame').addEventListener('change', loadFrame);
 $('s-table').addEventListener('change', loadPoints);
 $('s-marks').addEventListener('change', loadPoints);

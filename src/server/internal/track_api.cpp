@@ -1,0 +1,127 @@
+#include "track_api.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "app/video_frames.hpp"
+#include "app/video_trials.hpp"
+#include "io/experiment.hpp"
+#include "io/units.hpp"
+#include "model/input_error.hpp"
+
+namespace uphill::internal {
+namespace {
+
+using nlohmann::json;
+using nlohmann::ordered_json;
+
+int RowIndex(const StoreSnapshot& snapshot, std::int64_t id) {
+  const int index = snapshot.state.IndexOf(id);
+  if (index < 0) throw InputError("row", "row " + std::to_string(id) + " does not exist");
+  if (snapshot.state.rows[index].video.empty())
+    throw InputError("video", "trial " + snapshot.state.rows[index].trial + " has no video: attach one first");
+  return index;
+}
+
+VideoTrialResult Track(const ExperimentStore& store, const StoreSnapshot& snapshot, std::int64_t id) {
+  const int index = RowIndex(snapshot, id);
+  VideoTrialResult r = TrackTrialVideo(store.directory(), static_cast<std::size_t>(index));
+  if (!r.trial.error.empty()) throw InputError("video", r.trial.error);
+  return r;
+}
+
+std::string Number(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+}  // namespace
+
+ordered_json TrackRowVideo(const ExperimentStore& store, const StoreSnapshot& snapshot, std::int64_t id) {
+  const std::string& unit = snapshot.state.unit;
+  const auto L = [&](double si) { return ToUnit(si, Dimension::kLength, unit); };
+  const auto measured = [&](const std::optional<MeasuredValue>& m, bool length) -> ordered_json {
+    if (!m) return nullptr;
+    return {{"value", length ? L(m->value) : m->value},
+            {"u", m->u ? ordered_json(length ? L(*m->u) : *m->u) : ordered_json(nullptr)}};
+  };
+  const VideoTrialResult r = Track(store, snapshot, id);
+  const VideoTrial& t = r.trial;
+  const VideoProbe probe = ProbeVideo(store.directory() + "/" + t.video, t.video);
+  ordered_json out;
+  out["row"] = id;
+  out["video"] = t.video;
+  out["frames"] = t.frames;
+  out["frames_tracked"] = t.found;
+  out["partial"] = t.partial;
+  out["partial_reason"] = t.partial_reason;
+  out["release"] = t.release_x ? ordered_json{{"x0", measured(t.release_x, true)}, {"t0", measured(t.release_t, false)}}
+                               : ordered_json(nullptr);
+  // The direction of the first motion: from the release toward O (down the rails) or away.
+  std::string direction;
+  for (const TrackFrame& f : r.track.frames)
+    if (f.found && t.release_t && f.t > t.release_t->value + 0.1 && t.release_x) {
+      direction = f.x < t.release_x->value ? "toward O (down the rails)" : "away from O (up the rails)";
+      break;
+    }
+  out["direction"] = direction;
+  ordered_json turns = ordered_json::array();
+  for (const VideoTrialEvent& e : t.events)
+    if (e.kind == "turning point") turns.push_back({{"x", L(e.x.value)}, {"t", e.t.value}});
+  out["turns"] = turns;
+  if (t.rest) {
+    double rest_t = 0;
+    for (const VideoTrialEvent& e : t.events)
+      if (e.kind == "comes to rest") rest_t = e.t.value;
+    out["rest"] = {{"y", measured(t.rest, true)}, {"t", rest_t}};
+  } else {
+    out["rest"] = nullptr;
+  }
+  out["never_at_rest"] = t.no_rest;
+  if (t.fit_available && t.fit_value) {
+    const bool mu = t.fitted == "mu";
+    char text[200];
+    std::snprintf(text, sizeof text, "%s = %.4g ± %.2g%s, χ²/ν = %.2f (ν = %d)", mu ? "μ" : "g_eff",
+                  t.fit_value->value, t.fit_value->u.value_or(0), mu ? "" : " m/s²", t.reduced_chi2, t.dof);
+    out["fit"] = {{"text", text}};
+  } else {
+    out["fit"] = {{"text", "not available: " + t.fit_unavailable}};
+  }
+  out["warnings"] = t.notes;
+  out["width"] = probe.width;
+  out["height"] = probe.height;
+  ordered_json strip = ordered_json::array();
+  const std::size_t n = r.track.frames.size();
+  for (std::size_t k = 0; k < 8 && n > 0; ++k) {
+    const TrackFrame& f = r.track.frames[std::min(n - 1, k * (n - 1) / 7)];
+    if (!strip.empty() && strip.back()["frame"] == f.frame) continue;
+    strip.push_back({{"frame", f.frame},
+                     {"t", f.t},
+                     {"u", f.found ? ordered_json(f.u) : ordered_json(nullptr)},
+                     {"v", f.found ? ordered_json(f.v) : ordered_json(nullptr)},
+                     {"radius_px", f.found ? ordered_json(f.radius_px) : ordered_json(nullptr)},
+                     {"x", f.found ? ordered_json(L(f.x)) : ordered_json(nullptr)}});
+  }
+  out["strip"] = strip;
+  return out;
+}
+
+RestAsY RowRestAsY(const ExperimentStore& store, const StoreSnapshot& snapshot, std::int64_t id) {
+  const VideoTrialResult r = Track(store, snapshot, id);
+  if (!r.trial.rest)
+    throw InputError("video", "the body never comes to rest in " + r.trial.video +
+                                  (r.trial.no_rest.empty() ? "" : " (" + r.trial.no_rest + ")") + ": no Y to accept");
+  const std::string& unit = snapshot.state.unit;
+  return {Number(ToUnit(r.trial.rest->value, Dimension::kLength, unit)),
+          r.trial.rest->u ? Number(ToUnit(*r.trial.rest->u, Dimension::kLength, unit)) : ""};
+}
+
+ExperimentAnalysis AnalyseFolder(const std::string& directory, const AnalysisOptions& options, Experiment* experiment) {
+  *experiment = LoadExperiment(directory);
+  if (!experiment->HasVideos()) return AnalyseExperiment(*experiment, options);
+  const std::vector<VideoTrial> trials = TrackExperimentVideos(*experiment);
+  return AnalyseExperimentWithVideos(experiment, trials, options);
+}
+
+}  // namespace uphill::internal

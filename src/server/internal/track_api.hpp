@@ -1,0 +1,35 @@
+// The tracking part of the server's API (http_server.hpp lists the routes): a trial's video
+// tracked and analysed by the use case of app/video_trials.hpp (cached in EXP/.uphill-cache/),
+// and the fit report with the videos. Private to src/server/. Lengths in the experiment's unit.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "io/experiment.hpp"
+#include "report/analysis.hpp"
+#include "server/experiment_store.hpp"
+
+namespace uphill::internal {
+
+// POST /api/rows/<id>/track: {row, video, frames, frames_tracked, partial, partial_reason,
+// release: {x0: {value, u}, t0: {value, u}}, direction, turns: [{x, t}], rest: {y: {value, u}, t},
+// never_at_rest, fit: {text}, warnings, width, height, strip: [{frame, t, u, v, radius_px, x}]}
+// (8 frames spread over the clip; u, v, x null where the body was not found). Throws
+// InputError("video") with the trial's own message (not a video, a scene of another size, the
+// body never found ...).
+nlohmann::ordered_json TrackRowVideo(const ExperimentStore& store, const StoreSnapshot& snapshot, std::int64_t id);
+
+// The row's video's rest position as the row's Y and u_Y (plain numbers in the unit, 6
+// significant digits). Throws InputError("video") when the video has no rest (why).
+struct RestAsY {
+  std::string y, u_y;
+};
+RestAsY RowRestAsY(const ExperimentStore& store, const StoreSnapshot& snapshot, std::int64_t id);
+
+// The experiment folder's analysis for the report, its videos tracked (cached) when it has any.
+// `experiment` receives the folder's experiment, into which the analysis points.
+ExperimentAnalysis AnalyseFolder(const std::string& directory, const AnalysisOptions& options, Experiment* experiment);
+
+}  // namespace uphill::internal
