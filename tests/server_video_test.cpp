@@ -332,6 +332,74 @@ TEST_F(VideoApiTest, AttachingChecksTheVideoAndTheScene) {
   EXPECT_EQ(State()["rows"][0]["video"], "videos/clip.mp4");  // unchanged
 }
 
+// Tracking in the page (app/video_trials.hpp): a ball resting inside its rest band (μ = 0.05) is
+// found where make_video drew it (truth.csv's x, the exact camera and pose as the experiment's),
+// and its rest becomes the row's Y through the journal; a ball that rolls up and falls off has no
+// rest to accept.
+class TrackApiTest : public ServerFixture {
+ protected:
+  void SetUp() override {}
+  void MakeTrial(const std::string& flags) {
+    clip_ = FreshFolder("server-track-clip");
+    ASSERT_EQ(std::system((std::string(UPHILL_MAKE_VIDEO) + " " + clip_.string() +
+                           " --width 640 --height 360 --boards 0 --noise 1 --mu 0.05 " + flags + " > /dev/null").c_str()),
+              0);
+    fs::create_directories(dir_ / "calibration");
+    fs::create_directories(dir_ / "videos");
+    fs::copy_file(clip_ / "cam.json", dir_ / "calibration" / "camera.json");
+    fs::copy_file(clip_ / "scene.json", dir_ / "calibration" / "scene-main.json");
+    fs::copy_file(clip_ / "clip.mp4", dir_ / "videos" / "t1.mp4");
+    const json experiment = {{"format", "uphill-experiment/2"},
+                             {"body", {{"type", "sphere"}, {"R", "25.4 mm"}}},
+                             {"apparatus", {{"L", "1000 mm"}, {"H", "100 mm"}, {"D", "150 mm"}, {"rod_diameter", "8 mm"}}},
+                             {"camera", "calibration/camera.json"},
+                             {"scenes", {{"main", "calibration/scene-main.json"}}}};
+    std::ofstream(dir_ / "experiment.json") << experiment.dump(2);
+    std::ofstream(dir_ / "measurements.csv") << "trial,series,Y_mm,video,note\nt1,,,videos/t1.mp4,\n";
+    Start();
+  }
+  void TearDown() override {
+    ServerFixture::TearDown();
+    fs::remove_all(clip_);
+  }
+  fs::path clip_;
+};
+
+TEST_F(TrackApiTest, RestPositionBecomesY) {
+  MakeTrial("--x0-band -0.02 --seconds 1");
+  const std::int64_t id = State()["rows"][0]["id"];
+  auto [status, track] = Send("POST", "/api/rows/" + std::to_string(id) + "/track", json::object());
+  ASSERT_EQ(status, 200) << track.dump();
+  EXPECT_EQ(track["frames_tracked"], track["frames"]);
+  EXPECT_GE(track["strip"].size(), 4u);
+  const auto truth = ReadCsv(clip_ / "truth.csv");
+  const double drawn = std::stod(truth.back()[2]);  // mm
+  ASSERT_TRUE(track["rest"].is_object()) << track.dump();
+  EXPECT_NEAR(track["rest"]["y"]["value"].get<double>(), drawn, 0.5);
+  // The outline on the strip is where the ball was drawn (truth.csv's pixels of its centre).
+  for (const json& f : track["strip"]) {
+    const auto& row = truth.at(f["frame"].get<std::size_t>());
+    EXPECT_NEAR(f["u"].get<double>(), std::stod(row[4]), 0.5);
+    EXPECT_NEAR(f["v"].get<double>(), std::stod(row[5]), 0.5);
+  }
+  auto [accepted, state] = Send("POST", "/api/rows/" + std::to_string(id) + "/accept-y", {{"version", State()["version"]}});
+  ASSERT_EQ(accepted, 200) << state.dump();
+  EXPECT_NEAR(std::stod(state["rows"][0]["Y"].get<std::string>()), track["rest"]["y"]["value"].get<double>(), 1e-3);
+  EXPECT_FALSE(state["rows"][0]["u_Y"].get<std::string>().empty());
+  Stop();
+  Start();
+  EXPECT_EQ(State()["rows"][0]["Y"], state["rows"][0]["Y"]);
+}
+
+TEST_F(TrackApiTest, NoRestNoY) {
+  MakeTrial("--x0-band 0.3 --release-time 0.3 --until-end");
+  const std::int64_t id = State()["rows"][0]["id"];
+  auto [status, body] = Send("POST", "/api/rows/" + std::to_string(id) + "/accept-y", {{"version", State()["version"]}});
+  EXPECT_EQ(status, 422);
+  EXPECT_NE(body["error"].get<std::string>().find("never comes to rest"), std::string::npos) << body.dump();
+  EXPECT_TRUE(State()["rows"][0]["Y"].is_null());
+}
+
 // The camera from chessboard views in the folder: make_video's views of its exact camera give
 // that camera back (fx within 1 %), with the verdict and the views used; the file is journaled.
 class CameraCalibrationTest : public ServerFixture {};
