@@ -74,6 +74,13 @@ TrackAnalysisOptions AnalysisOptionsOf(const VideoAnalysisSettings& v) {
 
 MeasuredValue Measured(const Estimate& e) { return {e.value, e.u}; }
 
+// The uncertainty analyse-track says to quote (track_analysis.hpp, "Uncertainty of the fit"):
+// u carries the tracker's systematic error, which the scatter of the residuals does not show
+// (se_scaled shrinks below the real error when chi2/dof < 1).
+MeasuredValue Quoted(const FittedParameter& p) {
+  return {p.value, p.u ? p.u : p.se_scaled ? p.se_scaled : p.se};
+}
+
 VideoTrialEvent EventOf(const TrackEvent& e) { return {e.kind, Measured(e.t), Measured(e.x)}; }
 
 // The report's plain numbers of an analysis.
@@ -105,11 +112,11 @@ void FillFromAnalysis(const TrackAnalysis& a, VideoTrial* t) {
   t->fitted = a.fit.fitted;
   if (a.fit.available) {
     if (const FittedParameter* p = a.fit.Parameter(a.fit.fitted)) {
-      t->fit_value = MeasuredValue{p->value, p->se_scaled ? p->se_scaled : p->se};
+      t->fit_value = Quoted(*p);
     }
     // The fit's own x0 and t0 are better than the band's (track_analysis.hpp: release).
-    if (const FittedParameter* x0 = a.fit.Parameter("x0")) t->release_x = MeasuredValue{x0->value, x0->se_scaled ? x0->se_scaled : x0->se};
-    if (const FittedParameter* t0 = a.fit.Parameter("t0")) t->release_t = MeasuredValue{t0->value, t0->se_scaled ? t0->se_scaled : t0->se};
+    if (const FittedParameter* x0 = a.fit.Parameter("x0")) t->release_x = Quoted(*x0);
+    if (const FittedParameter* t0 = a.fit.Parameter("t0")) t->release_t = Quoted(*t0);
   }
   t->reduced_chi2 = a.fit.reduced_chi2;
   t->dof = a.fit.dof;

@@ -70,7 +70,8 @@ void AddVideoSections(const ExperimentAnalysis& a, bool with_figures, Document* 
   d->Heading("Motion fits");
   d->Paragraph("The model motion released from rest at x0 at time t0 fitted to each track's x(t) (vision's "
                "analyse-track): with fit = mu the rolling resistance at the stated g, with fit = g an effective g "
-               "(mu = 0). Standard errors scaled by sqrt(chi2/dof).");
+               "(mu = 0). Uncertainties are analyse-track's u: the residuals' scatter and the tracker's systematic "
+               "error added in quadrature (docs/analyse-track.md, \"Accuracy\").");
   Table fits{{"trial", "x0 (mm)", "t0 (s)", "fit", "chi2/dof", "frames (found)", "events", "notes"}, {}};
   for (const VideoTrial& t : a.video_trials) {
     if (!t.error.empty()) continue;

@@ -62,7 +62,7 @@ struct VideoTrial {
   bool fit_available = false;
   std::string fit_unavailable;
   std::string fitted;                   // "g" or "mu"
-  std::optional<MeasuredValue> fit_value;  // u: the standard error scaled by sqrt(χ²/ν) when ν > 0
+  std::optional<MeasuredValue> fit_value;  // u: analyse-track's u (statistical and the tracker's systematic part)
   double reduced_chi2 = 0;
   int dof = 0;
   std::vector<std::string> notes;
