@@ -8,7 +8,9 @@
 // leaves a truncated file: an SVG must end with </svg>, a PNG with its IEND chunk), fsyncing it,
 // and renaming it into place. The temporary folder is removed however the call ends. Anything but
 // a regular file at an output's name (a folder in the way, a link, a device) is refused before
-// anything is written.
+// anything is written. A figure whose four files are already what the call would write (the same
+// data and script, whole images newer than both) is left as it is, without running gnuplot: a
+// second report of an unchanged experiment costs no drawing.
 #pragma once
 
 #include <string>
