@@ -175,7 +175,10 @@ void RunReportBenchmark(const ReportBenchmarkOptions& o, std::ostream& out) {
   const std::string self = fs::read_symlink("/proc/self/exe").parent_path().string();
   const std::string uphill = (fs::path(self) / "uphill").string();
   const fs::path report_dir = exp.parent_path() / (exp.filename().string() + "-report");
+  // Both emptied: the first report tracks every video and draws every figure (report/gnuplot_figure.hpp
+  // reuses a figure already on disk); the second finds all of it.
   fs::remove_all(exp / ".uphill-cache");
+  fs::remove_all(report_dir);
   const std::string jobs_flag = std::to_string(jobs);
   const std::vector<std::string> report_argv = {uphill, "report", exp.string(), "-o", report_dir.string(),
                                                 "--jobs", jobs_flag, "--quiet"};
