@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -123,6 +124,30 @@ TEST_F(VideoTrials, RestPositionFromTheVideoMatchesTheTruthAndABadTrialStopsNoth
   const VideoTrial& bad = trials[2];
   EXPECT_NE(bad.error.find("trial 'bad' (videos/text.mp4)"), std::string::npos) << bad.error;
   EXPECT_EQ(last[2], VideoProgress::Stage::kFailed);
+}
+
+// One job at a time: the trials are started largest file first and each is handed to the done
+// callback once, with its index into VideoRows. Truth: the files' sizes as the file system states
+// them, and the rows of measurements.csv.
+TEST_F(VideoTrials, LargestVideoFirstAndEachTrialHandedOverOnce) {
+  const Experiment experiment = LoadExperiment(dir_->string());
+  const std::vector<const ExperimentRow*> rows = VideoRows(experiment);
+  std::vector<std::size_t> expected = {0, 1, 2};
+  std::stable_sort(expected.begin(), expected.end(), [&](std::size_t a, std::size_t b) {
+    return fs::file_size(*dir_ / rows[a]->video) > fs::file_size(*dir_ / rows[b]->video);
+  });
+  // The roll clip (longer) is larger than the rest clip: the order differs from the rows'.
+  ASSERT_NE(expected, (std::vector<std::size_t>{0, 1, 2}));
+  std::vector<std::size_t> order;
+  const std::vector<VideoTrial> trials =
+      TrackExperimentVideos(experiment, 1, {}, [&](std::size_t index, const VideoTrial& trial) {
+        ASSERT_LT(index, rows.size());
+        EXPECT_EQ(trial.trial, rows[index]->trial);
+        order.push_back(index);
+      });
+  EXPECT_EQ(order, expected);
+  ASSERT_EQ(trials.size(), 3u);
+  for (std::size_t i = 0; i < trials.size(); ++i) EXPECT_EQ(trials[i].trial, rows[i]->trial);
 }
 
 TEST_F(VideoTrials, SecondRunReadsTheCacheOnly) {

@@ -4,6 +4,7 @@
 #include <unistd.h>
 #include <xxhash.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cmath>
@@ -138,25 +139,13 @@ std::optional<VideoTrial> ReadCached(const ContainedDirectory& root, const std::
   }
 }
 
-// Writes the entry into a staging folder and renames it into place whole.
-void WriteCache(const ContainedDirectory& root, const std::string& key, const TrackResult& track,
-                const TrackSources& sources, const TrackAnalysis& analysis, const VideoTrial& trial) {
-  const ContainedDirectory cache = root.Subdirectory(kCacheFolder, true);
-  ContainedDirectory staging = cache.MakeStagingDirectory(".staging-");
+// Renames the entry written into `staging` into place whole (replacing a damaged one).
+void CommitCache(const ContainedDirectory& cache, const ContainedDirectory& staging, const std::string& key) {
   const std::string staging_name = fs::path(staging.path()).filename().string();
-  try {
-    WriteTrack((fs::path(staging.path()) / "track.csv").string(), track, sources);
-    staging.WriteFileAtomically("track_analysis.json", TrackAnalysisJson(analysis).dump(2) + "\n");
-    staging.WriteFileAtomically(kTrialFile, VideoTrialToJson(trial).dump() + "\n");
-    staging.Sync();
-    if (cache.KindOf(key) != ContainedDirectory::Kind::kAbsent)  // a damaged entry: replaced
-      ContainedDirectory::RemoveStaging(cache, cache.Subdirectory(key, false));
-    cache.RenameNoReplace(staging_name, key);
-    cache.Sync();
-  } catch (...) {
-    ContainedDirectory::RemoveStaging(cache, std::move(staging));
-    throw;
-  }
+  staging.Sync();
+  if (cache.KindOf(key) != ContainedDirectory::Kind::kAbsent)  // a damaged entry: replaced
+    ContainedDirectory::RemoveStaging(cache, cache.Subdirectory(key, false));
+  cache.RenameNoReplace(staging_name, key);
 }
 
 VideoTrial Failed(VideoTrial t, const std::string& message) {
@@ -259,25 +248,32 @@ VideoTrial TrackTrial(const Experiment& experiment, const ExperimentRow& row, st
     trial.partial = track.partial;
     trial.partial_reason = track.partial_reason;
     tell(VideoProgress::Stage::kAnalysing);
-    // The analysis reads the track as the cache keeps it (the CSV's millimetres), so that a
-    // fresh run and a cached one agree: the track is written first, into a private folder.
+    // The entry is written into a staging folder and renamed into place whole. The analysis
+    // reads the track as the cache keeps it (the CSV's millimetres), so that a fresh run and a
+    // cached one agree: the track is written first, once, and read back.
     const TrackSources sources{row.video, experiment.camera, scene_file, scene.body().Name()};
     const ContainedDirectory cache = root.Subdirectory(kCacheFolder, true);
-    ContainedDirectory work = cache.MakeStagingDirectory(".track-");
-    TrackAnalysis analysis;
+    ContainedDirectory staging = cache.MakeStagingDirectory(".staging-");
     try {
-      const std::string csv = (fs::path(work.path()) / "track.csv").string();
+      const std::string csv = (fs::path(staging.path()) / "track.csv").string();
       WriteTrack(csv, track, sources);
       Track read = ReadTrackFile(csv);
       read.source = row.video;
-      analysis = AnalyseTrack(read, scene, AnalysisOptionsOf(experiment.video_analysis));
+      const TrackAnalysis analysis = AnalyseTrack(read, scene, AnalysisOptionsOf(experiment.video_analysis));
+      FillFromAnalysis(analysis, &trial);
+      staging.WriteFileAtomically("track_analysis.json", TrackAnalysisJson(analysis).dump(2) + "\n");
+      staging.WriteFileAtomically(kTrialFile, VideoTrialToJson(trial).dump() + "\n");
     } catch (...) {
-      ContainedDirectory::RemoveStaging(cache, std::move(work));
+      ContainedDirectory::RemoveStaging(cache, std::move(staging));
       throw;
     }
-    ContainedDirectory::RemoveStaging(cache, std::move(work));
-    FillFromAnalysis(analysis, &trial);
-    WriteCache(root, key, track, sources, analysis, trial);
+    try {
+      CommitCache(cache, staging, key);
+    } catch (...) {
+      ContainedDirectory::RemoveStaging(cache, std::move(staging));
+      throw;
+    }
+    cache.Sync();
     tell(VideoProgress::Stage::kDone);
     return trial;
   } catch (const InputError& e) {
@@ -317,17 +313,37 @@ VideoTrialResult TrackTrialVideo(const std::string& folder, std::size_t row_inde
   return result;
 }
 
+namespace {
+
+// The rows in the order they are started: the largest file first (the file size stands for the
+// decoding work); a file that cannot be sized fails (quickly) when it is opened, last.
+std::vector<std::size_t> LongestFirst(const Experiment& experiment, const std::vector<const ExperimentRow*>& rows) {
+  std::vector<std::uintmax_t> bytes(rows.size(), 0);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    std::error_code ignored;
+    const std::uintmax_t size = fs::file_size(fs::path(experiment.directory) / rows[i]->video, ignored);
+    bytes[i] = ignored ? 0 : size;
+  }
+  std::vector<std::size_t> order(rows.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return bytes[a] > bytes[b]; });
+  return order;
+}
+
+}  // namespace
+
 std::vector<VideoTrial> TrackExperimentVideos(const Experiment& experiment, unsigned jobs,
-                                              const VideoProgressCallback& progress) {
+                                              const VideoProgressCallback& progress,
+                                              const VideoTrialDoneCallback& done) {
   const std::vector<const ExperimentRow*> rows = VideoRows(experiment);
   std::vector<VideoTrial> out(rows.size());
   if (rows.empty()) return out;
   if (jobs == 0) jobs = std::max(1u, std::thread::hardware_concurrency());
   jobs = std::min<unsigned>(jobs, static_cast<unsigned>(rows.size()));
-  std::mutex progress_mutex;
+  std::mutex callback_mutex;
   const VideoProgressCallback serialised = [&](const VideoProgress& p) {
     if (!progress) return;
-    std::lock_guard<std::mutex> lock(progress_mutex);
+    std::lock_guard<std::mutex> lock(callback_mutex);
     progress(p);
   };
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -336,13 +352,19 @@ std::vector<VideoTrial> TrackExperimentVideos(const Experiment& experiment, unsi
     queued.trial = rows[i]->trial;
     serialised(queued);
   }
+  const std::vector<std::size_t> order = LongestFirst(experiment, rows);
   std::atomic<std::size_t> next{0};
   std::exception_ptr failure;
   std::mutex failure_mutex;
   const auto work = [&] {
-    for (std::size_t i = next++; i < rows.size(); i = next++) {
+    for (std::size_t k = next++; k < order.size(); k = next++) {
+      const std::size_t i = order[k];
       try {
         out[i] = TrackTrialVideo(experiment, *rows[i], i, serialised);
+        if (done) {
+          std::lock_guard<std::mutex> lock(callback_mutex);
+          done(i, out[i]);
+        }
       } catch (...) {
         std::lock_guard<std::mutex> lock(failure_mutex);
         if (!failure) failure = std::current_exception();

@@ -25,7 +25,7 @@
 // size is not the video's, a body that is never found, a double cone) is that trial's error: a
 // one-line message naming the trial and the file; the other trials are still analysed.
 // Threads: TrackExperimentVideos runs `jobs` trials at once, one per thread, each decoding on
-// one thread (OneDecodeThreadPerVideo), so that the cores are used across videos.
+// one thread (OneDecodeThreadPerVideo), so that the cores are used across videos, largest first.
 #pragma once
 
 #include <cstddef>
@@ -75,9 +75,18 @@ struct VideoTrialResult {
 VideoTrialResult TrackTrialVideo(const std::string& folder, std::size_t row_index,
                                  const VideoProgressCallback& progress = {});
 
-// Every row with a video, `jobs` at a time (0: std::thread::hardware_concurrency()), in row order.
+// Called with a trial as soon as it is finished (tracked, from the cache, or failed) and its index
+// into VideoRows; serialised with the progress calls. The report draws the trial's figures then,
+// while the other videos are still being tracked.
+using VideoTrialDoneCallback = std::function<void(std::size_t index, const VideoTrial& trial)>;
+
+// Every row with a video, `jobs` at a time (0: std::thread::hardware_concurrency()); the result is
+// in row order. The largest files are started first: the file size stands for the decoding work
+// (the frames, their size, and the bits per frame), so that no long video is left to run alone on
+// one core at the end while the others are idle.
 std::vector<VideoTrial> TrackExperimentVideos(const Experiment& experiment, unsigned jobs = 0,
-                                              const VideoProgressCallback& progress = {});
+                                              const VideoProgressCallback& progress = {},
+                                              const VideoTrialDoneCallback& done = {});
 
 // The rows with a video, in file order (what the callbacks' index refers to).
 std::vector<const ExperimentRow*> VideoRows(const Experiment& experiment);

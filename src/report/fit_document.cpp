@@ -215,13 +215,24 @@ std::vector<std::string> FitReportFiles() {
   return files;
 }
 
-void WriteFitReport(const ExperimentAnalysis& a, const std::string& directory) {
-  namespace fs = std::filesystem;
+void CreateReportFolder(const std::string& directory) {
   std::error_code ec;
-  fs::create_directories(directory, ec);
+  std::filesystem::create_directories(directory, ec);
   if (ec) throw EnvironmentError(directory + ": cannot create the folder: " + ec.message());
-  for (const GnuplotFigure& f : AnalysisFigures(a)) RenderFigure(f, directory);
-  for (const GnuplotFigure& f : VideoTrialFigures(a)) RenderFigure(f, directory);
+}
+
+void WriteFitReport(const ExperimentAnalysis& a, const std::string& directory) {
+  FigurePool figures;
+  WriteFitReport(a, directory, &figures);
+}
+
+void WriteFitReport(const ExperimentAnalysis& a, const std::string& directory, FigurePool* figures) {
+  namespace fs = std::filesystem;
+  CreateReportFolder(directory);
+  for (GnuplotFigure& f : AnalysisFigures(a)) figures->Render(std::move(f), directory);
+  for (GnuplotFigure& f : VideoTrialFigures(a)) figures->Render(std::move(f), directory);
+  // The documents after the figures: report.html embeds the images.
+  figures->Wait();
   const Document d = FitDocument(a, true);
   WriteFileAtomically((fs::path(directory) / "fit.json").string(), AnalysisToJson(a).dump(2) + "\n");
   WriteFileAtomically((fs::path(directory) / "report.md").string(), RenderMarkdown(d));

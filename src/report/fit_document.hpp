@@ -8,6 +8,7 @@
 
 #include "report/analysis.hpp"
 #include "report/document.hpp"
+#include "report/figure_pool.hpp"
 
 namespace uphill {
 
@@ -16,9 +17,17 @@ Document FitDocument(const ExperimentAnalysis& analysis, bool with_figures);
 // Plain-text rendering of a Document for a terminal (aligned tables), used by `uphill fit`.
 std::string RenderText(const Document& document);
 
-// Creates `directory` if needed; every file is written atomically or not at all. Throws
-// EnvironmentError (figures: gnuplot missing or failing; files: the path and the failing call).
+// Creates `directory` if needed; every file is written atomically or not at all. The figures are
+// drawn concurrently, one gnuplot process per core (figure_pool.hpp), then the documents are
+// written. Throws EnvironmentError (figures: gnuplot missing or failing, naming every failed
+// figure, the others written; files: the path and the failing call).
 void WriteFitReport(const ExperimentAnalysis& analysis, const std::string& directory);
+// The same with the caller's pool, which may already be drawing some of the figures (a video
+// trial's, submitted as soon as the trial was tracked: VideoTrialFigures(trial, index)); those
+// are not drawn twice.
+void WriteFitReport(const ExperimentAnalysis& analysis, const std::string& directory, FigurePool* figures);
+// Creates the report folder (and its parents) if needed; throws EnvironmentError.
+void CreateReportFolder(const std::string& directory);
 // The names of the files WriteFitReport writes into its folder.
 std::vector<std::string> FitReportFiles();
 

@@ -1,6 +1,7 @@
 #include "report/gnuplot_figure.hpp"
 
 #include <fcntl.h>
+#include <spawn.h>
 #include <stdlib.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -21,12 +22,6 @@ namespace uphill {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string Quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
 
 std::string Slurp(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -60,6 +55,39 @@ void SyncFile(const fs::path& path, const std::string& figure) {
     throw EnvironmentError("figure " + figure + ": " + path.filename().string() + " cannot be saved: " + std::strerror(saved));
   }
   ::close(fd);
+}
+
+// Runs `gnuplot -e ASSIGNMENTS SCRIPT` in `dir`, its output into `log`; spawned directly (no
+// shell), so that several figures can be drawn at once from threads (figure_pool.hpp) and each
+// call waits for its own child only. Throws EnvironmentError starting with `what` when gnuplot is
+// missing or fails (with gnuplot's complaint, which names the script's line).
+void RunGnuplot(const fs::path& dir, const std::string& assignments, const std::string& script, const fs::path& log,
+                const std::string& what) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addchdir_np(&actions, dir.c_str());
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  std::string program = "gnuplot", e = "-e", a = assignments, s = script;
+  char* argv[] = {program.data(), e.data(), a.data(), s.data(), nullptr};
+  pid_t pid = 0;
+  const int spawned = ::posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned == ENOENT) throw EnvironmentError(what + ": gnuplot not found (install Debian's gnuplot-nox)");
+  if (spawned != 0) throw EnvironmentError(what + ": gnuplot cannot be started: " + std::strerror(spawned));
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) throw EnvironmentError(what + ": waiting for gnuplot: " + std::strerror(errno));
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    std::string complaint = Slurp(log);
+    while (!complaint.empty() && (complaint.back() == '\n' || complaint.back() == ' ')) complaint.pop_back();
+    if (complaint.empty())
+      complaint = WIFSIGNALED(status) ? "killed by signal " + std::to_string(WTERMSIG(status))
+                                      : "exit status " + std::to_string(WEXITSTATUS(status));
+    throw EnvironmentError(what + ": gnuplot failed: " + complaint);
+  }
 }
 
 // A private folder for gnuplot's output, removed with everything in it however RenderFigure ends.
@@ -141,20 +169,11 @@ void RenderFigure(const GnuplotFigure& f, const std::string& directory) {
   const std::string folder = render.path().filename().string();  // our own characters only
   const fs::path svg = render.path() / (f.name + ".svg"), png = render.path() / (f.name + ".png");
   const fs::path log = render.path() / "gnuplot.log";
-  const std::string command = "cd " + Quote(dir.string()) + " && gnuplot -e " +
-                              Quote("svg_out='" + folder + "/" + f.name + ".svg'; png_out='" + folder + "/" + f.name +
-                                    ".png'") +
-                              " " + Quote(f.name + ".gp") + " > " + Quote(log.string()) + " 2>&1";
-  const int status = std::system(command.c_str());
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
-    throw EnvironmentError("figure " + f.name + ": gnuplot not found (install Debian's gnuplot-nox)");
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    std::string complaint = Slurp(log);
-    while (!complaint.empty() && (complaint.back() == '\n' || complaint.back() == ' ')) complaint.pop_back();
-    throw EnvironmentError("figure " + f.name + ": gnuplot failed: " + complaint);
-  }
+  const std::string script_file = (dir / (f.name + ".gp")).string();
+  RunGnuplot(dir, "svg_out='" + folder + "/" + f.name + ".svg'; png_out='" + folder + "/" + f.name + ".png'",
+             f.name + ".gp", log, "figure " + f.name + " (" + script_file + ")");
   if (!CompleteSvg(Slurp(svg)) || !CompletePng(Slurp(png)))
-    throw EnvironmentError("figure " + f.name + ": gnuplot left an incomplete image (is the disk full?) in " +
+    throw EnvironmentError("figure " + f.name + " (" + script_file + "): gnuplot left an incomplete image (is the disk full?) in " +
                            dir.string() + "; the previous images, if any, are unchanged");
   SyncFile(svg, f.name);
   SyncFile(png, f.name);

@@ -129,13 +129,15 @@ void AddVideoSections(const ExperimentAnalysis& a, bool with_figures, Document* 
   }
 }
 
+std::vector<GnuplotFigure> VideoTrialFigures(const VideoTrial& t, std::size_t index) {
+  if (!t.error.empty() || t.figure.measured.empty()) return {};
+  return TrackFigures(t.figure, Stem(index), " (trial " + t.trial + ")");
+}
+
 std::vector<GnuplotFigure> VideoTrialFigures(const ExperimentAnalysis& a) {
   std::vector<GnuplotFigure> out;
-  for (std::size_t i = 0; i < a.video_trials.size(); ++i) {
-    const VideoTrial& t = a.video_trials[i];
-    if (!t.error.empty() || t.figure.measured.empty()) continue;
-    for (GnuplotFigure& f : TrackFigures(t.figure, Stem(i), " (trial " + t.trial + ")")) out.push_back(std::move(f));
-  }
+  for (std::size_t i = 0; i < a.video_trials.size(); ++i)
+    for (GnuplotFigure& f : VideoTrialFigures(a.video_trials[i], i)) out.push_back(std::move(f));
   return out;
 }
 

@@ -24,6 +24,9 @@ namespace uphill {
 
 void AddVideoSections(const ExperimentAnalysis& analysis, bool with_figures, Document* document);
 std::vector<GnuplotFigure> VideoTrialFigures(const ExperimentAnalysis& analysis);
+// The figures of one trial, the `index`-th of the video trials (from 0): what
+// VideoTrialFigures(analysis) holds for it, so that they can be drawn as soon as it is tracked.
+std::vector<GnuplotFigure> VideoTrialFigures(const VideoTrial& trial, std::size_t index);
 // fit.json's "video_trials" (VideoTrialToJson without figure data) and "motion_mu".
 void AddVideoJson(const ExperimentAnalysis& analysis, nlohmann::ordered_json* j);
 

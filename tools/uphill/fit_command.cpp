@@ -21,6 +21,8 @@
 #include "model/input_error.hpp"
 #include "report/fit_document.hpp"
 #include "report/fit_json.hpp"
+#include "report/figure_pool.hpp"
+#include "report/video_report.hpp"
 #include "vision_program.hpp"
 #if UPHILL_VISION_PROGRAM
 #include "app/video_trials.hpp"
@@ -103,7 +105,9 @@ void RunXy(const FitFlags& f) {
   }
 }
 
-ExperimentAnalysis Analyse(const FitFlags& f, Experiment* keep) {
+// `figures`, when given (`uphill report`), draws each video trial's figures into f.output as soon
+// as the trial is tracked, while the other videos are tracked.
+ExperimentAnalysis Analyse(const FitFlags& f, Experiment* keep, FigurePool* figures = nullptr) {
   *keep = LoadExperiment(f.experiment);
   AnalysisOptions options;
   // Per row; 10^7 take about half a second a row. Fewer than 100 give no usable u(X): 0 gave
@@ -122,7 +126,14 @@ ExperimentAnalysis Analyse(const FitFlags& f, Experiment* keep) {
     std::optional<VideoProgressDisplay> display;
     if (!f.quiet && isatty(STDERR_FILENO) && !rows.empty()) display.emplace(labels);
     const std::vector<VideoTrial> trials = TrackExperimentVideos(
-        *keep, f.jobs, [&](const VideoProgress& p) { if (display) display->Update(p); });
+        *keep, f.jobs, [&](const VideoProgress& p) { if (display) display->Update(p); },
+        [&, folder_made = false](std::size_t index, const VideoTrial& trial) mutable {
+          std::vector<GnuplotFigure> list = figures ? VideoTrialFigures(trial, index) : std::vector<GnuplotFigure>{};
+          if (list.empty()) return;
+          if (!folder_made) CreateReportFolder(f.output);  // not before: a failed report leaves nothing
+          folder_made = true;
+          for (GnuplotFigure& figure : list) figures->Render(std::move(figure), f.output);
+        });
     if (display) display->Finish();
     for (const VideoTrial& t : trials)
       if (!t.error.empty()) {
@@ -135,6 +146,7 @@ ExperimentAnalysis Analyse(const FitFlags& f, Experiment* keep) {
   }
 #else
   if (keep->HasVideos()) RunInVisionProgram();  // the videos are tracked with OpenCV
+  (void)figures;
   ExperimentAnalysis a = AnalyseExperiment(*keep, options);
 #endif
   for (const auto& e : a.row_errors) {
@@ -195,8 +207,9 @@ void AddFitCommand(CLI::App& app) {
     outputs.AddInput((std::filesystem::path(flags->experiment) / "measurements.csv").string(), "the experiment's");
     outputs.CheckFolder(flags->output, "-o", FitReportFiles());
     Experiment experiment;
-    const ExperimentAnalysis a = Analyse(*flags, &experiment);
-    WriteFitReport(a, flags->output);
+    FigurePool figures(flags->jobs);  // drawing while the videos are tracked, one gnuplot per core
+    const ExperimentAnalysis a = Analyse(*flags, &experiment, &figures);
+    WriteFitReport(a, flags->output, &figures);
     std::cout << "wrote " << flags->output << "/report.html, report.md, fit.json, and the figures "
               << "fit_y_vs_x, fit_offset, fit_residuals";
     if (!a.video_trials.empty()) std::cout << ", and each video's video_<n>_x_vs_t, video_<n>_residuals";
