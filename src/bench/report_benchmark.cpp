@@ -32,10 +32,18 @@ constexpr const char* kMethod =
     "far edge of the rest band and stay (Y from the video), half are released beyond it after 8 s at rest and roll "
     "up and fall off (mu from the motion). \"report\": the `uphill report EXP -o OUT` program run as a user runs "
     "it, empty video cache, wall time from start to exit and its peak RSS (every video tracked and analysed, one "
-    "per core, then the fits, figures and documents). \"decode only\": every frame of every video read by OpenCV "
-    "(VideoCapture::read, FFmpeg, one decoding thread per video) on the same number of threads, wall time; the "
-    "floor any tracker that reads every frame meets; its CPU is the process's over the decoding. CPU of a program: "
-    "its user + system time with its children's (gnuplot). \"report, cached\": the same command again with nothing "
+    "per core, largest first, each trial's figures drawn as soon as it is tracked; then the fits, the other figures "
+    "and the documents). \"tracking phase\": the report's first part alone, in the benchmark's process, from an "
+    "empty cache: every video decoded, tracked, analysed and cached (TrackExperimentVideos, the call the program "
+    "makes). \"decode only\": every frame of every video read by OpenCV (VideoCapture::read, FFmpeg, one decoding "
+    "thread per video) on the same number of threads: the floor any tracker that reads every frame meets. The "
+    "runs follow one another in rounds (--rounds, default 2: decode only, report, report cached, fit cached, "
+    "tracking phase), and each row is its run's best round (shortest wall time), so that on a loaded machine "
+    "the runs are compared at their least disturbed; the decodings of every round are stated. On a machine busier "
+    "than its cores (load average above the thread count) wall times depend on how the kernel shares the cores "
+    "among all the runnable threads, and the ratios of CPU time (\"Phases\") are the better guide. CPU: the process's over the run; of a program, its user + system time with its "
+    "children's (gnuplot); CPU/frame divides it by the frames of all the videos, so that decoding and the "
+    "tracker's share are seen apart. \"report, cached\": the same command again with nothing "
     "changed (the videos hashed, the cache read); \"fit, cached\": `uphill fit EXP` likewise (no figures). "
     "Accuracy: Y of the resting trials against the renderer's true position (largest |Y - truth| / u(Y)) and "
     "mu of the rolling trials (inverse-variance mean, its pull against 0.05).";
@@ -175,30 +183,57 @@ void RunReportBenchmark(const ReportBenchmarkOptions& o, std::ostream& out) {
   const std::string self = fs::read_symlink("/proc/self/exe").parent_path().string();
   const std::string uphill = (fs::path(self) / "uphill").string();
   const fs::path report_dir = exp.parent_path() / (exp.filename().string() + "-report");
-  // Both emptied: the first report tracks every video and draws every figure (report/gnuplot_figure.hpp
-  // reuses a figure already on disk); the second finds all of it.
-  fs::remove_all(exp / ".uphill-cache");
-  fs::remove_all(report_dir);
   const std::string jobs_flag = std::to_string(jobs);
   const std::vector<std::string> report_argv = {uphill, "report", exp.string(), "-o", report_dir.string(),
                                                 "--jobs", jobs_flag, "--quiet"};
-  const ProcessRun first = RunProcess(report_argv);
-  const ProcessRun second = RunProcess(report_argv);
-  const ProcessRun fit = RunProcess({uphill, "fit", exp.string(), "--quiet"});
+
+  // Each round measures every run once, one after the other, from an empty cache and report
+  // folder: decode only, report, report cached, fit cached, tracking phase. The best (shortest
+  // wall time) of the rounds is kept for each, so that on a loaded machine the runs are compared
+  // at their least disturbed. The in-process runs return their freed memory before a child is
+  // started (a child's ru_maxrss counts this process's memory at the fork).
+  long frames = 0;
+  ProcessRun decode, first, second, fit, tracking;
+  std::vector<double> decode_walls;
+  std::vector<VideoTrial> results;
+  const auto keep_best = [](ProcessRun* best, const ProcessRun& run) {
+    if (best->exit_status != 0 || (run.exit_status == 0 && run.wall_seconds < best->wall_seconds)) *best = run;
+  };
+  for (int round = 0; round < o.rounds; ++round) {
+    fs::remove_all(exp / ".uphill-cache");
+    fs::remove_all(report_dir);
+    ProcessRun d;
+    const double decode_cpu0 = ProcessCpuSeconds();
+    d.wall_seconds = DecodeAll(videos, jobs, &frames);
+    d.cpu_seconds = ProcessCpuSeconds() - decode_cpu0;
+    d.exit_status = 0;
+    decode_walls.push_back(d.wall_seconds);
+    keep_best(&decode, d);
+    ResetPeakResident();
+    keep_best(&first, RunProcess(report_argv));
+    keep_best(&second, RunProcess(report_argv));
+    keep_best(&fit, RunProcess({uphill, "fit", exp.string(), "--quiet"}));
+    // The tracking phase alone, in this process: what `uphill report` does before its analysis,
+    // figures and documents (app/video_trials.hpp, the same call), from an empty cache.
+    fs::remove_all(exp / ".uphill-cache");
+    Experiment experiment = LoadExperiment(exp.string());
+    ProcessRun t;
+    const double tracking_cpu0 = ProcessCpuSeconds(), tracking_wall0 = WallSeconds();
+    results = TrackExperimentVideos(experiment, jobs);
+    t.wall_seconds = WallSeconds() - tracking_wall0;
+    t.cpu_seconds = ProcessCpuSeconds() - tracking_cpu0;
+    t.exit_status = 0;
+    keep_best(&tracking, t);
+    ResetPeakResident();
+  }
   if (first.exit_status != 0 || second.exit_status != 0 || fit.exit_status != 0)
     section.notes.push_back("exit status of report, report (cached), fit (cached): " +
                             std::to_string(first.exit_status) + ", " + std::to_string(second.exit_status) + ", " +
                             std::to_string(fit.exit_status) + " (expected 0)");
+  const double decode_seconds = decode.wall_seconds, decode_cpu_seconds = decode.cpu_seconds;
+  const double tracking_wall = tracking.wall_seconds, tracking_cpu = tracking.cpu_seconds;
 
-  // Decoding after the children: their ru_maxrss counts this process's memory at the fork.
-  long frames = 0;
-  const double decode_cpu0 = ProcessCpuSeconds();
-  const double decode = DecodeAll(videos, jobs, &frames);
-  const double decode_cpu = ProcessCpuSeconds() - decode_cpu0;
-
-  // Accuracy from the cache (the report's own numbers).
-  Experiment experiment = LoadExperiment(exp.string());
-  const std::vector<VideoTrial> results = TrackExperimentVideos(experiment, jobs);
+  // Accuracy of the tracking phase's results (what the report shows).
   double worst_pull = 0;
   int rests = 0;
   for (std::size_t i = 0; i < results.size(); ++i)
@@ -211,29 +246,55 @@ void RunReportBenchmark(const ReportBenchmarkOptions& o, std::ostream& out) {
   out << "\nuphill bench report: " << o.videos << " trial videos, " << o.width << "x" << o.height << ", "
       << o.seconds << " s at 30 fps (" << frames << " frames), " << jobs << " threads; experiment in " << exp.string()
       << "\n\n";
-  Table table({{"run", 16, true}, {"wall", 9}, {"frames/s", 9}, {"x decode", 8}, {"CPU", 9}, {"peak RSS", 8}});
+  const auto per_frame = [&](double cpu) { return Fixed("%.2f ms", 1e3 * cpu / static_cast<double>(frames)); };
+  Table table({{"run", 22, true}, {"wall", 9}, {"frames/s", 9}, {"x decode", 8}, {"CPU", 9}, {"CPU/frame", 10},
+               {"peak RSS", 8}});
   table.Start(out);
-  table.Add({"decode only", FormatSeconds(decode), Fixed("%.0f", frames / decode), "1.00", FormatSeconds(decode_cpu), ""});
+  table.Add({"decode only", FormatSeconds(decode_seconds), Fixed("%.0f", frames / decode_seconds), "1.00",
+             FormatSeconds(decode_cpu_seconds), per_frame(decode_cpu_seconds), ""});
   table.Add({"report", FormatSeconds(first.wall_seconds), Fixed("%.0f", frames / first.wall_seconds),
-             Fixed("%.2f", first.wall_seconds / decode), FormatSeconds(first.cpu_seconds), FormatBytes(first.peak_bytes)});
-  table.Add({"report, cached", FormatSeconds(second.wall_seconds), "", Fixed("%.2f", second.wall_seconds / decode),
-             FormatSeconds(second.cpu_seconds), FormatBytes(second.peak_bytes)});
-  table.Add({"fit, cached", FormatSeconds(fit.wall_seconds), "", Fixed("%.2f", fit.wall_seconds / decode),
-             FormatSeconds(fit.cpu_seconds), FormatBytes(fit.peak_bytes)});
+             Fixed("%.2f", first.wall_seconds / decode_seconds), FormatSeconds(first.cpu_seconds),
+             per_frame(first.cpu_seconds), FormatBytes(first.peak_bytes)});
+  table.Add({"tracking phase", FormatSeconds(tracking_wall), Fixed("%.0f", frames / tracking_wall),
+             Fixed("%.2f", tracking_wall / decode_seconds), FormatSeconds(tracking_cpu), per_frame(tracking_cpu), ""});
+  table.Add({"report, cached", FormatSeconds(second.wall_seconds), "", Fixed("%.2f", second.wall_seconds / decode_seconds),
+             FormatSeconds(second.cpu_seconds), "", FormatBytes(second.peak_bytes)});
+  table.Add({"fit, cached", FormatSeconds(fit.wall_seconds), "", Fixed("%.2f", fit.wall_seconds / decode_seconds),
+             FormatSeconds(fit.cpu_seconds), "", FormatBytes(fit.peak_bytes)});
   section.tables.emplace_back("", &table);
+
+  std::string decodes = "Decode only, wall time of each round:";
+  for (std::size_t r = 0; r < decode_walls.size(); ++r) decodes += (r ? ", " : " ") + FormatSeconds(decode_walls[r]);
+  decodes += " (the rounds' spread is the load's doing).";
+  out << "\n" << decodes << "\n";
+  section.results.push_back(decodes);
+  const double tracker_cpu = tracking_cpu - decode_cpu_seconds;
+  const std::string phases =
+      "Phases: per frame, decoding costs " + per_frame(decode_cpu_seconds) + " of CPU and the tracker " +
+      per_frame(tracker_cpu) + " on top of it (tracking phase " + per_frame(tracking_cpu) +
+      "); with every core busy the tracking phase can come no closer to decode-only than " +
+      Fixed("%.2f", tracking_cpu / decode_cpu_seconds) + "x, and the report " +
+      Fixed("%.2f", first.cpu_seconds / decode_cpu_seconds) + "x (its CPU beyond the tracking phase: " +
+      FormatSeconds(first.cpu_seconds - tracking_cpu) + " for the analysis, the figures' gnuplot processes, the "
+      "documents and the program's start).";
+  out << phases << "\n";
+  section.results.push_back(phases);
   std::string accuracy = "Accuracy: Y of " + std::to_string(rests) + " resting trials within " +
                          Fixed("%.2f", worst_pull) + " u(Y) of the truth (largest)";
   if (mu)
     accuracy += "; mu of " + std::to_string(mu->trials) + " rolling trials " + Fixed("%.5f", mu->mu) + " ± " +
                 Fixed("%.5f", mu->u) + " (truth 0.05, pull " + Fixed("%.2f", (mu->mu - kMu) / mu->u) + ")";
-  out << "\n" << accuracy << ".\n";
+  out << accuracy << ".\n";
   section.results.push_back(accuracy + ".");
+  const double report_ratio = first.wall_seconds / decode_seconds, tracking_ratio = tracking_wall / decode_seconds;
+  const auto within = [](double ratio) { return ratio <= 1.10 ? std::string("met") : std::string("not met"); };
   const std::string goal =
-      "Goal (issue 13): the report's wall time near the decode-only time (every core used across videos: " +
-      Fixed("%.2f", first.wall_seconds / decode) + "x decode); a second report of the unchanged folder < 1 s: " +
-      FormatSeconds(second.wall_seconds) + " for the report with its figures (" +
-      (second.wall_seconds < 1 ? "met" : "not met") + "), " + FormatSeconds(fit.wall_seconds) + " for `uphill fit` (" +
-      (fit.wall_seconds < 1 ? "met" : "not met") + ").";
+      "Goal (issue 13): each video tracked at its decode-limited speed, every core used across videos (met when "
+      "the wall time is within 10 % of decode-only): the report " + Fixed("%.2f", report_ratio) + "x decode (" +
+      within(report_ratio) + "), its tracking phase " + Fixed("%.2f", tracking_ratio) + "x (" + within(tracking_ratio) +
+      "); a second report of the unchanged folder < 1 s: " + FormatSeconds(second.wall_seconds) +
+      " for the report with its figures (" + (second.wall_seconds < 1 ? "met" : "not met") + "), " +
+      FormatSeconds(fit.wall_seconds) + " for `uphill fit` (" + (fit.wall_seconds < 1 ? "met" : "not met") + ").";
   out << goal << "\n";
   section.results.push_back(goal);
   Record(section, o.common.doc, o.common.no_doc, out);

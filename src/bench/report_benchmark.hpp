@@ -20,6 +20,7 @@ struct ReportBenchmarkOptions {
   double seconds = 10;
   bool fresh = false;  // render the videos again
   unsigned jobs = 0;   // 0: every core
+  int rounds = 2;      // each run's best of this many
 };
 
 void RunReportBenchmark(const ReportBenchmarkOptions& options, std::ostream& out);

@@ -138,10 +138,12 @@ void AddReport(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>&
   cmd->add_option("--height", o->height, "video height, px")->capture_default_str();
   cmd->add_option("--seconds", o->seconds, "length of each video, s (>= 3)")->capture_default_str();
   cmd->add_option("--jobs", o->jobs, "threads (0: every core)")->capture_default_str();
+  cmd->add_option("--rounds", o->rounds, "rounds of all the runs; each run's best is kept")->capture_default_str();
   AddCommonFlags(cmd, &o->common, "unused (no Python peer: decoding is the baseline)");
   cmd->callback([o, argv] {
     o->common.command = CommandLine(*argv);
     if (o->videos < 2 || o->videos > 200) throw InputError("--videos", "must be between 2 and 200");
+    if (o->rounds < 1 || o->rounds > 20) throw InputError("--rounds", "must be between 1 and 20");
     if (o->seconds < 3 || o->seconds > 120) throw InputError("--seconds", "must be between 3 and 120 s");
     if (o->width < 320 || o->height < 180 || o->width > 4096 || o->height > 4096)
       throw InputError("--width/--height", "must be between 320x180 and 4096x4096");
