@@ -270,7 +270,22 @@ TEST_F(PovrayTest, MotionBlurEqualsTheAverageOfWholeFrames) {
   c.max_step_px = 1e-3;  // as many sub-frames as allowed:
   c.max_subframes = 8;   // exactly 8
   const fs::path dir = TempDir("blur");
-  const FootageFiles files = RenderFootage(c, (dir / "cache").string());
+  const std::string cache = (dir / "cache").string();
+  // render_clip --plan's count, checked against what the render then does: the POV-Ray programs
+  // RenderFootage ran (counted as it starts them), the sub-frames it composed (8 per frame: the
+  // cap above), and nothing left to render once the clip and its pictures are cached.
+  const FootageWork plan = PlanFootage(c, cache);
+  const FootageFiles files = RenderFootage(c, cache);
+  EXPECT_FALSE(plan.clip_cached);
+  EXPECT_EQ(plan.static_to_render, 1);
+  EXPECT_EQ(plan.static_to_render + plan.runs_to_render, files.povray_runs);
+  EXPECT_EQ(plan.subframes, files.subframes);
+  ASSERT_EQ(plan.frames.size(), 2u);
+  for (const FootageFrameWork& f : plan.frames) EXPECT_GE(f.subframes, 8) << "frame " << f.frame;
+  const FootageWork after = PlanFootage(c, cache);
+  EXPECT_TRUE(after.clip_cached);
+  EXPECT_EQ(after.static_to_render + after.runs_to_render + after.subframes_to_render, 0);
+  EXPECT_EQ(after.subframes, plan.subframes);
   cv::VideoCapture video(files.video, cv::CAP_FFMPEG);
   cv::Mat frame;
   ASSERT_TRUE(video.read(frame) && video.read(frame));  // frame 1

@@ -134,6 +134,13 @@ std::vector<Vector2d> ProjectOrOutside(const CameraIntrinsics& camera, const Cam
   return ProjectApparatusPoints(camera, CameraPose{}, in_camera);
 }
 
+// One POV-Ray run as counted by PlanFootage.
+struct PovrayWork {
+  int subframes = 0;
+  double pixels = 0;
+  bool cached = false;
+};
+
 class FootageRenderer {
  public:
   // work: a private folder for POV-Ray's files; pictures: the shared cache of POV-Ray renders.
@@ -315,6 +322,18 @@ class FootageRenderer {
 
   // The static scene (no body) as a raw linear picture, for each camera pose.
   void RenderStatic() {
+    std::vector<PovrayJob> jobs = StaticJobs();
+    RunJobs(jobs, poses_.size() == 1 ? 2 : 1);
+    for (PovrayJob& job : jobs) static_raw_.push_back(lens_.ToRaw(job.pictures[0]));
+  }
+
+  struct PovrayJob {
+    PovrayShot shot;
+    std::vector<cv::Mat> pictures;
+  };
+
+  // The whole pinhole picture without the body, for each camera pose.
+  std::vector<PovrayJob> StaticJobs() const {
     std::vector<PovrayJob> jobs;
     for (size_t k = 0; k < poses_.size(); ++k) {
       PovrayJob job;
@@ -323,8 +342,7 @@ class FootageRenderer {
       job.shot.bodies = {std::nullopt};
       jobs.push_back(job);
     }
-    RunJobs(jobs, poses_.size() == 1 ? 2 : 1);
-    for (PovrayJob& job : jobs) static_raw_.push_back(lens_.ToRaw(job.pictures[0]));
+    return jobs;
   }
 
   // A part of the picture that the moving body changes, rendered at its own sub-frame times:
@@ -462,15 +480,43 @@ class FootageRenderer {
   // A region of one sub-frame with the same pose and window as one already rendered (a body at
   // rest) is reused.
   void Render(std::vector<FramePlan>& plans) {
+    Batch batch = Jobs(plans);
+    std::vector<PovrayJob>& jobs = batch.jobs;
+    const std::vector<Part>& parts = batch.parts;
+    RunJobs(jobs, 1);
+    for (size_t j = 0; j < jobs.size(); ++j) {
+      Region& region = *parts[j].region;
+      for (size_t k = 0; k < jobs[j].pictures.size(); ++k) {
+        const size_t i = parts[j].first + k;
+        if (!region.boxes[i].empty())
+          region.raw[i] = lens_.ToRaw(jobs[j].pictures[k], region.windows[i], region.boxes[i]);
+      }
+      if (region.bodies.size() == 1) {
+        if (rest_.size() > 16) rest_.clear();
+        rest_[RestKey(region, parts[j].pose_index)] = region.raw[0];
+      }
+    }
+    for (auto& [region, job] : batch.copies) region->raw[0] = parts[job].region->raw[0];
+  }
+
+  struct Part {
+    Region* region;
+    int pose_index;
+    size_t first;  // its first sub-frame
+  };
+  struct Batch {
     std::vector<PovrayJob> jobs;
-    struct Part {
-      Region* region;
-      int pose_index;
-      size_t first;
-    };
-    std::vector<Part> parts;
-    std::map<std::string, size_t> pending;           // rest key -> its job in this batch
-    std::vector<std::pair<Region*, size_t>> copies;  // regions that take a pending job's picture
+    std::vector<Part> parts;                         // per job: the sub-frames it renders
+    std::vector<std::pair<Region*, size_t>> copies;  // regions that take a job's picture
+  };
+
+  // The POV-Ray jobs of the plans' sub-frames, `subframes` counted; a resting region rendered
+  // before (rest_) takes its picture now, one rendered in this batch becomes a copy.
+  Batch Jobs(std::vector<FramePlan>& plans) {
+    Batch batch;
+    std::vector<PovrayJob>& jobs = batch.jobs;
+    std::vector<Part>& parts = batch.parts;
+    std::map<std::string, size_t> pending;  // rest key -> its job in this batch
     for (FramePlan& plan : plans)
       for (Region& region : plan.regions) {
         const size_t K = region.bodies.size();
@@ -483,7 +529,7 @@ class FootageRenderer {
             continue;
           }
           if (const auto it = pending.find(key); it != pending.end()) {
-            copies.emplace_back(&region, it->second);
+            batch.copies.emplace_back(&region, it->second);
             continue;
           }
           pending[key] = jobs.size();
@@ -502,20 +548,7 @@ class FootageRenderer {
           parts.push_back({&region, plan.pose_index, first});
         }
       }
-    RunJobs(jobs, 1);
-    for (size_t j = 0; j < jobs.size(); ++j) {
-      Region& region = *parts[j].region;
-      for (size_t k = 0; k < jobs[j].pictures.size(); ++k) {
-        const size_t i = parts[j].first + k;
-        if (!region.boxes[i].empty())
-          region.raw[i] = lens_.ToRaw(jobs[j].pictures[k], region.windows[i], region.boxes[i]);
-      }
-      if (region.bodies.size() == 1) {
-        if (rest_.size() > 16) rest_.clear();
-        rest_[RestKey(region, parts[j].pose_index)] = region.raw[0];
-      }
-    }
-    for (auto& [region, job] : copies) region->raw[0] = parts[job].region->raw[0];
+    return batch;
   }
 
   // The linear raw frame of a rendered plan (before vignetting, gain and noise): each row the
@@ -555,6 +588,18 @@ class FootageRenderer {
     return frame;
   }
 
+  // What POV-Ray would be asked for (its scene text and picture size) and whether the picture
+  // cache holds it already.
+  PovrayWork Work(const PovrayJob& job) const {
+    PovrayWork w;
+    w.subframes = static_cast<int>(job.shot.bodies.size());
+    w.pixels = static_cast<double>(job.shot.crop.area()) * w.subframes;
+    PovrayOptions options = c_.povray;
+    options.picture_cache = pictures_.empty() ? std::string() : pictures_.string();
+    w.cached = PovrayPicturesCached(Text(job), job.shot.crop.size(), w.subframes, options);
+    return w;
+  }
+
   // The chessboard views (camera frame as the scene's frame), rendered in parallel.
   std::vector<cv::Mat> RenderBoards(const std::vector<BoardInView>& boards) {
     std::vector<PovrayJob> jobs;
@@ -577,14 +622,15 @@ class FootageRenderer {
   double povray_cpu = 0;
 
  private:
-  struct PovrayJob {
-    PovrayShot shot;
-    std::vector<cv::Mat> pictures;
-  };
+  std::string Text(const PovrayJob& job) const {
+    return job.shot.board ? PovrayBoardSceneText(job.shot) : PovraySceneText(c_.scene, c_.apparatus, c_.look, job.shot);
+  }
 
-  // Runs the jobs on up to kWorkers POV-Ray processes at once (`threads` each).
+  // Runs the jobs on up to povray_processes POV-Ray processes at once (`threads` each, at most
+  // povray.threads).
   void RunJobs(std::vector<PovrayJob>& jobs, int threads) {
-    constexpr int kWorkers = 6;
+    const size_t most_workers = static_cast<size_t>(std::max(1, c_.povray_processes));
+    threads = std::clamp(threads, 1, std::max(1, c_.povray.threads));
     std::atomic<size_t> next{0};
     std::mutex mutex;
     std::exception_ptr failure;
@@ -593,8 +639,7 @@ class FootageRenderer {
       for (size_t j = next++; j < jobs.size(); j = next++) {
         try {
           PovrayJob& job = jobs[j];
-          const std::string text = job.shot.board ? PovrayBoardSceneText(job.shot)
-                                                  : PovraySceneText(c_.scene, c_.apparatus, c_.look, job.shot);
+          const std::string text = Text(job);
           PovrayOptions options = c_.povray;
           options.threads = threads;
           options.picture_cache = pictures_.empty() ? std::string() : pictures_.string();
@@ -610,7 +655,7 @@ class FootageRenderer {
         }
       }
     };
-    const int workers = static_cast<int>(std::min<size_t>(kWorkers, jobs.size()));
+    const int workers = static_cast<int>(std::min(most_workers, jobs.size()));
     std::vector<std::thread> threads_;
     for (int w = 1; w < workers; ++w) threads_.emplace_back(worker, w);
     worker(0);
@@ -759,6 +804,45 @@ std::vector<ApparatusPoint> FootageApparatusPoints(const FootageCondition& c) {
   return VisibleApparatusPoints(c.camera.camera, c.camera.pose,
                                 ApparatusCalibrationPoints(c.scene.rails(), c.apparatus.crossbar_x, c.apparatus.table_z,
                                                            c.apparatus.marks));
+}
+
+FootageWork PlanFootage(const FootageCondition& condition, const std::string& cache_root) {
+  Validate(condition);
+  const fs::path root = fs::absolute(cache_root);
+  FootageWork work;
+  work.clip_cached = fs::exists(root / FootageKey(condition) / "condition.json");
+  work.boards_cached =
+      condition.boards == 0 ||
+      fs::exists(root / ("boards-" + internal::ContentKey(DescribeBoards(condition).dump())) / "complete");
+  FootageRenderer renderer(condition, fs::path(), root / "pictures");
+  for (const auto& job : renderer.StaticJobs()) {
+    const PovrayWork w = renderer.Work(job);
+    work.static_pictures += 1;
+    work.static_to_render += !w.cached;
+    work.static_pixels_to_render += w.cached ? 0 : w.pixels;
+  }
+  // All frames in one batch, so that a resting body's picture is shared as RenderFootage shares it.
+  std::vector<FootageRenderer::FramePlan> plans;
+  for (int f = 0; f < condition.frames; ++f) plans.push_back(renderer.Plan(f));
+  auto batch = renderer.Jobs(plans);
+  std::map<const void*, int> frame_of;  // region -> index of its frame
+  for (size_t i = 0; i < plans.size(); ++i) {
+    work.frames.push_back({plans[i].frame});
+    for (const auto& region : plans[i].regions) frame_of[&region] = static_cast<int>(i);
+  }
+  for (size_t j = 0; j < batch.jobs.size(); ++j) {
+    const PovrayWork w = renderer.Work(batch.jobs[j]);
+    FootageFrameWork& frame = work.frames[frame_of.at(batch.parts[j].region)];
+    frame.subframes += w.subframes;
+    work.subframes += w.subframes;
+    if (w.cached) continue;
+    frame.subframes_to_render += w.subframes;
+    frame.pixels_to_render += w.pixels;
+    work.runs_to_render += 1;
+    work.subframes_to_render += w.subframes;
+    work.pixels_to_render += w.pixels;
+  }
+  return work;
 }
 
 FootageFiles RenderFootage(const FootageCondition& condition, const std::string& cache_root, bool fresh,

@@ -100,7 +100,11 @@ struct FootageCondition {
   FootageEvents events;
   int boards = 14;                // chessboard views for the camera calibration
   ChessboardTarget board_target;  // 9 × 6 inner corners, 20 mm
-  PovrayOptions povray;
+  PovrayOptions povray;           // povray.threads caps each POV-Ray program's threads (+WT)
+  // How many POV-Ray programs run at once. POV-Ray 3.7 idles ~0.2 s per picture in its own
+  // polling loops, so several keep the cores busy; on a shared machine 1 (with povray.threads = 1)
+  // keeps the render to one core. Neither changes a pixel (no jitter): not in the cache key.
+  int povray_processes = 6;
 };
 
 // The description that keys the cache (everything that changes a pixel; JSON, SI units).
@@ -131,6 +135,29 @@ struct FootageProgress {
 // longer than the frame time, ...), std::runtime_error when povray or ffmpeg is missing or fails.
 FootageFiles RenderFootage(const FootageCondition& condition, const std::string& cache_root,
                            bool fresh = false, const FootageProgress& progress = {});
+
+// What rendering a condition asks of POV-Ray, found without rendering (render_clip --plan), for
+// estimating a render's time from a sample's time per sub-frame: the sub-frames of each frame
+// (a body at rest shares one picture over consecutive frames), and what is still to render, the
+// pictures the picture cache holds (<cache root>/pictures) apart.
+struct FootageFrameWork {
+  int frame = 0;
+  int subframes = 0;           // POV-Ray pictures of the body's windows in this frame
+  int subframes_to_render = 0;
+  double pixels_to_render = 0;
+};
+struct FootageWork {
+  bool clip_cached = false;              // the whole clip is in the cache: nothing to render
+  bool boards_cached = false;            // the chessboard views are
+  int static_pictures = 0;               // whole pictures without the body, one per camera pose
+  int static_to_render = 0;
+  double static_pixels_to_render = 0;
+  int runs_to_render = 0;                // POV-Ray runs of the body's windows
+  int subframes = 0, subframes_to_render = 0;
+  double pixels_to_render = 0;
+  std::vector<FootageFrameWork> frames;
+};
+FootageWork PlanFootage(const FootageCondition& condition, const std::string& cache_root);
 
 // The truth of a rendered clip (truth.csv). Throws InputError naming the file and row.
 std::vector<ClipTruth> ReadFootageTruth(const std::string& path);

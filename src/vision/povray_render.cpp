@@ -18,15 +18,30 @@ namespace uphill {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// The picture cache's folder for a render (empty without a cache): keyed by everything that
+// changes its pixels (not the thread count: no jitter).
+fs::path CacheFolder(const std::string& scene_text, cv::Size size, int frames, const PovrayOptions& options) {
+  if (options.picture_cache.empty()) return {};
+  char quality[80];
+  std::snprintf(quality, sizeof quality, "%dx%d %d frames, aa %.6g depth %d\n", size.width, size.height, frames,
+                options.antialias_threshold, options.antialias_depth);
+  return fs::path(options.picture_cache) / internal::ContentKey(quality + scene_text);
+}
+
+}  // namespace
+
+bool PovrayPicturesCached(const std::string& scene_text, cv::Size size, int frames, const PovrayOptions& options) {
+  const fs::path cached = CacheFolder(scene_text, size, frames, options);
+  return !cached.empty() && fs::exists(cached / "complete");
+}
+
 PovrayRun RunPovray(const std::string& scene_text, cv::Size size, int frames, const std::string& work_dir,
                     const PovrayOptions& options) {
   if (size.width <= 0 || size.height <= 0) throw std::invalid_argument("RunPovray: empty picture size");
   if (frames < 1) throw std::invalid_argument("RunPovray: frames must be >= 1");
-  char quality[80];
-  std::snprintf(quality, sizeof quality, "%dx%d %d frames, aa %.6g depth %d\n", size.width, size.height, frames,
-                options.antialias_threshold, options.antialias_depth);
-  const fs::path cached =
-      options.picture_cache.empty() ? fs::path() : fs::path(options.picture_cache) / internal::ContentKey(quality + scene_text);
+  const fs::path cached = CacheFolder(scene_text, size, frames, options);
   const int digits = static_cast<int>(std::to_string(frames).size());
   auto picture_name = [&](int f) {
     // POV-Ray numbers animation frames with as many digits as the last one has; one frame: none.
@@ -46,7 +61,7 @@ PovrayRun RunPovray(const std::string& scene_text, cv::Size size, int frames, co
       run->pictures.push_back(picture);
     }
   };
-  if (!cached.empty() && fs::exists(cached / "complete")) {
+  if (PovrayPicturesCached(scene_text, size, frames, options)) {
     PovrayRun run;
     run.cached = true;
     read(cached, &run, "");

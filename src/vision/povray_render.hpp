@@ -42,6 +42,10 @@ struct PovrayRun {
 PovrayRun RunPovray(const std::string& scene_text, cv::Size size, int frames, const std::string& work_dir,
                     const PovrayOptions& options = {});
 
+// True when options.picture_cache holds the pictures RunPovray would render for these arguments
+// (then RunPovray reads them instead of running POV-Ray).
+bool PovrayPicturesCached(const std::string& scene_text, cv::Size size, int frames, const PovrayOptions& options);
+
 // True when the povray program can be run (for tests and benchmarks that need it).
 bool PovrayAvailable(const std::string& program = "povray");
 

@@ -3,9 +3,14 @@
 // and the commands of the user's path: calibrate the camera from the chessboard views, calibrate
 // the scene from the apparatus points, track.
 //
-// Usage: render_clip CONDITION [--cache DIR] [--fresh] [--frames N]
+// Usage: render_clip CONDITION [--cache DIR] [--fresh] [--frames N] [--processes N] [--threads N]
+//        render_clip CONDITION --plan [--cache DIR] [--frames N]
 //        render_clip --list
+// --plan renders nothing: it prints what POV-Ray would be asked for (sub-frames per frame, those
+// already in the picture cache apart), to estimate a render's time from a sample's.
+// --processes 1 --threads 1 keeps POV-Ray to one core of a shared machine (the clip is the same).
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <unistd.h>
@@ -19,9 +24,23 @@ using namespace uphill;
 
 struct Flags {
   std::string condition, cache;
-  bool fresh = false, list = false;
+  bool fresh = false, list = false, plan = false;
   int frames = 0;
+  int processes = 6, threads = 2;
 };
+
+void PrintPlan(const FootageCondition& c, const FootageWork& w) {
+  std::printf("%s: %d frames %dx%d%s\n", c.name.c_str(), c.frames, c.camera.camera.width, c.camera.camera.height,
+              w.clip_cached ? " (the clip is cached: nothing to render)" : "");
+  std::printf("chessboard views: %s\n", w.boards_cached ? "cached" : (std::to_string(c.boards) + " to render").c_str());
+  std::printf("static pictures: %d, %d to render (%.2f Mpx)\n", w.static_pictures, w.static_to_render,
+              w.static_pixels_to_render * 1e-6);
+  std::printf("body windows: %d sub-frames, %d to render in %d POV-Ray runs (%.2f Mpx)\n", w.subframes,
+              w.subframes_to_render, w.runs_to_render, w.pixels_to_render * 1e-6);
+  std::printf("frame  sub-frames  to-render  Mpx-to-render\n");
+  for (const FootageFrameWork& f : w.frames)
+    std::printf("%5d  %10d  %9d  %13.3f\n", f.frame, f.subframes, f.subframes_to_render, f.pixels_to_render * 1e-6);
+}
 
 int Run(const Flags& f) {
   if (f.list) {
@@ -33,11 +52,20 @@ int Run(const Flags& f) {
   NamedFootage named = FootageByName(f.condition);
   FootageCondition& c = named.condition;
   if (f.frames > 0) c.frames = f.frames;
+  c.povray_processes = f.processes;
+  c.povray.threads = f.threads;
   const std::string cache = f.cache.empty() ? FootageCacheRoot() : f.cache;
+  if (f.plan) {
+    PrintPlan(c, PlanFootage(c, cache));
+    return 0;
+  }
   FootageProgress progress;
   const bool tty = isatty(STDERR_FILENO);
-  progress.report = [tty](const std::string& stage, int done, int total) {
-    if (tty) std::fprintf(stderr, "\r%s %d/%d   ", stage.c_str(), done + 1, total);
+  const auto start = std::chrono::steady_clock::now();
+  progress.report = [tty, start](const std::string& stage, int done, int total) {
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // On a terminal one line that updates; into a log a line per step, with the time so far.
+    std::fprintf(stderr, tty ? "\r%s %d/%d (%.0f s)   " : "%s %d/%d (%.0f s)\n", stage.c_str(), done + 1, total, s);
   };
   const FootageFiles files = RenderFootage(c, cache, f.fresh, progress);
   if (tty) std::fprintf(stderr, "\n");
@@ -71,6 +99,9 @@ int main(int argc, char** argv) {
   app.add_option("--cache", f.cache, "clip cache (default ${XDG_CACHE_HOME:-~/.cache}/uphill/clips)");
   app.add_flag("--fresh", f.fresh, "render again even if cached");
   app.add_option("--frames", f.frames, "render only this many frames (a different clip in the cache)");
+  app.add_option("--processes", f.processes, "POV-Ray programs at once (default 6)")->check(CLI::Range(1, 64));
+  app.add_option("--threads", f.threads, "threads of each POV-Ray program (default 2)")->check(CLI::Range(1, 64));
+  app.add_flag("--plan", f.plan, "print what POV-Ray would render (sub-frames per frame), render nothing");
   app.add_flag("--list", f.list, "list the conditions");
   CLI11_PARSE(app, argc, argv);
   if (f.condition.empty() && !f.list) {
