@@ -36,7 +36,7 @@ constexpr double kFastMaxRmsPx = 0.3;       // RMS of the edge points about the 
 constexpr double kFastMinAgreement = 0.85;  // share of the searched rays that are inliers
 constexpr double kFastMaxDisagreementPx = 0.5;  // edge fit against the model, at acquisition
 constexpr int kFastDistrust = 3;            // untrusted fast fits in a row: the clip needs the model
-constexpr int kLearnEvery = 4;              // on the fast path, frames between background updates
+constexpr int kLearnEvery = 8;              // on the fast path, frames between background updates
 
 struct Sample {
   double t, x, z;  // s (clip time of the reported centre), m
@@ -548,12 +548,15 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
     cv::polylines(m.occluder, polyline, false, cv::Scalar(1),
                   std::max(1, static_cast<int>(std::ceil(2 * (max_halfwidth + 2.5)))), cv::LINE_8, 4);
   g.occluder = &m.occluder;
-  m.edges = std::make_unique<internal::EdgeFit>(m.geometry, kEdgePoints);
+  m.edges = std::make_unique<internal::EdgeFit>(
+      m.geometry, kEdgePoints, options.transfer == VideoTransfer::kLinear ? internal::Transfer::kLinear : internal::Transfer::kSrgb);
 
   // The band the body can sweep: discs along the centre path, a radius and a margin wider than
   // the body (the rays reach beyond the outline), for the background model.
   cv::Mat band = cv::Mat::zeros(height, width, CV_8U);
   const int steps = 2000;
+  cv::Point last_at(-1 << 30, 0);
+  int last_radius = -1;
   for (int i = 0; i <= steps; ++i) {
     const double x = m.x_lo + (m.x_hi - m.x_lo) * i / steps;
     const double z = scene.At(x).z;
@@ -562,8 +565,11 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
     const Vector2d q = g.Project(x, z);
     if (std::abs(q.x()) > 4 * width || std::abs(q.y()) > 4 * height) continue;
     const double r = m.RadiusPx(x, z) * std::max(1.0, 1.0 / g.s);
-    cv::circle(band, cv::Point(static_cast<int>(std::lround(q.x())), static_cast<int>(std::lround(q.y()))),
-               static_cast<int>(std::ceil(1.6 * r + 16)), cv::Scalar(255), cv::FILLED);
+    const cv::Point at(static_cast<int>(std::lround(q.x())), static_cast<int>(std::lround(q.y())));
+    const int radius = static_cast<int>(std::ceil(1.6 * r + 16));
+    if (at == last_at && radius == last_radius) continue;  // the same disc again
+    cv::circle(band, at, radius, cv::Scalar(255), cv::FILLED);
+    last_at = at, last_radius = radius;
   }
   m.background = std::make_unique<internal::BackgroundModel>(
       band, options.transfer == VideoTransfer::kLinear ? internal::Transfer::kLinear : internal::Transfer::kSrgb);

@@ -35,16 +35,16 @@
 // ellipse, which perspective shifts.
 //
 // Model only what the scene needs (the fast path): most frames of most clips are a body that
-// differs from its surroundings in grey level, moving less than a quarter of its radius during
-// the exposure. There the outline's grey-level edges, fitted with Ceres (internal/edge_fit.hpp,
+// differs from its surroundings in luminance, moving less than a quarter of its radius during
+// the exposure. There the outline's edges in linear luminance, fitted with Ceres (internal/edge_fit.hpp,
 // one small solve), measure it as well as the model above at a fraction of the cost, so each
 // frame near the prediction is first tried that way. The model takes over for the frame when
 // the predicted smear is longer than a quarter radius, when a rolling shutter is set, or when
 // the edge fit is not trusted (edges found on less than 85 % of the rays, RMS above 0.3 px,
-// grey contrast below 20 levels); and for the rest of the clip when the edge fit disagrees with
+// luminance contrast below 20 levels of 255); and for the rest of the clip when the edge fit disagrees with
 // the model where the body is found (by more than 0.5 px: a body as grey as its table, a painted
 // body) or is distrusted three frames in a row. On the fast path the background is learnt every
-// fourth frame (it is only needed when the model takes over). Where the model lacks the
+// eighth frame (it is only needed when the model takes over). Where the model lacks the
 // background under the body (it rested there since the first frame) and the edge fit is trusted
 // and agrees within 1 px, the edge fit is reported until the background is seen.
 //

@@ -47,11 +47,12 @@ class BackgroundModel {
   // Whether every pixel of `rect` (clipped to the frame) has been seen; the background there
   // (linear light, gain 1), bilinear.
   bool Known(double x, double y) const {
-    const int i = static_cast<int>(x), j = static_cast<int>(y);
+    const int i = static_cast<int>(x) - box_.x, j = static_cast<int>(y) - box_.y;
     return i >= 0 && j >= 0 && i + 1 < count_.cols && j + 1 < count_.rows && count_.at<std::uint8_t>(j, i) &&
            count_.at<std::uint8_t>(j, i + 1) && count_.at<std::uint8_t>(j + 1, i) && count_.at<std::uint8_t>(j + 1, i + 1);
   }
-  cv::Vec3f At(double x, double y) const { return SampleFloat(background_, x, y); }
+  // Only where Known(x, y).
+  cv::Vec3f At(double x, double y) const { return SampleFloat(background_, x - box_.x, y - box_.y); }
   bool InBand(double x, double y) const {
     return band_.at<std::uint8_t>(static_cast<int>(y), static_cast<int>(x)) != 0;
   }
@@ -63,9 +64,16 @@ class BackgroundModel {
   std::array<float, 256> table_;
   cv::Rect box_;                    // bounding box of the band
   cv::Mat band_;                    // CV_8U, frame size
-  cv::Mat background_;              // CV_32FC3, frame size (zero outside the band)
-  cv::Mat count_;                   // CV_8U, looks so far (saturating)
+  // The band's runs of pixels, row by row (frame columns [begin, end)): Learn visits only those.
+  struct Run {
+    int y, begin, end;
+  };
+  std::vector<Run> runs_;
+  cv::Mat background_;              // CV_32FC3 over box_ (zero outside the band)
+  cv::Mat count_;                   // CV_8U over box_, looks so far (saturating)
   std::vector<cv::Point> probes_;   // fixed pixels of the band for the gain
+  std::vector<float> probe_luminance_;  // the background's B + G + R at each probe, 0 if unknown
+  void UpdateProbes();
   double gain_ = 1, residual_ = -1;
   double noise_ = 0.01;             // linear units, running estimate of |I/g − B|
 };

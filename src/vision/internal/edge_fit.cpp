@@ -87,10 +87,15 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
                                 cv::Point(static_cast<int>(std::ceil(u1 + pad)), static_cast<int>(std::ceil(v1 + pad)))) &
                        full;
   if (roi.width < 8 || roi.height < 8) return fit;
-  cv::Mat grey, smooth;
-  if (bgr.channels() == 3) cv::cvtColor(bgr(roi), grey, cv::COLOR_BGR2GRAY);
-  else grey = bgr(roi);
-  grey.convertTo(smooth, CV_32F);
+  // Linear luminance (Rec. 709 weights on the decoded channels), scaled to 0..255 so that the
+  // thresholds read in 8-bit levels: only in linear light is a blurred edge's ramp a straight
+  // blend whose middle is the outline at mid-exposure.
+  cv::Mat smooth(roi.size(), CV_32F);
+  for (int y = 0; y < roi.height; ++y) {
+    const std::uint8_t* in = bgr.ptr<std::uint8_t>(roi.y + y) + 3 * roi.x;
+    float* out = smooth.ptr<float>(y);
+    for (int x = 0; x < roi.width; ++x, in += 3) out[x] = luminance_[0][in[0]] + luminance_[1][in[1]] + luminance_[2][in[2]];
+  }
   cv::GaussianBlur(smooth, smooth, cv::Size(7, 7), 1.0);
 
   const int samples = 2 * static_cast<int>(std::ceil(half_width / kStep)) + 1;
@@ -206,6 +211,13 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
   fit.rms_px = fit.inliers ? std::sqrt(sum2 / fit.inliers) : 0;
   if (polarity_ == 0 && fit.inliers > 0) polarity_ = votes >= 0 ? 1 : -1;
   return fit;
+}
+
+EdgeFit::EdgeFit(const OutlineGeometry& geometry, int points, Transfer transfer) : geometry_(geometry), points_(points) {
+  const std::array<float, 256> linear = LinearTable(transfer);
+  constexpr double kWeights[3] = {0.0722, 0.7152, 0.2126};  // B, G, R: Rec. 709 luminance
+  for (int c = 0; c < 3; ++c)
+    for (int k = 0; k < 256; ++k) luminance_[c][k] = static_cast<float>(255.0 * kWeights[c] * linear[k]);
 }
 
 EdgeFitOutcome EdgeFit::Measure(const cv::Mat& bgr, double x, double z, double half_width) {

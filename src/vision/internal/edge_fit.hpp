@@ -1,27 +1,36 @@
-// The tracker's fast path: the body's outline located as grey-level edges and fitted with Ceres.
+// The tracker's fast path: the body's outline located as edges of the linear luminance and
+// fitted with Ceres.
 //
 // Rays from the predicted centre's image cross `points` tangent points of the predicted outline
-// (the cone of rays tangent to the body, outline_fit.hpp's OutlineGeometry). Along each, the grey
-// level of the frame (8-bit, smoothed by a Gaussian of σ = 1 px) is sampled every half pixel over
-// ±half_width; the edge is the centroid of the gradient above half its strongest peak of the
-// expected polarity (the middle of the edge's ramp: for a short motion blur, the edge at
-// mid-exposure). Rays through the near rail's band are not used. The centre (x, z) and a uniform
-// edge bias (prior N(0, 0.5 px)) are fitted to the edge points' viewing rays with a Cauchy loss
-// (scale 0.5 px): the angle between each ray and the centre's direction minus the outline's half
-// angle, in pixels. A second, narrow pass (±2.5 px) around the first fit when it moved more than a
-// pixel or lost edges.
+// (the cone of rays tangent to the body, outline_fit.hpp's OutlineGeometry). Along each, the
+// frame's luminance in linear light (each channel decoded by the camera's transfer curve,
+// linear_light.hpp, weighted as Rec. 709, on a 0..255 scale; smoothed by a Gaussian of σ = 1 px)
+// is sampled every half pixel over ±half_width; the edge is the centroid of the gradient above
+// half its strongest peak of the expected polarity. In linear light a motion-blurred edge is a
+// blend of body and background whose ramp runs straight across the edge's sweep, so that
+// centroid is the outline at mid-exposure (up to the outline's curvature over the sweep, about
+// blur²/(16·radius) at the sides, the same on opposite sides); in the camera's encoded grey the
+// ramp bends and its centroid moves toward the darker side by a fraction of the blur. Rays
+// through the near rail's band are not used. The centre (x, z) and a uniform edge bias (prior
+// N(0, 0.5 px)) are fitted to the edge points' viewing rays with a Cauchy loss (scale 0.5 px):
+// the angle between each ray and the centre's direction minus the outline's half angle, in
+// pixels. A second, narrow pass (±2.5 px) around the first fit when it moved more than a pixel or
+// lost edges.
 //
 // What it assumes, and the tracker checks before trusting it (ball_tracker.cpp, "fast path"):
-// the body differs from its surroundings in grey level all round, the motion blur is short
+// the body differs from its surroundings in luminance all round, the motion blur is short
 // against the radius, the body has no inner edges near its outline, the shutter is global. Where
-// these hold it is about 0.05–0.25 px RMS at a cost of one small Ceres solve (3 parameters,
-// ≤ 96 residuals) per frame; where they do not, its edges are biased (a blurred edge in the
-// camera's gamma-encoded grey is not centred at mid-exposure) or wrong (a painted band's edge).
+// these hold it is about 0.02–0.1 px RMS on the synthetic and ray-traced clips of `uphill bench
+// track` at a cost of one small Ceres solve (3 parameters, ≤ 96 residuals) per frame; where they
+// do not, its edges are wrong (a painted band's edge, a body as bright as its table).
 #pragma once
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include <array>
+
+#include "linear_light.hpp"
 #include "outline_fit.hpp"
 
 namespace uphill::internal {
@@ -38,7 +47,8 @@ struct EdgeFitOutcome {
 
 class EdgeFit {
  public:
-  EdgeFit(const OutlineGeometry& geometry, int points) : geometry_(geometry), points_(points) {}
+  // bgr frames are 8-bit BGR encoded by `transfer` (linear_light.hpp).
+  EdgeFit(const OutlineGeometry& geometry, int points, Transfer transfer);
 
   // Fits the outline near the body centred at (x, z) (m), the edge searched ±half_width px.
   EdgeFitOutcome Measure(const cv::Mat& bgr, double x, double z, double half_width);
@@ -52,6 +62,7 @@ class EdgeFit {
 
   const OutlineGeometry& geometry_;
   int points_;
+  std::array<std::array<float, 256>, 3> luminance_;  // per channel: its share of linear luminance, 0..255
   int polarity_ = 0;  // sign of the grey step from inside to outside the body; 0: unknown
 };
 
