@@ -111,25 +111,7 @@ class RayCost : public ceres::CostFunction {
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const size_t n = ray_.dirs.size();
-    const SmearNodes nodes(body_, parameters[0], ray_.offset, ray_.pieces);
-    std::vector<double> c(n);
-    std::vector<SmearGradient> grad(jacobians && jacobians[0] ? n : 0);
-    for (size_t i = 0; i < n; ++i) c[i] = nodes.Coverage(ray_.dirs[i], grad.empty() ? nullptr : &grad[i]);
-    const RayColours colours = SolveColours(ray_, c, 1.0 / inv_noise_);
-    for (size_t i = 0; i < n; ++i) {
-      const cv::Vec3d I = ray_.image[i];
-      const cv::Vec3d& B = colours.back[i];
-      const cv::Vec3d F = colours.ok ? colours.body : B;
-      for (int ch = 0; ch < 3; ++ch) {
-        residuals[3 * i + ch] = (I[ch] - B[ch] - c[i] * (F[ch] - B[ch])) * inv_noise_;
-        if (!grad.empty()) {
-          double* row = jacobians[0] + (3 * i + ch) * kSmearParameters;
-          const double k = -(F[ch] - B[ch]) * inv_noise_;
-          for (int q = 0; q < kSmearParameters; ++q) row[q] = k * grad[i][q];
-        }
-      }
-    }
+    Compute(parameters[0], residuals, jacobians ? jacobians[0] : nullptr, nullptr);
     return true;
   }
 
@@ -137,15 +119,11 @@ class RayCost : public ceres::CostFunction {
   void Assess(const double* p, double* contrast, double* mean_square) const {
     const size_t n = ray_.dirs.size();
     std::vector<double> r(3 * n);
-    const double* params[] = {p};
-    Evaluate(params, r.data(), nullptr);
+    RayColours colours;
+    Compute(p, r.data(), nullptr, &colours);
     double sum = 0;
     for (double v : r) sum += v * v;
     *mean_square = sum / static_cast<double>(r.size());
-    const SmearNodes nodes(body_, p, ray_.offset, ray_.pieces);
-    std::vector<double> c(n);
-    for (size_t i = 0; i < n; ++i) c[i] = nodes.Coverage(ray_.dirs[i], nullptr);
-    const RayColours colours = SolveColours(ray_, c, 1.0 / inv_noise_);
     cv::Vec3d mean_back(0, 0, 0);
     for (const cv::Vec3d& b : colours.back) mean_back += b;
     *contrast = colours.ok ? cv::norm(colours.body - mean_back / static_cast<double>(n)) : 0.0;
@@ -154,6 +132,31 @@ class RayCost : public ceres::CostFunction {
   size_t samples() const { return ray_.dirs.size(); }
 
  private:
+  // The residuals at p, their Jacobian (row-major, when not null) and the colours solved there
+  // (when not null).
+  void Compute(const double* p, double* residuals, double* jacobian, RayColours* solved) const {
+    const size_t n = ray_.dirs.size();
+    const SmearNodes nodes(body_, p, ray_.offset, ray_.pieces);
+    std::vector<double> c(n);
+    std::vector<SmearGradient> grad(jacobian ? n : 0);
+    for (size_t i = 0; i < n; ++i) c[i] = nodes.Coverage(ray_.dirs[i], grad.empty() ? nullptr : &grad[i]);
+    RayColours colours = SolveColours(ray_, c, 1.0 / inv_noise_);
+    for (size_t i = 0; i < n; ++i) {
+      const cv::Vec3d I = ray_.image[i];
+      const cv::Vec3d& B = colours.back[i];
+      const cv::Vec3d F = colours.ok ? colours.body : B;
+      for (int ch = 0; ch < 3; ++ch) {
+        residuals[3 * i + ch] = (I[ch] - B[ch] - c[i] * (F[ch] - B[ch])) * inv_noise_;
+        if (!grad.empty()) {
+          double* row = jacobian + (3 * i + ch) * kSmearParameters;
+          const double k = -(F[ch] - B[ch]) * inv_noise_;
+          for (int q = 0; q < kSmearParameters; ++q) row[q] = k * grad[i][q];
+        }
+      }
+    }
+    if (solved) *solved = std::move(colours);
+  }
+
   const SmearedBody& body_;
   RaySamples ray_;
   double inv_noise_;
