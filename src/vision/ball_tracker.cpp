@@ -86,6 +86,15 @@ struct BallTracker::Impl {
   bool needs_model = false;
   int distrusted = 0;
   long confident_model_frame = -1;  // the last frame the model measured, its background known
+  // A body found anew where the model could not check it against the background (rays whose
+  // background was never seen: the first frames of a clip) counts once the next frames find it
+  // again near it; found in that frame alone it was the table's texture (wood grain between the
+  // rails), not a body, and it is withdrawn (a revision that says not found).
+  struct Unconfirmed {
+    long frame;
+    bool needs_model_before;
+  };
+  std::optional<Unconfirmed> unconfirmed;
 
   Impl(const Scene& sc, const TrackerOptions& o) : scene(sc), options(o) {}
 
@@ -370,6 +379,9 @@ struct BallTracker::Impl {
   }
 
   void Remember(long f, double t, const BallObservation& o) {
+    // Found again from the unconfirmed frame's track (still in the history): confirmed.
+    if (unconfirmed && f > unconfirmed->frame && !history.empty() && history.front().first <= unconfirmed->frame)
+      unconfirmed.reset();
     samples[f] = Sample{t + o.time_offset, o.x, o.z};
     history.emplace_back(f, Sample{t + o.time_offset, o.x, o.z});
     if (history.size() > kHistory) history.pop_front();
@@ -460,6 +472,23 @@ struct BallTracker::Impl {
       pending_bytes -= it->window.total() * it->window.elemSize();
       it = pending.erase(it);
     }
+  }
+
+  void Withdraw() {
+    const long k = unconfirmed->frame;
+    revisions.emplace_back(k, BallObservation{});
+    samples.erase(k);
+    for (auto it = pending.begin(); it != pending.end();) {
+      if (it->frame != k) {
+        ++it;
+        continue;
+      }
+      pending_bytes -= it->window.total() * it->window.elemSize();
+      it = pending.erase(it);
+    }
+    std::erase_if(history, [k](const auto& h) { return h.first == k; });
+    needs_model = unconfirmed->needs_model_before;
+    unconfirmed.reset();
   }
 
   // Scene residual and gain bookkeeping (SceneChangedAt, ExposureChanges).
@@ -596,7 +625,9 @@ std::vector<std::pair<long, BallObservation>> BallTracker::TakeRevisions() {
 }
 
 void BallTracker::Finish() {
-  impl_->FitAgain(true);
+  Impl& m = *impl_;
+  m.FitAgain(true);
+  if (m.unconfirmed && m.frame_index > m.unconfirmed->frame) m.Withdraw();
 }
 const std::vector<long>& BallTracker::ExposureChanges() const { return impl_->exposure_changes; }
 
@@ -617,6 +648,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
 
   Vector2d centre, velocity;
   const bool predicted = m.Predict(f, t, &centre, &velocity);
+  if (m.unconfirmed && !predicted) m.Withdraw();  // not found again while it could be predicted
   if (predicted && m.row_delay > 0) {
     // The reference time: the mid-exposure of the predicted centre's row.
     const double row = m.geometry.Project(centre.x(), centre.y()).y();
@@ -631,6 +663,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
 
   // A frame the model measured. `acquired`: the body was found anew (not near the prediction).
   auto finish = [&](const FitOutcome& fit, const FitRequest& q, bool acquired) {
+    const bool needs_model_before = m.needs_model;
     BallObservation o = m.Observe(fit, q);
     m.noises.push_back(std::clamp(fit.noise, 1e-3, 0.2));
     if (m.noises.size() > 15) m.noises.pop_front();
@@ -666,6 +699,10 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
       }
     }
     m.Remember(f, t, o);
+    if (m.history.size() == 1 && fit.rays_without_background > 0) {
+      if (m.unconfirmed) m.Withdraw();
+      m.unconfirmed = Impl::Unconfirmed{f, needs_model_before};
+    }
     m.KeepForRefit(f, t, frame, gain, fit, o, motion_known, edge_fallback);
     // Not while a scene change is being confirmed: the changed picture is not the background.
     if (m.scene_suspect == 0)

@@ -61,7 +61,9 @@
 //
 // Hard cases: the near rail hides the lower edge (masked); the body leaves the frame or drops
 // between the rails (lost: found = false, quality 0; the next frames search the path again); a
-// frame with no body anywhere (not found, never invented); a double cone (refused). Where the
+// frame with no body anywhere (not found, never invented: a body found anew before the background
+// under it was seen, in the first frames, counts only once the next frames find it again near it;
+// else it was the table's texture and is withdrawn by a revision); a double cone (refused). Where the
 // body rested since the first frame the background under it is unknown until it leaves: those
 // rays use a background constant along the ray, solved in the fit.
 #pragma once
