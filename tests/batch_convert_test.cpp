@@ -1,16 +1,11 @@
 // The batch kernels (model/batch_convert.hpp) against the scalar model: kScalar bit for bit,
-// kAvx2 within a few ulp; both against the 60-digit references; and GaussianStream bit for bit
-// against boost::random::normal_distribution.
+// kAvx2 within a few ulp; both against the 60-digit references.
 #include "model/batch_convert.hpp"
-#include "model/gaussian_stream.hpp"
 
 #include <gtest/gtest.h>
 
-#include <Random123/philox.h>
-
 #include <boost/random/mersenne_twister.hpp>
 
-#include <boost/random/normal_distribution.hpp>
 #include <boost/random/uniform_real_distribution.hpp>
 #include <cmath>
 #include <cstring>
@@ -228,65 +223,6 @@ TEST(BatchConvert, ReferenceCases) {
     }
     EXPECT_GE(checked, 18);  // 4 lab cases and the sweeps' rows
   }
-}
-
-// The stream as gaussian_stream.hpp documents it, written out here from Random123 itself: a
-// 64-bit engine whose words are the Philox4x32-10 blocks (counter (j lo, j hi, id, 0), key = seed).
-struct DocumentedPhiloxWords {
-  using result_type = std::uint64_t;
-  static constexpr result_type min() { return 0; }
-  static constexpr result_type max() { return ~result_type{0}; }
-  std::uint64_t seed;
-  std::uint32_t id;
-  std::uint64_t k = 0;
-  result_type operator()() {
-    const std::uint64_t j = k / 2;
-    const r123::Philox4x32::ctr_type c = {{static_cast<std::uint32_t>(j), static_cast<std::uint32_t>(j >> 32), id, 0}};
-    const r123::Philox4x32::key_type key = {{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32)}};
-    const r123::Philox4x32::ctr_type r = r123::Philox4x32()(c, key);
-    const bool second = k++ % 2 == 1;
-    return second ? r.v[2] | (std::uint64_t{r.v[3]} << 32) : r.v[0] | (std::uint64_t{r.v[1]} << 32);
-  }
-};
-
-TEST(GaussianStream, IsBoostsNormalDistributionOnThePhiloxStreamBitForBit) {
-  const std::size_t n = 1'000'003;
-  for (std::uint64_t seed : {1ull, 0x9E3779B97F4A7C15ull}) {
-    for (std::uint32_t id : {0u, 7u}) {
-      DocumentedPhiloxWords engine{seed, id};
-      boost::random::normal_distribution<double> unit;
-      std::vector<double> expected(n);
-      for (double& z : expected) z = unit(engine);
-      for (VectorKernel kernel : Kernels()) {
-        SCOPED_TRACE(VectorKernelName(kernel));
-        GaussianStream stream(seed, id);
-        std::vector<double> z(n);
-        // Odd chunk sizes: the stream's state carries over between calls.
-        std::size_t done = 0, chunk = 1;
-        while (done < n) {
-          const std::size_t m = std::min(chunk, n - done);
-          stream.Fill(m, z.data() + done, kernel);
-          done += m;
-          chunk = chunk * 7 % 2053 + 1;
-        }
-        std::size_t mismatches = 0;
-        for (std::size_t i = 0; i < n; ++i) mismatches += !SameBits(z[i], expected[i]);
-        EXPECT_EQ(mismatches, 0u);
-      }
-    }
-  }
-}
-
-// Philox's first published known-answer vector (Random123's kat_vectors: philox4x32 10 rounds,
-// counter and key all ones): the generator this build links is the one documented.
-TEST(GaussianStream, PhiloxKnownAnswer) {
-  const r123::Philox4x32::ctr_type c = {{0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff}};
-  const r123::Philox4x32::key_type key = {{0xffffffff, 0xffffffff}};
-  const r123::Philox4x32::ctr_type r = r123::Philox4x32()(c, key);
-  EXPECT_EQ(r.v[0], 0x408f276du);
-  EXPECT_EQ(r.v[1], 0x41c83b0eu);
-  EXPECT_EQ(r.v[2], 0xa20bc7c6u);
-  EXPECT_EQ(r.v[3], 0x6d5451fdu);
 }
 
 TEST(VectorKernelName, NamesTheChoice) {

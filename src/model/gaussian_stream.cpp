@@ -2,7 +2,8 @@
 
 #include <Random123/philox.h>
 
-#include <boost/random/normal_distribution.hpp>
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
 // The AVX2 kernels need no libmvec (integer and IEEE arithmetic only); whether they run is still
@@ -16,38 +17,17 @@
 
 namespace uphill {
 
-// Boost's normal_distribution reads the engine through this view of the stream's buffer, so the
-// scalar path and the vector path's fallback consume exactly the outputs Boost would.
-struct GaussianStreamAccess {
-  using result_type = std::uint64_t;
-  static constexpr result_type min() { return 0; }
-  static constexpr result_type max() { return ~result_type{0}; }
-  GaussianStream* s;
-  result_type operator()() {
-    if (s->pos_ == s->end_) s->Refill();
-    return s->buffer_[s->pos_++];
-  }
-  static double Next(GaussianStream* stream) {
-    // A 64-bit engine (0 .. 2^64 − 1): Boost takes its fast 64-bit path.
-    GaussianStreamAccess engine{stream};
-    return boost::random::normal_distribution<double>()(engine);
-  }
-  static std::size_t Available(const GaussianStream* s) { return s->end_ - s->pos_; }
-  static const std::uint64_t* Peek(const GaussianStream* s) { return s->buffer_ + s->pos_; }
-  static void Skip(GaussianStream* s, std::size_t k) { s->pos_ += k; }
-};
-
 namespace {
 
 // Blocks [first, first + count) of the stream (gaussian_stream.hpp), two words each, by
 // Random123's own Philox4x32-10.
 void PhiloxBlocks(std::uint64_t first, std::size_t count, const std::uint32_t key[2], std::uint32_t id,
-                  std::uint64_t* words) {
+                  std::uint32_t lane3, std::uint64_t* words) {
   const r123::Philox4x32 philox;
   const r123::Philox4x32::key_type k = {{key[0], key[1]}};
   for (std::size_t b = 0; b < count; ++b) {
     const std::uint64_t j = first + b;
-    const r123::Philox4x32::ctr_type c = {{static_cast<std::uint32_t>(j), static_cast<std::uint32_t>(j >> 32), id, 0}};
+    const r123::Philox4x32::ctr_type c = {{static_cast<std::uint32_t>(j), static_cast<std::uint32_t>(j >> 32), id, lane3}};
     const r123::Philox4x32::ctr_type r = philox(c, k);
     words[2 * b] = r.v[0] | (std::uint64_t{r.v[1]} << 32);
     words[2 * b + 1] = r.v[2] | (std::uint64_t{r.v[3]} << 32);
@@ -70,7 +50,7 @@ inline void MulHiLo(__m256i x, __m256i m, __m256i* hi, __m256i* lo) {
 // on vector lanes, block b in lane b % 8 of set b / 8 (four independent sets hide the multiplies'
 // latency). Falls back to PhiloxBlocks where j's low word would wrap.
 void PhiloxBlocksAvx2(std::uint64_t first, std::size_t count, const std::uint32_t key[2], std::uint32_t id,
-                      std::uint64_t* words) {
+                      std::uint32_t lane3, std::uint64_t* words) {
   constexpr int kSets = 4;
   std::size_t b = 0;
   const __m256i m0 = _mm256_set1_epi32(static_cast<int>(PHILOX_M4x32_0));
@@ -79,7 +59,7 @@ void PhiloxBlocksAvx2(std::uint64_t first, std::size_t count, const std::uint32_
   for (; b + 8 * kSets <= count; b += 8 * kSets) {
     const std::uint64_t j = first + b;
     if (static_cast<std::uint32_t>(j) > 0xFFFFFFFFu - 8 * kSets) {
-      PhiloxBlocks(j, 8 * kSets, key, id, words + 2 * b);
+      PhiloxBlocks(j, 8 * kSets, key, id, lane3, words + 2 * b);
       continue;
     }
     __m256i x0[kSets], x1[kSets], x2[kSets], x3[kSets];
@@ -87,7 +67,7 @@ void PhiloxBlocksAvx2(std::uint64_t first, std::size_t count, const std::uint32_
       x0[s] = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(static_cast<std::uint32_t>(j) + 8u * s)), lane);
       x1[s] = _mm256_set1_epi32(static_cast<int>(static_cast<std::uint32_t>(j >> 32)));
       x2[s] = _mm256_set1_epi32(static_cast<int>(id));
-      x3[s] = _mm256_setzero_si256();
+      x3[s] = _mm256_set1_epi32(static_cast<int>(lane3));
     }
     std::uint32_t k0 = key[0], k1 = key[1];
     for (int round = 0; round < 10; ++round) {
@@ -117,11 +97,37 @@ void PhiloxBlocksAvx2(std::uint64_t first, std::size_t count, const std::uint32_
       _mm256_storeu_si256(out + 3, _mm256_permute2x128_si256(p1, q1, 0x31));  // blocks 6, 7
     }
   }
-  PhiloxBlocks(first + b, count - b, key, id, words + 2 * b);
+  PhiloxBlocks(first + b, count - b, key, id, lane3, words + 2 * b);
 }
 
 #pragma GCC pop_options
 #endif  // UPHILL_NORMALS_AVX2
+
+
+// The fast path's two numbers per layer side by side (one 16-byte load per word): x_i·2^-52
+// (exact: a power-of-two scaling of a normal double) and x_{i+1}.
+struct alignas(16) LayerPair {
+  double scale, next;
+};
+struct FastTable {
+  LayerPair layer[ziggurat::kLayers];
+  constexpr FastTable() : layer() {
+    for (int i = 0; i < ziggurat::kLayers; ++i)
+      layer[i] = {ziggurat::kX[i] * 0x1p-52, ziggurat::kX[i + 1]};
+  }
+};
+constexpr FastTable kFast;
+constexpr std::uint64_t kLayerMask = ziggurat::kLayers - 1;
+static_assert((ziggurat::kLayers & kLayerMask) == 0 && kLayerMask == 1023,
+              "the stream's definition uses 10 bits for the layer, bit 10 for the sign");
+
+// The fast path of gaussian_stream.hpp for one word: *z = ±x, true when accepted.
+inline bool FastPath(std::uint64_t w, double* z) {
+  const LayerPair& p = kFast.layer[w & kLayerMask];
+  const double x = static_cast<double>(w >> 12) * p.scale;  // < 2^52: converted exactly
+  *z = (w >> 10) & 1 ? -x : x;
+  return x < p.next;
+}
 
 }  // namespace
 
@@ -131,81 +137,117 @@ void GaussianStream::Refill() {
   const std::size_t blocks = (kBuffer - left) / 2;
 #if UPHILL_NORMALS_AVX2
   if (avx2_) {
-    PhiloxBlocksAvx2(next_block_, blocks, key_, id_, buffer_ + left);
+    PhiloxBlocksAvx2(next_block_, blocks, key_, id_, 0, buffer_ + left);
   } else {
-    PhiloxBlocks(next_block_, blocks, key_, id_, buffer_ + left);
+    PhiloxBlocks(next_block_, blocks, key_, id_, 0, buffer_ + left);
   }
 #else
-  PhiloxBlocks(next_block_, blocks, key_, id_, buffer_ + left);
+  PhiloxBlocks(next_block_, blocks, key_, id_, 0, buffer_ + left);
 #endif
   next_block_ += blocks;
   pos_ = 0;
   end_ = left + 2 * blocks;
 }
 
+void GaussianStream::RefillSide() {
+  constexpr std::size_t blocks = kSideBuffer / 2;
+#if UPHILL_NORMALS_AVX2
+  if (avx2_) {
+    PhiloxBlocksAvx2(next_side_block_, blocks, key_, id_, 1, side_);
+  } else {
+    PhiloxBlocks(next_side_block_, blocks, key_, id_, 1, side_);
+  }
+#else
+  PhiloxBlocks(next_side_block_, blocks, key_, id_, 1, side_);
+#endif
+  next_side_block_ += blocks;
+  side_pos_ = 0;
+}
+
+// The slow path of gaussian_stream.hpp for main word w whose fast path rejected: wedge, tail and
+// retries, reading side words in order.
+struct GaussianStreamAccess {
+  template <bool kScale>
+  static void Fill(GaussianStream* s, std::size_t n, double mean, double scale, double* out, VectorKernel kernel);
+  static double SlowPath(GaussianStream* s, std::uint64_t w) {
+    for (;;) {
+      const std::size_t i = w & kLayerMask;
+      const bool negative = (w >> 10) & 1;
+      const double x = static_cast<double>(w >> 12) * kFast.layer[i].scale;
+      if (x < kFast.layer[i].next) return negative ? -x : x;  // a retry's fast path
+      if (i == 0) {
+        for (;;) {
+          const double a = static_cast<double>((s->NextSide() >> 11) + 1) * 0x1p-53;
+          const double b = static_cast<double>((s->NextSide() >> 11) + 1) * 0x1p-53;
+          const double xi = -std::log(a) / ziggurat::kR;
+          const double eta = -std::log(b);
+          if (eta + eta > xi * xi) return negative ? -(ziggurat::kR + xi) : ziggurat::kR + xi;
+        }
+      }
+      const double u = static_cast<double>(s->NextSide() >> 11) * 0x1p-53;
+      const double y = ziggurat::kF[i] + u * (ziggurat::kF[i + 1] - ziggurat::kF[i]);
+      if (y < std::exp(-(x * x) * 0.5)) return negative ? -x : x;
+      w = s->NextSide();
+    }
+  }
+};
+
 namespace {
+
+// Deviates (kScale: mean + scale·z) for the words w[0 … n), fast path only; the offsets of the
+// rejected words are appended to `rejected`, and their outputs are to be overwritten.
+template <bool kScale>
+std::size_t FastScalar(const std::uint64_t* w, std::size_t n, double mean, double scale, double* out,
+                       std::uint32_t* rejected) {
+  std::size_t count = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    double z;
+    if (!FastPath(w[j], &z)) rejected[count++] = static_cast<std::uint32_t>(j);
+    out[j] = kScale ? mean + scale * z : z;
+  }
+  return count;
+}
 
 #if UPHILL_NORMALS_AVX2
 #pragma GCC push_options
-// No "fma": nothing here may be contracted, the values must be Boost's to the bit.
+// No "fma": nothing here may be contracted; the values must be the scalar code's to the bit.
 #pragma GCC target("avx2")
 
-// Boost 1.74's unit_normal_distribution fast path for a 64-bit engine (detail/int_float_pair.hpp,
-// normal_distribution.hpp), four outputs u at a time:
-//   bucket = u & 0xFF; i = bucket >> 1; sign = bucket & 1 ? +1 : −1
-//   r = double((u & ~(1 << 11)) >> 8) · 2^-56     (the int → double conversion rounds to nearest)
-//   x = r · table_x[i]; accepted iff x < table_x[i + 1]; value x·sign.
-// The 56-bit integer is converted exactly as cvtsi2sd does: high and low 32-bit halves are exact
-// doubles, and their sum hi·2^32 + lo is rounded once. Returns the accepted lanes as a bit mask.
-int FastNormals4(const std::uint64_t* u, double* z) {
-  const double* table_x = boost::random::detail::normal_table<double>::table_x;
-  const __m256i raw = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(u));
-  const __m256i bucket = _mm256_and_si256(raw, _mm256_set1_epi64x(0xFF));
-  const __m256i bits = _mm256_srli_epi64(_mm256_andnot_si256(_mm256_set1_epi64x(1 << 11), raw), 8);
-  // 2^52 + k as a double is exact for k < 2^32: the classic exact uint32 → double conversion.
+// FastScalar four words at a time, the same operations lane by lane: the 52-bit m becomes a double
+// exactly as 2^52 + m (its bits OR-ed into 2^52's) minus 2^52; bit 10 moved to the sign bit is the
+// negation; the table pair of each lane by one 16-byte load (scalar loads beat AVX2 gathers on
+// current x86 cores).
+template <bool kScale>
+std::size_t FastAvx2(const std::uint64_t* w, std::size_t n, double mean, double scale, double* out,
+                     std::uint32_t* rejected) {
   const __m256i magic = _mm256_set1_epi64x(0x4330000000000000LL);
-  const __m256d two52 = _mm256_set1_pd(4503599627370496.0);
-  const __m256d lo = _mm256_sub_pd(
-      _mm256_castsi256_pd(_mm256_or_si256(_mm256_and_si256(bits, _mm256_set1_epi64x(0xFFFFFFFFLL)), magic)),
-      two52);
-  const __m256d hi = _mm256_sub_pd(
-      _mm256_castsi256_pd(_mm256_or_si256(_mm256_srli_epi64(bits, 32), magic)), two52);
-  const __m256d r = _mm256_mul_pd(
-      _mm256_add_pd(_mm256_mul_pd(hi, _mm256_set1_pd(4294967296.0)), lo),
-      _mm256_set1_pd(1.0 / 72057594037927936.0));  // 2^-56
-  // Table lookups by scalar loads: AVX2 gathers are slower than four loads on current x86 cores.
-  const std::size_t i0 = (u[0] & 0xFF) >> 1, i1 = (u[1] & 0xFF) >> 1, i2 = (u[2] & 0xFF) >> 1,
-                    i3 = (u[3] & 0xFF) >> 1;
-  const __m256d x = _mm256_mul_pd(r, _mm256_set_pd(table_x[i3], table_x[i2], table_x[i1], table_x[i0]));
-  const __m256d next = _mm256_set_pd(table_x[i3 + 1], table_x[i2 + 1], table_x[i1 + 1], table_x[i0 + 1]);
-  const int accepted = _mm256_movemask_pd(_mm256_cmp_pd(x, next, _CMP_LT_OQ));
-  // sign −1 (bucket bit 0 clear): flip the sign bit, which is what x·(−1.0) does, also for 0.
-  const __m256i minus = _mm256_slli_epi64(
-      _mm256_xor_si256(_mm256_and_si256(bucket, _mm256_set1_epi64x(1)), _mm256_set1_epi64x(1)), 63);
-  _mm256_storeu_pd(z, _mm256_xor_pd(x, _mm256_castsi256_pd(minus)));
-  return accepted;
-}
-
-void Avx2Normals(GaussianStream* stream, std::size_t n, double* z) {
-  std::size_t k = 0;
-  while (k + 4 <= n) {
-    if (GaussianStreamAccess::Available(stream) < 4) {
-      z[k++] = GaussianStreamAccess::Next(stream);  // refills the buffer, keeping order
-      continue;
-    }
-    const int accepted = FastNormals4(GaussianStreamAccess::Peek(stream), z + k);
-    if (accepted == 0xF) {
-      GaussianStreamAccess::Skip(stream, 4);
-      k += 4;
-      continue;
-    }
-    // Lanes before the first rejected one are final; Boost produces the rejected one.
-    const int good = __builtin_ctz(~accepted & 0xF);
-    GaussianStreamAccess::Skip(stream, static_cast<std::size_t>(good));
-    k += static_cast<std::size_t>(good);
-    z[k++] = GaussianStreamAccess::Next(stream);
+  const __m256d two52 = _mm256_set1_pd(0x1p52);
+  const __m256i sign_bit = _mm256_set1_epi64x(static_cast<long long>(1ULL << 63));
+  const __m256d vmean = _mm256_set1_pd(mean), vscale = _mm256_set1_pd(scale);
+  const double* table = &kFast.layer[0].scale;
+  std::size_t count = 0, j = 0;
+  for (; j + 4 <= n; j += 4) {
+    const __m256i word = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(w + j));
+    const __m128d p0 = _mm_load_pd(table + 2 * (w[j] & kLayerMask));
+    const __m128d p1 = _mm_load_pd(table + 2 * (w[j + 1] & kLayerMask));
+    const __m128d p2 = _mm_load_pd(table + 2 * (w[j + 2] & kLayerMask));
+    const __m128d p3 = _mm_load_pd(table + 2 * (w[j + 3] & kLayerMask));
+    const __m256d p02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(p0), p2, 1);  // s0 n0 s2 n2
+    const __m256d p13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(p1), p3, 1);  // s1 n1 s3 n3
+    const __m256d lane_scale = _mm256_unpacklo_pd(p02, p13), next = _mm256_unpackhi_pd(p02, p13);
+    const __m256d m = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(_mm256_srli_epi64(word, 12), magic)), two52);
+    const __m256d x = _mm256_mul_pd(m, lane_scale);
+    const int accepted = _mm256_movemask_pd(_mm256_cmp_pd(x, next, _CMP_LT_OQ));
+    __m256d z = _mm256_xor_pd(x, _mm256_castsi256_pd(_mm256_and_si256(_mm256_slli_epi64(word, 53), sign_bit)));
+    if (kScale) z = _mm256_add_pd(vmean, _mm256_mul_pd(vscale, z));
+    _mm256_storeu_pd(out + j, z);
+    if (__builtin_expect(accepted != 0xF, 0))
+      for (int lane = 0; lane < 4; ++lane)
+        if (!(accepted & (1 << lane))) rejected[count++] = static_cast<std::uint32_t>(j + lane);
   }
-  for (; k < n; ++k) z[k] = GaussianStreamAccess::Next(stream);
+  const std::size_t tail = FastScalar<kScale>(w + j, n - j, mean, scale, out + j, rejected + count);
+  for (std::size_t t = count; t < count + tail; ++t) rejected[t] += static_cast<std::uint32_t>(j);
+  return count + tail;
 }
 
 #pragma GCC pop_options
@@ -213,14 +255,42 @@ void Avx2Normals(GaussianStream* stream, std::size_t n, double* z) {
 
 }  // namespace
 
-void GaussianStream::Fill(std::size_t n, double* z, VectorKernel kernel) {
+// Fill and FillScaled: the main words in the buffer's chunks, the fast path over each chunk, then
+// its rejected words in order (so the side words are read in the deviates' order).
+template <bool kScale>
+void GaussianStreamAccess::Fill(GaussianStream* s, std::size_t n, double mean, double scale, double* out,
+                                VectorKernel kernel) {
 #if UPHILL_NORMALS_AVX2
-  avx2_ = UseAvx2(kernel);
-  if (avx2_) return Avx2Normals(this, n, z);
+  s->avx2_ = UseAvx2(kernel);
 #else
   UseAvx2(kernel);
 #endif
-  for (std::size_t k = 0; k < n; ++k) z[k] = GaussianStreamAccess::Next(this);
+  std::uint32_t rejected[GaussianStream::kBuffer];
+  for (std::size_t k = 0; k < n;) {
+    if (s->pos_ == s->end_) s->Refill();
+    const std::size_t c = std::min(s->end_ - s->pos_, n - k);
+    const std::uint64_t* w = s->buffer_ + s->pos_;
+#if UPHILL_NORMALS_AVX2
+    const std::size_t r = s->avx2_ ? FastAvx2<kScale>(w, c, mean, scale, out + k, rejected)
+                                   : FastScalar<kScale>(w, c, mean, scale, out + k, rejected);
+#else
+    const std::size_t r = FastScalar<kScale>(w, c, mean, scale, out + k, rejected);
+#endif
+    for (std::size_t t = 0; t < r; ++t) {
+      const double z = SlowPath(s, w[rejected[t]]);
+      out[k + rejected[t]] = kScale ? mean + scale * z : z;
+    }
+    s->pos_ += c;
+    k += c;
+  }
+}
+
+void GaussianStream::Fill(std::size_t n, double* z, VectorKernel kernel) {
+  GaussianStreamAccess::Fill<false>(this, n, 0.0, 1.0, z, kernel);
+}
+
+void GaussianStream::FillScaled(std::size_t n, double mean, double scale, double* y, VectorKernel kernel) {
+  GaussianStreamAccess::Fill<true>(this, n, mean, scale, y, kernel);
 }
 
 }  // namespace uphill

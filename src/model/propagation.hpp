@@ -29,13 +29,13 @@
 //
 // Reproducibility. Each input has its own counter-based stream: Random123's Philox4x32-10 with
 // key = options.seed and the input's index (InputQuantity, 0 … kNumInputs − 1) as the stream id
-// in the counter; the Gaussian draws are exactly the values of
-// boost::random::normal_distribution<double> on that stream's 64-bit words (a fixed ziggurat,
-// unlike std::normal_distribution, whose algorithm is implementation-defined), produced by
-// GaussianStream (gaussian_stream.hpp, which states the stream to the bit), whose vectorised
-// kernel is bit-identical to Random123 + Boost. Trial k of an input uses its k-th draw. So the
-// trials' inputs depend only on the seed and the Boost version, not on the machine, and a draw
-// of D does not change when another input gains or loses its uncertainty. The outputs
+// in the counter, turned into standard normal deviates by a 1024-layer ziggurat with fixed,
+// generated tables: GaussianStream (gaussian_stream.hpp, which states the stream operation by
+// operation; its AVX2 and scalar kernels give the same bits). Input i of trial k is
+// value_i + u_i·z_k (one multiplication, one addition) with z_k the k-th deviate of stream i. So
+// the trials' inputs depend only on the seed (not on the machine, the compiler or a library's
+// version; the rare tail deviates up to the C library's log in the last bit), and a draw of D
+// does not change when another input gains or loses its uncertainty. The outputs
 // come from the batch kernel (batch_convert.hpp): the same numbers on every run, to a few ulp the
 // same on another CPU (kScalar and kAvx2 differ in the last bits; options.kernel picks one).
 //
@@ -48,8 +48,7 @@
 // interval is found without sorting the M values: a pilot of 2^14 trials places a narrow window
 // around each quantile, later trials are only counted (below) or kept (inside) — exact, with an
 // exact rerun in the (≈ 1e-4 probable) case that a window misses. Memory: ≈ 2 % of M per output.
-// About half of a trial's time is its Gaussian draws (`uphill bench convert` measures it:
-// docs/benchmarks.md).
+// `uphill bench convert` measures the cost per trial against NumPy (docs/benchmarks.md).
 
 // Errors: InputError (model/input_error.hpp) naming the quantity and the rule, for a bad value
 // (the model's own checks: e.g. "D: must be > 0 (got -0.003)"), a bad uncertainty

@@ -118,10 +118,7 @@ class MonteCarloRun {
     for (std::uint64_t done = 0; done < o_.trials;) {
       const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(kBlock, o_.trials - done));
       for (Stream& s : streams) {
-        double* in = Input(s.input);
-        s.gauss.Fill(n, in, o_.kernel);
-        const double v = p_.value[s.input], u = p_.u[s.input];
-        for (std::size_t j = 0; j < n; ++j) in[j] = v + u * in[j];
+        s.gauss.FillScaled(n, p_.value[s.input], p_.u[s.input], Input(s.input), o_.kernel);
       }
       const std::size_t valid = Evaluate(n, &rejected);
       for (std::size_t k = 0; k < nout; ++k) {
