@@ -266,11 +266,17 @@ TEST(MonteCarlo, StronglyNonlinearCaseIsFlagged) {
 // The coverage interval is the exact pair of order statistics of JCGM 101 §7.7, whether the
 // windows or the store-everything path found it; mean and standard deviation equal a two-pass
 // computation over the same samples.
+// Both kernels: the windows' and the moments' vector pass and their scalar pass.
 TEST(MonteCarlo, StatisticsAreThoseOfTheSamples) {
+  std::vector<VectorKernel> kernels = {VectorKernel::kScalar};
+  if (VectorKernelAvailable(VectorKernel::kAvx2)) kernels.push_back(VectorKernel::kAvx2);
+  for (VectorKernel kernel : kernels)
   for (std::uint64_t m : {2001ull, 100000ull}) {
     SCOPED_TRACE(m);
+    SCOPED_TRACE(VectorKernelName(kernel));
     PropagationOptions o = Trials(m, 7);
     o.keep_samples = true;
+    o.kernel = kernel;
     const auto res = Propagate(UncertainRails::Apparatus({kL, 0.002}, {kH, 0.001}, {kD, 0.003}),
                                UncertainBody::Spheroid({kA, 2e-5}, {kB, 2e-5}), {}, o);
     const auto ys = res.Outputs();

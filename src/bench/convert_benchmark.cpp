@@ -223,9 +223,11 @@ void RunConvertBenchmark(const ConvertBenchmarkOptions& f, std::ostream& out) {
       Printf("|u_NumPy/u_uphill - 1| <= %.2f %% (statistical)", 100 * worst_np));
 
   const double speed_convert = np_batch.seconds / batch.seconds, speed_mc = np_monte_carlo.seconds / monte_carlo.seconds;
+  // Issue 14 sets no speed goal for the conversion (its 10x was measured against an older, slower
+  // NumPy peer, and it asks to keep the kernel as it is); the agreement with NumPy is checked.
   const std::string goal_convert = "uphill vs NumPy per core: convert " + FormatRatio(speed_convert) +
-                                   " (goal >= 10x, rel diff " + Printf("%.2g", diff) + ", goal <= 1e-14): " +
-                                   (speed_convert >= 10 && diff <= 1e-14 ? "met" : "NOT met");
+                                   " (no speed goal; rel diff " + Printf("%.2g", diff) + ", goal <= 1e-14: " +
+                                   (diff <= 1e-14 ? "met" : "NOT met") + ")";
   const std::string goal_mc = "uphill vs NumPy per core: Monte Carlo " + FormatRatio(speed_mc) + " (goal >= 10x): " +
                               (speed_mc >= 10 ? "met" : "NOT met");
   out << "\n" << goal_convert << "\n" << goal_mc << "\n";

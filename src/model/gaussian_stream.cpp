@@ -168,7 +168,8 @@ void GaussianStream::RefillSide() {
 // retries, reading side words in order.
 struct GaussianStreamAccess {
   template <bool kScale>
-  static void Fill(GaussianStream* s, std::size_t n, double mean, double scale, double* out, VectorKernel kernel);
+  static void Fill(GaussianStream* s, std::size_t n, double mean, double scale, double* out, VectorKernel kernel,
+                   GaussianStream::Range* range);
   static double SlowPath(GaussianStream* s, std::uint64_t w) {
     for (;;) {
       const std::size_t i = w & kLayerMask;
@@ -196,15 +197,21 @@ namespace {
 
 // Deviates (kScale: mean + scale·z) for the words w[0 … n), fast path only; the offsets of the
 // rejected words are appended to `rejected`, and their outputs are to be overwritten.
+// *range grows to contain every output written (also those to be overwritten: it may be wider
+// than the final values, never narrower).
 template <bool kScale>
 std::size_t FastScalar(const std::uint64_t* w, std::size_t n, double mean, double scale, double* out,
-                       std::uint32_t* rejected) {
+                       std::uint32_t* rejected, GaussianStream::Range* range) {
   std::size_t count = 0;
+  double lo = range->min, hi = range->max;
   for (std::size_t j = 0; j < n; ++j) {
     double z;
     if (!FastPath(w[j], &z)) rejected[count++] = static_cast<std::uint32_t>(j);
     out[j] = kScale ? mean + scale * z : z;
+    lo = std::min(lo, out[j]);
+    hi = std::max(hi, out[j]);
   }
+  *range = {lo, hi};
   return count;
 }
 
@@ -219,7 +226,8 @@ std::size_t FastScalar(const std::uint64_t* w, std::size_t n, double mean, doubl
 // current x86 cores).
 template <bool kScale>
 std::size_t FastAvx2(const std::uint64_t* w, std::size_t n, double mean, double scale, double* out,
-                     std::uint32_t* rejected) {
+                     std::uint32_t* rejected, GaussianStream::Range* range) {
+  __m256d lo = _mm256_set1_pd(range->min), hi = _mm256_set1_pd(range->max);
   const __m256i magic = _mm256_set1_epi64x(0x4330000000000000LL);
   const __m256d two52 = _mm256_set1_pd(0x1p52);
   const __m256i sign_bit = _mm256_set1_epi64x(static_cast<long long>(1ULL << 63));
@@ -241,11 +249,18 @@ std::size_t FastAvx2(const std::uint64_t* w, std::size_t n, double mean, double 
     __m256d z = _mm256_xor_pd(x, _mm256_castsi256_pd(_mm256_and_si256(_mm256_slli_epi64(word, 53), sign_bit)));
     if (kScale) z = _mm256_add_pd(vmean, _mm256_mul_pd(vscale, z));
     _mm256_storeu_pd(out + j, z);
+    lo = _mm256_min_pd(lo, z);
+    hi = _mm256_max_pd(hi, z);
     if (__builtin_expect(accepted != 0xF, 0))
       for (int lane = 0; lane < 4; ++lane)
         if (!(accepted & (1 << lane))) rejected[count++] = static_cast<std::uint32_t>(j + lane);
   }
-  const std::size_t tail = FastScalar<kScale>(w + j, n - j, mean, scale, out + j, rejected + count);
+  alignas(32) double l[4], h[4];
+  _mm256_store_pd(l, lo);
+  _mm256_store_pd(h, hi);
+  *range = {std::min(std::min(l[0], l[1]), std::min(l[2], l[3])),
+            std::max(std::max(h[0], h[1]), std::max(h[2], h[3]))};
+  const std::size_t tail = FastScalar<kScale>(w + j, n - j, mean, scale, out + j, rejected + count, range);
   for (std::size_t t = count; t < count + tail; ++t) rejected[t] += static_cast<std::uint32_t>(j);
   return count + tail;
 }
@@ -259,7 +274,8 @@ std::size_t FastAvx2(const std::uint64_t* w, std::size_t n, double mean, double 
 // its rejected words in order (so the side words are read in the deviates' order).
 template <bool kScale>
 void GaussianStreamAccess::Fill(GaussianStream* s, std::size_t n, double mean, double scale, double* out,
-                                VectorKernel kernel) {
+                                VectorKernel kernel, GaussianStream::Range* range) {
+  *range = {HUGE_VAL, -HUGE_VAL};
 #if UPHILL_NORMALS_AVX2
   s->avx2_ = UseAvx2(kernel);
 #else
@@ -271,14 +287,16 @@ void GaussianStreamAccess::Fill(GaussianStream* s, std::size_t n, double mean, d
     const std::size_t c = std::min(s->end_ - s->pos_, n - k);
     const std::uint64_t* w = s->buffer_ + s->pos_;
 #if UPHILL_NORMALS_AVX2
-    const std::size_t r = s->avx2_ ? FastAvx2<kScale>(w, c, mean, scale, out + k, rejected)
-                                   : FastScalar<kScale>(w, c, mean, scale, out + k, rejected);
+    const std::size_t r = s->avx2_ ? FastAvx2<kScale>(w, c, mean, scale, out + k, rejected, range)
+                                   : FastScalar<kScale>(w, c, mean, scale, out + k, rejected, range);
 #else
-    const std::size_t r = FastScalar<kScale>(w, c, mean, scale, out + k, rejected);
+    const std::size_t r = FastScalar<kScale>(w, c, mean, scale, out + k, rejected, range);
 #endif
     for (std::size_t t = 0; t < r; ++t) {
       const double z = SlowPath(s, w[rejected[t]]);
-      out[k + rejected[t]] = kScale ? mean + scale * z : z;
+      const double y = kScale ? mean + scale * z : z;
+      out[k + rejected[t]] = y;
+      *range = {std::min(range->min, y), std::max(range->max, y)};
     }
     s->pos_ += c;
     k += c;
@@ -286,11 +304,15 @@ void GaussianStreamAccess::Fill(GaussianStream* s, std::size_t n, double mean, d
 }
 
 void GaussianStream::Fill(std::size_t n, double* z, VectorKernel kernel) {
-  GaussianStreamAccess::Fill<false>(this, n, 0.0, 1.0, z, kernel);
+  Range range;
+  GaussianStreamAccess::Fill<false>(this, n, 0.0, 1.0, z, kernel, &range);
 }
 
-void GaussianStream::FillScaled(std::size_t n, double mean, double scale, double* y, VectorKernel kernel) {
-  GaussianStreamAccess::Fill<true>(this, n, mean, scale, y, kernel);
+GaussianStream::Range GaussianStream::FillScaled(std::size_t n, double mean, double scale, double* y,
+                                                 VectorKernel kernel) {
+  Range range;
+  GaussianStreamAccess::Fill<true>(this, n, mean, scale, y, kernel, &range);
+  return range;
 }
 
 }  // namespace uphill

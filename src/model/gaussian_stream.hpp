@@ -63,9 +63,14 @@ class GaussianStream {
       : key_{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32)}, id_(id) {}
   // The next n deviates z_k.
   void Fill(std::size_t n, double* z, VectorKernel kernel = VectorKernel::kAuto);
+  // Bounds that contain every value of a fill (they may be wider, never narrower): a caller that
+  // screens its draws against a domain checks two numbers instead of n.
+  struct Range {
+    double min = 0.0, max = 0.0;
+  };
   // The next n deviates as mean + scale·z_k: one IEEE multiplication, then one addition.
-  void FillScaled(std::size_t n, double mean, double scale, double* y,
-                  VectorKernel kernel = VectorKernel::kAuto);
+  Range FillScaled(std::size_t n, double mean, double scale, double* y,
+                   VectorKernel kernel = VectorKernel::kAuto);
 
  private:
   friend struct GaussianStreamAccess;

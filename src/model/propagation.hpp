@@ -8,6 +8,11 @@
 //       10^6); per output the mean, the standard deviation (divisor M − 1) and the
 //       probabilistically symmetric 95 % coverage interval [y_(r), y_(r+q)], q = pM rounded,
 //       r = (M − q)/2 rounded up (JCGM 101 §7.7), from exact order statistics.
+//       Mean and u come from the shifted sums S1 = Σ(y − s), S2 = Σ(y − s)², s = the first valid
+//       trial's value (a sample, so |ȳ − s| is a few u), as plain sums over each block of 1024
+//       trials added up with Neumaier's compensation: u² = (S2 − S1²/M)/(M − 1) then loses
+//       relative accuracy ≈ 2^-53·(1024 + (ȳ − s)²/u²)·a few, i.e. u is good to ~1e-12 or better
+//       (the statistical error, 1/sqrt(2M), is ~1e-3); the mean to ~1e-13·u.
 //
 // The two agree when the model is close to linear over ± a few u; where they do not, the first-
 // order value is the one that is wrong, and the output (and the result) is flagged: `disagrees`

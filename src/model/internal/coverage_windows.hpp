@@ -55,9 +55,22 @@ struct Window {
   Kept kept;                // lo <= y <= hi
 };
 
+// The shifted sums of one block, Σ(y − shift) and Σ(y − shift)², which the Monte Carlo's moments
+// take in the same pass over the values (monte_carlo.cpp). Each is a plain floating-point sum of
+// at most one block's terms (kBlock = 1024), in an order that depends on the kernel: relative
+// error ≤ ~1024·2^-53 of Σ|y − shift| (resp. Σ(y − shift)²) per block, before the blocks'
+// compensated total.
+struct BlockSums {
+  double shift = 0.0;
+  double sum = 0.0, sum2 = 0.0;
+};
+
 // Counts and keeps one block's values y[0 … n) for both windows of an output (AVX2 where the
-// kernel allows it and the CPU has it; the scalar and AVX2 versions give identical results).
-void CountWindows(Window (&w)[2], const double* y, std::size_t n, VectorKernel kernel);
+// kernel allows it and the CPU has it; both versions count and keep the same values, perhaps in
+// another order, which Select does not see), and adds the block's shifted sums to `sums` if
+// given.
+void CountWindows(Window (&w)[2], const double* y, std::size_t n, VectorKernel kernel,
+                  BlockSums* sums = nullptr);
 
 // The 1-based ranks [low, high] of the probabilistically symmetric coverage interval with
 // probability p among m values (JCGM 101 §7.7), clamped into [1, m].

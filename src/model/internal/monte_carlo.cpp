@@ -118,7 +118,7 @@ class MonteCarloRun {
     for (std::uint64_t done = 0; done < o_.trials;) {
       const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(kBlock, o_.trials - done));
       for (Stream& s : streams) {
-        s.gauss.FillScaled(n, p_.value[s.input], p_.u[s.input], Input(s.input), o_.kernel);
+        range_[s.input] = s.gauss.FillScaled(n, p_.value[s.input], p_.u[s.input], Input(s.input), o_.kernel);
       }
       const std::size_t valid = Evaluate(n, &rejected);
       for (std::size_t k = 0; k < nout; ++k) {
@@ -131,13 +131,17 @@ class MonteCarloRun {
           s.shift = y[0];
         }
         if (!s.varies) continue;
-        AccumulateMoments(s, y, valid);
         if (!windows) {  // one window holding everything serves both ends
+          AccumulateMoments(s, y, valid);
           s.window[0].kept.Append(y, valid);
         } else if (done < kPilot) {
+          AccumulateMoments(s, y, valid);
           pilot[k].insert(pilot[k].end(), y, y + valid);
-        } else {
-          CountWindows(s.window, y, valid, o_.kernel);
+        } else {  // the moments' sums in the windows' pass over the values
+          BlockSums sums{s.shift};
+          CountWindows(s.window, y, valid, o_.kernel, &sums);
+          Neumaier(&s.sum, &s.sum_c, sums.sum);
+          Neumaier(&s.sum2, &s.sum2_c, sums.sum2);
         }
       }
       done += n;
@@ -202,6 +206,8 @@ class MonteCarloRun {
     // Draws are finite (value + u·z), so the comparisons need no NaN care.
     auto screen = [&](InputQuantity q, Reason why, auto bad) {
       if (!Uncertain(q)) return;  // the nominal value passed the model's checks
+      // Every rule rejects the values outside an interval: when the block's extremes pass, all do.
+      if (!bad(range_[Index(q)].min) && !bad(range_[Index(q)].max)) return;
       const double* x = Input(Index(q));
       V2i count = {0, 0};
       std::size_t j = 0;
@@ -378,6 +384,7 @@ class MonteCarloRun {
   const PropagationOptions& o_;
   std::vector<int> outputs_;
   std::vector<double> buffer_;
+  GaussianStream::Range range_[kNumInputs];  // bounds of each uncertain input's current block
   MonteCarloValue values_[kOutCount];
 };
 
