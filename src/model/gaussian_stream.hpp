@@ -31,13 +31,15 @@
 // calls the C library's exp and log, whose last bit can differ between C libraries (glibc's are
 // within 1 ulp), which can change a tail value's last bit or, with probability ~2^-52 per wedge
 // test, a decision. Trial k depends only on (seed, id, k): a counter-based generator needs no
-// state to skip ahead, and the CPU or the kernel (AVX2 or scalar) changes nothing
-// (tests/gaussian_stream_test.cpp compares both kernels with a plain reimplementation of this
+// state to skip ahead, and the CPU or the code (scalar, AVX2, AVX-512) changes nothing
+// (tests/gaussian_stream_test.cpp compares every kernel with a plain reimplementation of this
 // paragraph, 10^6 values, bit for bit).
 //
 // Why this shape: the fast path is a handful of integer and IEEE operations on one word, so the
 // AVX2 kernel runs it four words at a time (Philox itself 32 blocks at a time, the same 32-bit
-// multiplies and xors as Random123's scalar code, on vector lanes) and finishes the rare rejected
+// multiplies and xors as Random123's scalar code, on vector lanes; with VectorKernel::kAuto on a
+// CPU with AVX-512F, 64 blocks at a time on 512-bit lanes, Philox being most of the cost; kAvx2
+// keeps to AVX2) and finishes the rare rejected
 // words afterwards from the side words, without disturbing the main words' one-word-per-deviate
 // order. 1024 layers (not the paper's 128 or 256): the fast path accepts 99.57 % of words rather
 // than 98.5 % (256), for 24 KB of tables.
@@ -84,7 +86,7 @@ class GaussianStream {
   }
   std::uint32_t key_[2];
   std::uint32_t id_;
-  bool avx2_ = false;  // the kernel of the current Fill (Philox by vectors or by Random123)
+  int simd_ = 0;  // the current Fill's code: 0 scalar (Random123's Philox), 1 AVX2, 2 AVX-512F
   std::uint64_t next_block_ = 0, next_side_block_ = 0;
   std::uint64_t buffer_[kBuffer] = {};
   std::size_t pos_ = 0, end_ = 0;  // unread main words: buffer_[pos_, end_)
