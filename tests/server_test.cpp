@@ -9,8 +9,13 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
+#include <iterator>
+#include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -443,6 +448,142 @@ TEST(ServeProcessTest, KillNineLosesNoAcknowledgedRow) {
   EXPECT_EQ(e.rows.size(), present.size());
   again.Kill(SIGTERM);
   fs::remove_all(dir);
+}
+
+// ---- stopping, and starting after a killed server ----
+
+// Runs `server` on a thread and says whether Run() returned within a minute. A Run() that never
+// returns cannot be joined: the test program then stops at once with the failure, instead of
+// hanging until ctest's timeout.
+void ExpectRunReturns(Server& server, const std::string& what) {
+  auto returned = std::make_shared<std::promise<void>>();
+  std::future<void> done = returned->get_future();
+  std::thread([&server, returned] {
+    server.Run();
+    returned->set_value();
+  }).detach();
+  if (done.wait_for(std::chrono::minutes(1)) != std::future_status::ready) {
+    ADD_FAILURE() << what << ": Run() did not return: the stop was lost";
+    std::_Exit(1);
+  }
+}
+
+// httplib's own stop() does nothing until the accept loop has marked itself running, so a Stop()
+// that came before Run() was lost and Run() listened for ever (ServerFixture's join hung). The
+// truth: Run() returns, and nobody listens on the port afterwards.
+TEST(ServerStopTest, StopBeforeRunOrBindMakesRunReturn) {
+  const fs::path dir = TempDir("stop-before-run");
+  ServerOptions options;
+  options.directory = dir.string();
+  options.port = 0;
+  {
+    Server server(options);
+    const int port = server.Bind();
+    server.Stop();
+    ExpectRunReturns(server, "Stop() after Bind()");
+    const int sock = ConnectLoopback(port);
+    EXPECT_LT(sock, 0) << "still listening on port " << port;
+    if (sock >= 0) ::close(sock);
+    server.Stop();  // twice: harmless
+  }
+  {
+    Server server(options);
+    server.Stop();
+    server.Bind();
+    ExpectRunReturns(server, "Stop() before Bind()");
+  }
+  fs::remove_all(dir);
+}
+
+// The fixture's own order: start (a thread that calls Run()) and stop at once, many times; each
+// Stop() joins. Then the server still works.
+TEST_F(ServerTest, StopsRightAfterStart) {
+  for (int i = 0; i < 50; ++i) {
+    Stop();
+    Start();
+  }
+  EXPECT_EQ(State()["version"], 0);
+}
+
+// What a folder holds, every entry by its path: a file's bytes, a link's target, or "folder".
+std::map<std::string, std::string> FolderBytes(const fs::path& root) {
+  std::map<std::string, std::string> out;
+  for (auto it = fs::recursive_directory_iterator(root); it != fs::recursive_directory_iterator(); ++it) {
+    const std::string name = fs::relative(it->path(), root).generic_string();
+    if (it->is_symlink()) {
+      out[name] = "link to " + fs::read_symlink(it->path()).string();
+    } else if (it->is_directory()) {
+      out[name] = "folder";
+    } else {
+      std::ifstream in(it->path(), std::ios::binary);
+      out[name] = std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+  }
+  return out;
+}
+
+void WriteBytes(const fs::path& path, const std::string& bytes) {
+  fs::create_directories(path.parent_path());
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+// A server killed mid-upload or mid-report leaves its staging folder behind (`.upload-` or
+// `.report-staging-` and 16 hex digits, where it stages). The next server to start alone on the
+// folder removes exactly those; while another server holds the folder, nothing is removed (its
+// staging may be live). Truth: the folder's own bytes, read before the server started.
+TEST(ServerStartTest, RemovesOnlyItsOwnStaleStagingAndOnlyWhenAlone) {
+  const fs::path dir = TempDir("stale-staging");
+  const fs::path outside = TempDir("stale-staging-outside");
+  {
+    ExperimentStore store(dir.string());
+    store.SetMetadata(0, ExperimentMetadata(), "mm");
+    store.AddRow(1, Row("t1"));
+  }
+  const std::string clip(5000, '\x7f');
+  WriteBytes(dir / "videos" / "clip.mp4", clip);
+  // Not the server's staging, whatever they look like: all kept.
+  WriteBytes(dir / "videos" / ".upload-0123" / "upload", "short suffix");
+  WriteBytes(dir / "videos" / ".upload-0123456789ABCDEF" / "upload", "upper-case hex");
+  WriteBytes(dir / "videos" / ".upload-1111111111111111", "a file, not a folder");
+  WriteBytes(dir / "videos" / ".upload-2222222222222222" / "inner" / "upload", "holds a folder");
+  WriteBytes(dir / ".upload-3333333333333333" / "upload", "uploads are not staged here");
+  WriteBytes(dir / "notes" / ".report-staging-4444444444444444" / "report.html", "reports are not staged here");
+  WriteBytes(dir / ".uphill-cache" / "video" / ".staging-5555555555555555" / "track.csv", "the tracker cache's");
+  WriteBytes(outside / "keep.txt", "outside the folder");
+  fs::create_directory_symlink(outside, dir / ".report-staging-6666666666666666");
+  fs::create_directories(dir / "calibration" / "views");  // where chessboard views are uploaded
+  const std::map<std::string, std::string> before = FolderBytes(dir);
+  // The server's own, stale.
+  const std::vector<fs::path> stale = {dir / "videos" / ".upload-0123456789abcdef",
+                                       dir / "calibration" / "views" / ".upload-fedcba9876543210",
+                                       dir / ".report-staging-00000000000000aa"};
+  const auto make_stale = [&] {
+    WriteBytes(stale[0] / "upload", clip.substr(0, 1234));
+    WriteBytes(stale[1] / "upload", "half a PNG");
+    WriteBytes(stale[2] / "report.html", "<html>");
+    WriteBytes(stale[2] / "fit.json", "{}");
+  };
+  make_stale();
+  // Another server holds the folder: nothing is removed.
+  ServerOptions options;
+  options.directory = dir.string();
+  options.port = 0;
+  {
+    Server first(options);
+    for (const fs::path& p : stale) EXPECT_FALSE(fs::exists(p)) << p << " (the first server is alone)";
+    make_stale();
+    Server second(options);
+    for (const fs::path& p : stale) EXPECT_TRUE(fs::exists(p)) << p << " removed while the first server holds the folder";
+  }
+  // Alone again: its own stale staging is gone, the rest untouched byte for byte.
+  {
+    Server alone(options);
+    for (const fs::path& p : stale) EXPECT_FALSE(fs::exists(p)) << p;
+    EXPECT_EQ(FolderBytes(dir), before);
+    EXPECT_EQ(FolderBytes(outside), (std::map<std::string, std::string>{{"keep.txt", "outside the folder"}}));
+  }
+  fs::remove_all(dir);
+  fs::remove_all(outside);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 // decoded by OpenCV directly; files compared byte for byte.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -429,6 +430,103 @@ TEST_F(CameraCalibrationTest, ViewsInTheFolderGiveTheCamera) {
   auto [missing, body] = Send("POST", "/api/camera/calibrate", {{"version", State()["version"]}, {"folder", "nothing"}});
   EXPECT_EQ(missing, 422);
   EXPECT_EQ(body["field"], "folder");
+}
+
+// Chessboard views uploaded from the page (PUT /api/views/NAME) land whole in calibration/views,
+// the folder the camera calibration reads, and give the camera back as views copied into the
+// folder do. Truth: the camera (cam.json) with which make_video rendered the views (the
+// project's chessboard renderer, vision/chessboard_render.hpp); files compared byte for byte. A
+// file that does not decode as an image (named, with the rule), a name without an image
+// extension, a name taken and a view over the limit are refused and leave nothing behind, not
+// even a staging folder. The camera file goes through the journal: a stale version is 409, and
+// a restarted server finds it.
+class ViewUploadTest : public CameraCalibrationTest {
+ protected:
+  void Configure(ServerOptions& options) override { options.max_view_upload_bytes = 1 << 20; }
+  std::vector<std::string> Views() {
+    std::vector<std::string> out;
+    if (!fs::exists(dir_ / "calibration" / "views")) return out;
+    for (const auto& e : fs::directory_iterator(dir_ / "calibration" / "views")) out.push_back(e.path().filename().string());
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+};
+
+TEST_F(ViewUploadTest, UploadedViewsGiveTheCamera) {
+  Create();
+  const fs::path clip = FreshFolder("server-camera-upload");
+  ASSERT_EQ(std::system((std::string(UPHILL_MAKE_VIDEO) + " " + clip.string() +
+                         " --width 640 --height 360 --frames 1 --boards 12 > /dev/null").c_str()),
+            0);
+  const CameraIntrinsics truth = ReadCameraFile((clip / "cam.json").string());
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(clip / "boards")) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  ASSERT_EQ(names.size(), 12u);
+  for (const std::string& name : names) {
+    const std::string bytes = ReadBytes(clip / "boards" / name);
+    ASSERT_LT(bytes.size(), 1u << 20);
+    auto r = client_->Put(("/api/views/" + name).c_str(), bytes, "application/octet-stream");
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->status, 200) << r->body;
+    const json answer = json::parse(r->body);
+    EXPECT_EQ(answer["path"], "calibration/views/" + name);
+    EXPECT_EQ(answer["width"], 640);
+    EXPECT_EQ(answer["height"], 360);
+    EXPECT_EQ(ReadBytes(dir_ / "calibration" / "views" / name), bytes);
+  }
+  EXPECT_EQ(Views(), names);
+
+  // Refused, each leaving the folder as it was.
+  const std::string first = ReadBytes(clip / "boards" / names[0]);
+  auto text = client_->Put("/api/views/notes.png", std::string(5000, 'a'), "application/octet-stream");
+  ASSERT_TRUE(text);
+  EXPECT_EQ(text->status, 422);
+  EXPECT_NE(text->body.find("notes.png: not an image OpenCV can decode (a chessboard view must be a PNG, JPEG"),
+            std::string::npos) << text->body;
+  auto named = client_->Put("/api/views/board.txt", first, "application/octet-stream");
+  ASSERT_TRUE(named);
+  EXPECT_EQ(named->status, 422);
+  EXPECT_NE(named->body.find("board.txt: not an image file name (.png, .jpg, .jpeg, .bmp, .tif, .tiff)"),
+            std::string::npos) << named->body;
+  auto taken = client_->Put(("/api/views/" + names[0]).c_str(), std::string("x"), "application/octet-stream");
+  ASSERT_TRUE(taken);
+  EXPECT_EQ(taken->status, 422);
+  EXPECT_EQ(ReadBytes(dir_ / "calibration" / "views" / names[0]), first);
+  const std::string big = "PUT /api/views/big.png HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port_) +
+                          "\r\nContent-Type: application/octet-stream\r\nContent-Length: " +
+                          std::to_string((1 << 20) + 1) + "\r\n\r\n";
+  EXPECT_EQ(StatusOf(RawExchange(port_, big, std::chrono::milliseconds(2000))), 413);
+  EXPECT_EQ(Views(), names);
+
+  // The calibration from the uploaded views: through the journal, version conflicts refused.
+  const json calibrate{{"folder", "calibration/views"}, {"cols", 9}, {"rows", 6}, {"square", 20}};
+  const std::int64_t version = State()["version"];
+  json stale = calibrate;
+  stale["version"] = version - 1;
+  auto [conflict, refused] = Send("POST", "/api/camera/calibrate", stale);
+  EXPECT_EQ(conflict, 409) << refused.dump();
+  EXPECT_FALSE(fs::exists(dir_ / "calibration" / "camera.json"));
+  json current = calibrate;
+  current["version"] = version;
+  auto [status, answer] = Send("POST", "/api/camera/calibrate", current);
+  ASSERT_EQ(status, 200) << answer.dump();
+  // make_video's views keep the board near the middle: the verdict says so, with its reason.
+  EXPECT_EQ(answer["calibration"]["verdict"], "poor");
+  ASSERT_EQ(answer["calibration"]["reasons"].size(), 1u);
+  EXPECT_NE(answer["calibration"]["reasons"][0].get<std::string>().find("the corners cover only"), std::string::npos)
+      << answer["calibration"]["reasons"].dump();
+  EXPECT_NEAR(answer["calibration"]["fx"].get<double>(), truth.fx, 0.01 * truth.fx);
+  EXPECT_NEAR(answer["calibration"]["fy"].get<double>(), truth.fy, 0.01 * truth.fy);
+  EXPECT_NEAR(answer["calibration"]["cx"].get<double>(), truth.cx, 3);
+  EXPECT_NEAR(answer["calibration"]["cy"].get<double>(), truth.cy, 3);
+  EXPECT_EQ(answer["calibration"]["views_used"].get<int>(), 12);
+  Stop();
+  Start();
+  EXPECT_EQ(State()["experiment"]["camera"], "calibration/camera.json");
+  EXPECT_DOUBLE_EQ(ReadCameraFile((dir_ / "calibration" / "camera.json").string()).fx,
+                   answer["calibration"]["fx"].get<double>());
+  fs::remove_all(clip);
 }
 
 }  // namespace

@@ -4,12 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
@@ -340,10 +342,14 @@ TEST(ChessboardTarget, PrintableImageHasTheSquaresAndMargin) {
 
 using testing::RunUphill;
 
+// A new folder of its own for each test. ctest runs each test of this file as its own process,
+// in parallel with the other tests and with the same tests of other builds (release and
+// sanitize, other checkouts) on the machine: a folder shared by name was emptied by one test's
+// final remove_all while another was still writing views into it or reading cam.json from it.
 fs::path CliDir() {
-  const fs::path dir = fs::temp_directory_path() / "uphill_vision_calibration_cli";
-  fs::create_directories(dir);
-  return dir;
+  std::string pattern = (fs::temp_directory_path() / "uphill_vision_calibration_cli_XXXXXX").string();
+  if (!::mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed in " + fs::temp_directory_path().string());
+  return pattern;
 }
 
 TEST_F(CameraCalibrationTest, CommandLineCalibratesCameraAndScene) {
@@ -381,37 +387,37 @@ TEST_F(CameraCalibrationTest, CommandLineCalibratesCameraAndScene) {
   EXPECT_LT((CameraCentre(read_scene.pose) - CameraCentre(LabPose())).norm(), 0.005);
 
   // Bad input: exit 2, the message names file, row and column, or the flag.
+  const std::string refused_output = (dir / "x.json").string();
   { std::ofstream(dir / "bad.csv") << "u,v,x_mm,y_mm,z_mm\n1,2,0,0,0\n3,4,abc,0,0\n"; }
-  auto bad = RunUphill("calibrate scene --camera " + cam + " --points " + (dir / "bad.csv").string() + " -o x.json");
+  auto bad = RunUphill("calibrate scene --camera " + cam + " --points " + (dir / "bad.csv").string() + " -o " + refused_output);
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("bad.csv, row 3, column x_mm: 'abc' is not a number"), std::string::npos) << bad.err;
   { std::ofstream(dir / "nounit.csv") << "u,v,x,y,z\n1,2,0,0,0\n"; }
-  bad = RunUphill("calibrate scene --camera " + cam + " --points " + (dir / "nounit.csv").string() + " -o x.json");
+  bad = RunUphill("calibrate scene --camera " + cam + " --points " + (dir / "nounit.csv").string() + " -o " + refused_output);
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("nounit.csv, row 2, column x: '0' has no unit"), std::string::npos) << bad.err;
   { std::ofstream(dir / "line.csv") << "u,v,x_mm,y_mm,z_mm\n100,100,0,0,0\n200,200,100,0,0\n300,300,200,0,0\n400,400,300,0,0\n"; }
-  bad = RunUphill("calibrate scene --camera " + cam + " --points " + (dir / "line.csv").string() + " -o x.json");
+  bad = RunUphill("calibrate scene --camera " + cam + " --points " + (dir / "line.csv").string() + " -o " + refused_output);
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("line.csv: points: all lie on one line"), std::string::npos) << bad.err;
   cv::imwrite((dir / "small_frame.png").string(), cv::Mat(480, 640, CV_8U, cv::Scalar(0)));
   bad = RunUphill("calibrate scene --camera " + cam + " --points " + points.string() + " --frame " +
-                  (dir / "small_frame.png").string() + " -o x.json");
+                  (dir / "small_frame.png").string() + " -o " + refused_output);
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("small_frame.png: is 640×480 pixels but the camera was calibrated at 1280×720"),
             std::string::npos) << bad.err;
-  bad = RunUphill("calibrate camera " + points.string() + " --cols 9 --rows 6 --square 25mm -o x.json");
+  bad = RunUphill("calibrate camera " + points.string() + " --cols 9 --rows 6 --square 25mm -o " + refused_output);
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("points.csv: cannot be read as an image"), std::string::npos) << bad.err;
-  bad = RunUphill("calibrate camera" + images + " --cols 9 --rows 6 --square 25 -o x.json");
+  bad = RunUphill("calibrate camera" + images + " --cols 9 --rows 6 --square 25 -o " + refused_output);
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("--square: '25' has no unit"), std::string::npos) << bad.err;
-  EXPECT_FALSE(fs::exists("x.json"));
+  EXPECT_FALSE(fs::exists(refused_output));  // no output for refused input
   fs::remove_all(dir);
 }
 
 TEST(CalibrateTargetCommand, WritesAnSvgOfExactSizeAndAPngThatIsDetected) {
-  const fs::path dir = CliDir() / "target";
-  fs::create_directories(dir);
+  const fs::path dir = CliDir();
   const auto svg = RunUphill("calibrate target --cols 9 --rows 6 --square 20mm -o " + (dir / "board.svg").string());
   ASSERT_EQ(svg.status, 0) << svg.err;
   std::ifstream in(dir / "board.svg");

@@ -15,6 +15,8 @@
 //   GET    /api/videos                    the video files in the folder
 //   PUT    /api/videos/<name>             the body (application/octet-stream, at most
 //                                         max_upload_bytes) becomes EXP/videos/<name>, atomically
+//   PUT    /api/views/<name>              the body (application/octet-stream, an image, at most
+//                                         max_view_upload_bytes) becomes EXP/calibration/views/<name>
 //   GET    /api/video/frame?video=P&frame=N[&format=jpeg]   a frame as PNG (or JPEG)
 //   POST   /api/rows/<id>/video           {version, video}: attach a video of the folder to a row
 //   GET    /api/scene/points?row=ID[&table_z=Z&marks=M,M]   the apparatus points to click
@@ -62,6 +64,7 @@ struct ServerOptions {
   int port = 8080;                     // 0: any free port (Bind returns it)
   std::size_t max_request_bytes = 64 * 1024;  // a request's body; its headers get 32 KiB more
   std::size_t max_upload_bytes = std::size_t{2} << 30;  // an uploaded video
+  std::size_t max_view_upload_bytes = std::size_t{64} << 20;  // an uploaded chessboard view
   std::chrono::milliseconds upload_deadline{30 * 60 * 1000};  // for the whole upload
   std::uint64_t report_mc_trials = 10000;  // per row, for u(X) by Monte Carlo in the report
   // A request must arrive whole within request_deadline; a connection idle for idle_timeout is
@@ -85,6 +88,9 @@ class Server {
   int Bind();
   // Serves until Stop() (from another thread). Call after Bind.
   void Run();
+  // Stops listening: Run() returns once the connections being served are answered. Safe at any
+  // time and more than once, from any thread: a Stop() that comes before Run() (or before
+  // Bind()) makes Run() return at once.
   void Stop();
 
   ExperimentStore& store();

@@ -1,7 +1,7 @@
 // End-to-end test of a trial's video in `uphill serve` (issue 13), in headless Chromium like
 // serve.e2e.mjs (run.sh starts the server; UPHILL_MAKE_VIDEO is tools/make_video). A new
-// technician, in the page alone: creates the experiment, calibrates the camera from chessboard
-// photos copied into the folder, uploads a trial's recording, clicks the calibration points on a
+// technician, in the page alone: creates the experiment, uploads chessboard photos and calibrates
+// the camera from them, uploads a trial's recording, clicks the calibration points on a
 // frame, saves the scene, tracks the video, accepts the rest position as Y, opens the report,
 // reloads and finds all of it again.
 //
@@ -73,11 +73,26 @@ try {
   await click('#save-experiment');
   await page.waitForSelector('#status:has-text("version 1")');
 
-  // 2. The camera: the chessboard photos are copied into the folder (one step outside the page).
-  fs.cpSync(path.join(clip, 'boards'), path.join(dir, 'calibration', 'views'), { recursive: true });
-  count(10 * KLM.click);
+  // 2. The camera: the chessboard photos are uploaded from the page (one file pick of all 12);
+  // the folder they land in is filled in for the calibration.
   await click('#camera-details summary');
-  await fill('#cam-folder', 'calibration/views');
+  const boards = fs.readdirSync(path.join(clip, 'boards')).sort().map((name) => path.join(clip, 'boards', name));
+  assert.equal(boards.length, 12);
+  count(4 * KLM.click);
+  await page.setInputFiles('#cam-upload', boards);
+  await page.waitForSelector('#cam-upload-status:has-text("12 of 12 views uploaded into calibration/views.")',
+    { timeout: 60000 });
+  for (const board of boards)
+    assert.ok(fs.readFileSync(path.join(dir, 'calibration', 'views', path.basename(board))).equals(fs.readFileSync(board)),
+      `${path.basename(board)} uploaded byte for byte`);
+  assert.equal(await page.inputValue('#cam-folder'), 'calibration/views');
+  // A file that is not an image is refused, named with the rule, and leaves nothing behind.
+  const notImage = path.join(work, 'notes.png');
+  fs.writeFileSync(notImage, 'not an image');
+  await page.setInputFiles('#cam-upload', notImage);
+  await page.waitForSelector('#cam-upload-status:has-text("0 of 1 views uploaded")');
+  assert.match(await page.textContent('#cam-upload-status'), /notes\.png: not an image OpenCV can decode/);
+  assert.deepEqual(fs.readdirSync(path.join(dir, 'calibration', 'views')).sort(), boards.map((b) => path.basename(b)));
   await click('#cam-run');  // 9 × 6 inner corners of 20 mm: the form's defaults
   // The verdict and its reasons are shown (make_video's 12 views cover only half of the image:
   // "poor", with that reason); the focal length is the true camera's within 1 %.
@@ -184,7 +199,7 @@ try {
   const csv = fs.readFileSync(path.join(dir, 'measurements.csv'), 'utf8').trim().split('\n');
   assert.equal(csv[0].split(',').includes('video'), true);
   assert.deepEqual(problems, []);
-  console.log(`video e2e: ok — ${steps} steps (one outside the page: copying the chessboard photos), ` +
+  console.log(`video e2e: ok — ${steps} steps, ` +
     `${seconds.toFixed(1)} s of the server's and the browser's work, ` +
     `about ${Math.round(seconds + personSeconds)} s for a person (keystroke-level model: ${personSeconds.toFixed(0)} s)`);
 } catch (e) {

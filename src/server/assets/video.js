@@ -111,6 +111,34 @@ function upload(file) {
 }
 
 // ---- camera -------------------------------------------------------------------------------------
+// Chessboard views uploaded one after another into calibration/views (the folder the calibration
+// then reads); each refused file is listed with the server's reason, the others are kept.
+async function uploadViews(files) {
+  if (!files.length) return;
+  const status = $('cam-upload-status');
+  const refused = el('ul', { class: 'flag-list' });
+  let stored = 0;
+  for (const [i, file] of files.entries()) {
+    status.replaceChildren(`Uploading ${file.name} (${i + 1} of ${files.length})…`);
+    let error = '';
+    try {
+      const response = await fetch('/api/views/' + encodeURIComponent(file.name),
+        { method: 'PUT', headers: { 'Content-Type': 'application/octet-stream' }, body: file });
+      let data = {};
+      try { data = await response.json(); } catch (e) { data = { error: 'HTTP ' + response.status }; }
+      if (response.ok) ++stored; else error = data.error;
+    } catch (e) {
+      error = 'the connection broke; nothing was kept';
+    }
+    if (error) refused.append(el('li', {}, error.includes(file.name) ? error : `${file.name}: ${error}`));
+  }
+  $('cam-folder').value = 'calibration/views';
+  const said = `${stored} of ${files.length} views uploaded into calibration/views`;
+  status.replaceChildren(refused.childElementCount ? `${said}; not uploaded:` : `${said}.`);
+  if (refused.childElementCount) status.append(refused);
+  $('cam-upload').value = '';
+}
+
 async function calibrateCamera(ev) {
   ev.preventDefault();
   const out = $('camera-result');
@@ -398,6 +426,7 @@ $('camera-form').addEventListener('submit', calibrateCamera);
 $('v-row').addEventListener('change', () => showRow($('v-row').value === 'new' ? null : Number($('v-row').value)));
 $('v-attach').addEventListener('click', () => attach($('v-file').value));
 $('v-upload').addEventListener('change', () => upload($('v-upload').files[0]));
+$('cam-upload').addEventListener('change', () => uploadViews([...$('cam-upload').files]));
 $('s-img').addEventListener('click', frameClick);
 $('s-zoom').addEventListener('change', () => { applyZoom(); drawOverlay(); });
 $('s-frame').addEventListener('change', loadFrame);

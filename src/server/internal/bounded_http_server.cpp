@@ -205,6 +205,15 @@ void BoundedHttpServer::WidenBacklog(int backlog) {
   if (svr_sock_ != INVALID_SOCKET) ::listen(svr_sock_, backlog);
 }
 
+void BoundedHttpServer::StopListening() {
+  // httplib's accept loop runs while svr_sock_ is valid and treats a failed accept on an
+  // invalidated socket as a stop; shutdown wakes a poll or accept already waiting on it.
+  const socket_t sock = svr_sock_.exchange(INVALID_SOCKET);
+  if (sock == INVALID_SOCKET) return;
+  ::shutdown(sock, SHUT_RDWR);
+  ::close(sock);
+}
+
 void BoundedHttpServer::CloseAfterResponse() {
   if (current_stream) current_stream->RequestClose();
 }

@@ -19,6 +19,7 @@
 //     SYN retransmissions, a second or more. Here the backlog is widened after binding.
 // A handler may also ask for the connection to be closed after its answer (CloseAfterResponse),
 // e.g. when it refused a request whose body it did not read.
+// Stopping: StopListening, which works even before listening has started (httplib's stop() does not).
 #pragma once
 
 #include <chrono>
@@ -45,6 +46,12 @@ class BoundedHttpServer : public httplib::Server {
 
   // After bind_to_port / bind_to_any_port: lets the kernel queue `backlog` connections.
   void WidenBacklog(int backlog = 256);
+
+  // Closes the listening socket, whenever it is called: before listen_after_bind() (which then
+  // returns at once), while it runs (it returns after the connections being served), or twice.
+  // httplib's own stop() does nothing until listen_after_bind() has marked itself running, so
+  // a stop that comes first is lost and the server then listens for ever.
+  void StopListening();
 
   // For handlers (the thread serving the request): close the connection after this answer.
   static void CloseAfterResponse();

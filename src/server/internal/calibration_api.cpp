@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <regex>
 
 #include "app/scene_clicks.hpp"
@@ -10,6 +11,7 @@
 #include "server/row_check.hpp"
 #include "vision/calibration.hpp"
 #include "vision/camera.hpp"
+#include "vision/library_logs.hpp"
 
 namespace uphill::internal {
 namespace {
@@ -204,6 +206,15 @@ ordered_json SolveScene(const ExperimentStore& store, const StoreSnapshot& snaps
           {"path", path},
           {"camera_centre", {{"x", InUnit(centre.x(), unit)}, {"y", InUnit(centre.y(), unit)}, {"z", InUnit(centre.z(), unit)}}},
           {"unit", unit}};
+}
+
+ImageSize ProbeImage(const std::string& path, const std::string& name) {
+  QuietVideoLibraryLogs();  // a refused file is said once, in the answer
+  const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (image.empty())
+    throw InputError(name, "not an image OpenCV can decode (a chessboard view must be a PNG, JPEG, BMP or TIFF "
+                           "photo or frame); nothing was kept");
+  return {image.cols, image.rows};
 }
 
 std::string SceneFilePath(const std::string& name) {

@@ -40,6 +40,13 @@ nlohmann::ordered_json SolveScene(const ExperimentStore& store, const StoreSnaps
 // unless the name is 1 to 32 letters, digits, '-' or '_'.
 std::string SceneFilePath(const std::string& name);
 
+// A chessboard view uploaded (PUT /api/views/NAME): its size when OpenCV decodes it. Throws
+// InputError(name) naming the rule when it does not decode as an image.
+struct ImageSize {
+  int width = 0, height = 0;
+};
+ImageSize ProbeImage(const std::string& path, const std::string& name);
+
 // POST /api/camera/calibrate {folder, cols, rows, square}: CalibrateCamera over the images (.png,
 // .jpg, .jpeg, .bmp, .tif) of a folder of the experiment; `camera_file` receives the camera file's
 // text: {verdict, reasons, rms_px, views_used, coverage, fx, fy, cx, cy, width, height,

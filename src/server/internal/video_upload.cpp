@@ -2,31 +2,63 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <regex>
 
+#include "folder_claim.hpp"
 #include "model/environment_error.hpp"
 #include "model/input_error.hpp"
 
 namespace uphill::internal {
 
+const UploadKind& VideoUpload() {
+  static const UploadKind kind{"video", {".mp4", ".avi", ".mkv", ".mov", ".m4v", ".webm"}};
+  return kind;
+}
+
+const UploadKind& ImageUpload() {
+  static const UploadKind kind{"image", {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"}};
+  return kind;
+}
+
+namespace {
+
+bool HasExtension(const std::string& name, const UploadKind& kind) {
+  std::string lower = name;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  for (const std::string& ext : kind.extensions)
+    if (lower.size() > ext.size() && lower.compare(lower.size() - ext.size(), ext.size(), ext) == 0) return true;
+  return false;
+}
+
+std::string Listed(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& item : items) out += (out.empty() ? "" : ", ") + item;
+  return out;
+}
+
+}  // namespace
+
 std::string ReceiveUpload(const ContainedDirectory& folder, const std::string& directory, const std::string& name,
-                          std::size_t declared_bytes, std::size_t max_bytes, const BodyReader& read,
-                          const std::function<void(const std::string& staged_path)>& check) {
+                          const UploadKind& kind, std::size_t declared_bytes, std::size_t max_bytes,
+                          const BodyReader& read, const std::function<void(const std::string& staged_path)>& check) {
   static const std::regex ok("[A-Za-z0-9_-][A-Za-z0-9._-]{0,99}");
-  static const std::regex video(".*\\.(mp4|avi|mkv|mov|m4v|webm|MP4|AVI|MKV|MOV|M4V|WEBM)");
   if (!std::regex_match(name, ok) || name.find("..") != std::string::npos)
     throw InputError("name", "a file name of 1 to 100 letters, digits, '.', '-' or '_' (rename the file)");
-  if (!std::regex_match(name, video)) throw InputError("name", name + ": not a video file name (.mp4, .avi, .mkv, .mov, .m4v, .webm)");
+  if (!HasExtension(name, kind))
+    throw InputError("name", name + ": not " + (kind.what == "image" ? "an " : "a ") + kind.what + " file name (" +
+                                 Listed(kind.extensions) + ")");
   if (declared_bytes > max_bytes)
     throw InputError("upload", name + " is " + std::to_string(declared_bytes >> 20) + " MiB: larger than the limit of " +
-                                   std::to_string(max_bytes >> 20) + " MiB (uphill serve --max-upload)");
+                                   std::to_string(max_bytes >> 20) + " MiB");
   const std::string target = directory + "/" + name;
   if (folder.KindOf(target) != ContainedDirectory::Kind::kAbsent)
     throw InputError("name", target + " exists already in the experiment folder: pick it from the list, or rename the file");
   const ContainedDirectory into = folder.Subdirectory(directory, true);
-  ContainedDirectory staging = into.MakeStagingDirectory(".upload-");
+  ContainedDirectory staging = into.MakeStagingDirectory(kUploadStagingPrefix);
   try {
     const int fd = staging.OpenForAppend("upload");
     std::size_t received = 0;
