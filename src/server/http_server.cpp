@@ -1,8 +1,10 @@
 #include "server/http_server.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <filesystem>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <type_traits>
@@ -16,6 +18,7 @@
 #include "report/fit_document.hpp"
 #include "vision/camera.hpp"
 #include "internal/calibration_api.hpp"
+#include "internal/folder_claim.hpp"
 #include "internal/page_assets.hpp"
 #include "internal/track_api.hpp"
 #include "internal/video_upload.hpp"
@@ -118,10 +121,19 @@ std::int64_t VersionOf(const json& body) {
   return body.at("version").get<std::int64_t>();
 }
 
-// The one route whose body is not JSON: an upload, streamed to disk (internal/video_upload.hpp).
-constexpr const char* kUploadPattern = R"(/api/videos/([^/]{1,120}))";
-const std::regex kUploadRoute(kUploadPattern);
-bool IsUpload(const httplib::Request& req) { return req.method == "PUT" && std::regex_match(req.path, kUploadRoute); }
+// The routes whose body is not JSON: uploads, streamed to disk (internal/video_upload.hpp).
+constexpr const char* kVideoUploadPattern = R"(/api/videos/([^/]{1,120}))";
+constexpr const char* kViewUploadPattern = R"(/api/views/([^/]{1,120}))";
+const std::regex kVideoUploadRoute(kVideoUploadPattern);
+const std::regex kViewUploadRoute(kViewUploadPattern);
+
+// The size limit of an upload request, or 0 when the request is not an upload.
+std::size_t UploadLimit(const httplib::Request& req, const ServerOptions& options) {
+  if (req.method != "PUT") return 0;
+  if (std::regex_match(req.path, kVideoUploadRoute)) return options.max_upload_bytes;
+  if (std::regex_match(req.path, kViewUploadRoute)) return options.max_view_upload_bytes;
+  return 0;
+}
 
 bool ValidReportName(const std::string& name) {
   static const std::regex ok("[A-Za-z0-9][A-Za-z0-9._-]{0,127}");
@@ -179,8 +191,21 @@ struct Server::Impl {
   internal::BoundedHttpServer http;
   int port = 0;
   std::mutex report_mutex;
+  std::atomic<bool> stopped{false};  // Stop() was called: Run() no longer listens
+  std::mutex claim_mutex;
+  std::optional<internal::FolderClaim> claim;  // once the folder exists (internal/folder_claim.hpp)
 
-  explicit Impl(ServerOptions o) : options(std::move(o)), store(options.directory), http(Limits(options)) {}
+  explicit Impl(ServerOptions o) : options(std::move(o)), store(options.directory), http(Limits(options)) {
+    ClaimFolder();
+  }
+
+  // Holds the experiment folder as one of its servers, from start or from when it is created;
+  // the first server on it removes the staging folders a killed server left. Before staging.
+  void ClaimFolder() {
+    std::lock_guard lock(claim_mutex);
+    if (claim) return;
+    if (const ContainedDirectory* folder = store.folder()) claim.emplace(*folder);
+  }
 
   // Whether EXP/report/report.html is there (a regular file, reached without links).
   bool ReportExists() const {
@@ -258,7 +283,8 @@ struct Server::Impl {
   void Routes() {
     // Uploads may be large; every other request is held to max_request_bytes before its body is
     // read (pre-routing handler) and by its connection's byte budget.
-    http.set_payload_max_length(std::max(options.max_request_bytes, options.max_upload_bytes));
+    http.set_payload_max_length(
+        std::max({options.max_request_bytes, options.max_upload_bytes, options.max_view_upload_bytes}));
 
     // Every request, before its body is read: the headers that decide how it is read and whom it
     // comes from must be there once, the body must have a length, and it must come from here.
@@ -273,13 +299,12 @@ struct Server::Impl {
         const std::string origin = req.get_header_value("Origin");
         if (!origin.empty() && origin != "http://" + req.get_header_value("Host"))
           return Refuse(res, 403, "cross-origin change refused");
-        if (IsUpload(req)) {
+        if (const std::size_t limit = UploadLimit(req, options)) {
           if (req.get_header_value("Content-Type") != "application/octet-stream")
             return Refuse(res, 415, "an upload must be sent as application/octet-stream");
           const std::size_t length = req.get_header_value<std::uint64_t>("Content-Length");
-          if (length > options.max_upload_bytes)
-            return Refuse(res, 413, "the file is larger than the upload limit (" +
-                                        std::to_string(options.max_upload_bytes >> 20) + " MiB)");
+          if (length > limit)
+            return Refuse(res, 413, "the file is larger than the upload limit (" + std::to_string(limit >> 20) + " MiB)");
           internal::BoundedHttpServer::AllowLargeRequest(length + 32 * 1024, options.upload_deadline);
           return httplib::Server::HandlerResponse::Unhandled;
         }
@@ -563,29 +588,52 @@ struct Server::Impl {
         return add ? store.AddRow(version, row) : store.EditRow(version, id, row);
       });
     });
-    http.Put(kUploadPattern, [this](const httplib::Request& req, httplib::Response& res,
-                                  const httplib::ContentReader& reader) {
-      try {
-        const ContainedDirectory* folder = store.folder();
-        if (!folder) throw InputError("experiment", "does not exist yet: create it first");
-        const std::string name = req.matches[1].str();
-        const std::string path = internal::ReceiveUpload(
-            *folder, "videos", name, req.get_header_value<std::uint64_t>("Content-Length"), options.max_upload_bytes,
-            [&](const std::function<bool(const char*, std::size_t)>& sink) { return reader(sink); },
-            [&](const std::string& staged) { ProbeVideo(staged, name); });
-        const VideoProbe probe = ProbeVideo(folder->path() + "/" + path, path);
-        SendJson(res, 200, {{"path", path}, {"width", probe.width}, {"height", probe.height}, {"fps", probe.fps},
-                            {"frames", probe.frames}});
-      } catch (const InputError& e) {
-        SendError(res, 422, e.what(), e.quantity());
-        res.set_header("Connection", "close");  // the rest of the body, if any, is not read
-        internal::BoundedHttpServer::CloseAfterResponse();
-      } catch (const std::exception& e) {
-        SendError(res, 500, e.what());
-        res.set_header("Connection", "close");
-        internal::BoundedHttpServer::CloseAfterResponse();
-      }
+    http.Put(kVideoUploadPattern, [this](const httplib::Request& req, httplib::Response& res,
+                                       const httplib::ContentReader& reader) {
+      Upload(req, res, reader, internal::kVideoUploadFolder, internal::VideoUpload(), options.max_upload_bytes,
+             [](const std::string& staged, const std::string& name) {
+               const VideoProbe probe = ProbeVideo(staged, name);
+               return ordered_json{{"width", probe.width}, {"height", probe.height}, {"fps", probe.fps},
+                                   {"frames", probe.frames}};
+             });
     });
+    http.Put(kViewUploadPattern, [this](const httplib::Request& req, httplib::Response& res,
+                                      const httplib::ContentReader& reader) {
+      Upload(req, res, reader, internal::kViewUploadFolder, internal::ImageUpload(), options.max_view_upload_bytes,
+             [](const std::string& staged, const std::string& name) {
+               const internal::ImageSize size = internal::ProbeImage(staged, name);
+               return ordered_json{{"width", size.width}, {"height", size.height}};
+             });
+    });
+  }
+
+  // An upload into `directory` (internal/video_upload.hpp): `probe` checks the staged file (throwing
+  // InputError to refuse it) and describes it; the answer is {path, ...the description}.
+  void Upload(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader,
+              const std::string& directory, const internal::UploadKind& kind, std::size_t max_bytes,
+              const std::function<ordered_json(const std::string& path, const std::string& name)>& probe) {
+    try {
+      const ContainedDirectory* folder = store.folder();
+      if (!folder) throw InputError("experiment", "does not exist yet: create it first");
+      ClaimFolder();
+      const std::string name = req.matches[1].str();
+      ordered_json described;
+      const std::string path = internal::ReceiveUpload(
+          *folder, directory, name, kind, req.get_header_value<std::uint64_t>("Content-Length"), max_bytes,
+          [&](const std::function<bool(const char*, std::size_t)>& sink) { return reader(sink); },
+          [&](const std::string& staged) { described = probe(staged, name); });
+      ordered_json answer{{"path", path}};
+      answer.update(described);
+      SendJson(res, 200, answer);
+    } catch (const InputError& e) {
+      SendError(res, 422, e.what(), e.quantity());
+      res.set_header("Connection", "close");  // the rest of the body, if any, is not read
+      internal::BoundedHttpServer::CloseAfterResponse();
+    } catch (const std::exception& e) {
+      SendError(res, 500, e.what());
+      res.set_header("Connection", "close");
+      internal::BoundedHttpServer::CloseAfterResponse();
+    }
   }
 
   // A scene file that does not fit the video's size is refused when the video is attached (the
@@ -629,7 +677,8 @@ struct Server::Impl {
     analysis_options.mc_trials = options.report_mc_trials;
     Experiment experiment;
     const ExperimentAnalysis analysis = internal::AnalyseFolder(store.directory(), analysis_options, &experiment);
-    ContainedDirectory staging = folder->MakeStagingDirectory(".report-staging-");
+    ClaimFolder();
+    ContainedDirectory staging = folder->MakeStagingDirectory(internal::kReportStagingPrefix);
     std::vector<std::string> names;
     try {
       WriteFitReport(analysis, staging.path());
@@ -669,10 +718,15 @@ int Server::Bind() {
   return impl_->port;
 }
 
-void Server::Run() { impl_->http.listen_after_bind(); }
+void Server::Run() {
+  // A Stop() after this test closes the socket, and listen_after_bind() then returns at once.
+  if (!impl_->stopped) impl_->http.listen_after_bind();
+}
 
 void Server::Stop() {
-  if (impl_) impl_->http.stop();
+  if (!impl_) return;
+  impl_->stopped = true;
+  impl_->http.StopListening();
 }
 
 ExperimentStore& Server::store() { return impl_->store; }
