@@ -11,6 +11,7 @@
 #include "internal/background_model.hpp"
 #include "internal/edge_fit.hpp"
 #include "internal/outline_fit.hpp"
+#include "internal/rejected_windows.hpp"
 
 namespace uphill {
 namespace {
@@ -95,6 +96,9 @@ struct BallTracker::Impl {
     bool needs_model_before;
   };
   std::optional<Unconfirmed> unconfirmed;
+  // The whole-path search's candidates fitted and rejected since the body was last found, with
+  // their pixels (see rejected_windows.hpp).
+  internal::RejectedWindows rejected;
 
   Impl(const Scene& sc, const TrackerOptions& o) : scene(sc), options(o) {}
 
@@ -762,10 +766,16 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
   if (guesses.empty() || !predicted)
     for (const Vector2d& c : m.Candidates(frame, gain, m.x_lo, m.x_hi)) guesses.push_back(c);
   for (const Vector2d& guess : guesses) {
+    // Without a prediction a candidate's fit depends on its window of the frame alone.
+    const cv::Rect window = predicted ? cv::Rect() : m.BodyRegion(guess, Vector2d::Zero());
+    if (!predicted && m.rejected.Unchanged(frame, window)) continue;
     const Vector2d v = predicted ? velocity : Vector2d::Zero();
     const FitRequest q = m.Request(guess, v, predicted && m.history.size() >= 2, 2 * m.options.search_half_width_px);
     const FitOutcome fit = m.Measure({frame, {0, 0}, gain}, q);
-    if (m.Accept(fit, 0.6)) {
+    if (!m.Accept(fit, 0.6)) {
+      if (!predicted) m.rejected.Remember(frame, window);
+    } else {
+      m.rejected.Clear();
       const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
       if (!predicted || (m.geometry.Project(c.x(), c.y()) - m.geometry.Project(centre.x(), centre.y())).norm() >
                             2 * m.RadiusPx(c.x(), c.y()) + 3 * velocity.norm() / m.options.fps / m.MetresPerPx(c.x(), c.y()))

@@ -42,10 +42,41 @@ void RequireInFront(const Eigen::Vector3d& p) {
                                   std::to_string(p.z()) + " m)");
 }
 
+// OpenCV's lens model as cv::projectPoints documents it, for the coefficient counts it has
+// without the thin prism and the tilted sensor (0, 4, 5, 8: k1 k2 p1 p2 [k3 [k4 k5 k6]]).
+// cv::projectPoints costs microseconds a call in set-up alone, and the tracker projects single
+// points many times a frame; the same arithmetic agrees with it to rounding
+// (tests/vision_camera_test.cpp, against cv::projectPoints). Other counts go through OpenCV.
+bool HasPlainLensModel(const CameraIntrinsics& c) {
+  const std::size_t n = c.distortion.size();
+  return n == 0 || n == 4 || n == 5 || n == 8;
+}
+
+Eigen::Vector2d ProjectWithPlainLensModel(const CameraIntrinsics& c, const Eigen::Vector3d& p) {
+  const double x = p.x() / p.z(), y = p.y() / p.z();
+  if (c.distortion.empty()) return {c.fx * x + c.cx, c.fy * y + c.cy};
+  const std::vector<double>& d = c.distortion;
+  const auto k = [&](std::size_t i) { return i < d.size() ? d[i] : 0.0; };
+  const double r2 = x * x + y * y, r4 = r2 * r2, r6 = r4 * r2;
+  const double radial = (1 + k(0) * r2 + k(1) * r4 + k(4) * r6) / (1 + k(5) * r2 + k(6) * r4 + k(7) * r6);
+  const double xd = x * radial + 2 * k(2) * x * y + k(3) * (r2 + 2 * x * x);
+  const double yd = y * radial + k(2) * (r2 + 2 * y * y) + 2 * k(3) * x * y;
+  return {c.fx * xd + c.cx, c.fy * yd + c.cy};
+}
+
 // Raw pixels of points already in the camera frame (each checked to be in front).
 std::vector<Eigen::Vector2d> ProjectCameraFramePoints(const CameraIntrinsics& camera,
                                                       const std::vector<Eigen::Vector3d>& points) {
   if (points.empty()) return {};
+  if (HasPlainLensModel(camera)) {
+    std::vector<Eigen::Vector2d> out;
+    out.reserve(points.size());
+    for (const auto& p : points) {
+      RequireInFront(p);
+      out.push_back(ProjectWithPlainLensModel(camera, p));
+    }
+    return out;
+  }
   std::vector<cv::Point3d> object;
   object.reserve(points.size());
   for (const auto& p : points) {
@@ -181,6 +212,10 @@ void ValidateIntrinsics(const CameraIntrinsics& c, const std::string& context) {
 }
 
 Eigen::Vector2d ProjectCameraPoint(const CameraIntrinsics& camera, const Eigen::Vector3d& point) {
+  if (HasPlainLensModel(camera)) {
+    RequireInFront(point);
+    return ProjectWithPlainLensModel(camera, point);
+  }
   return ProjectCameraFramePoints(camera, {point}).front();
 }
 
