@@ -321,6 +321,34 @@ TEST(MonteCarlo, SameSeedSameResultsOtherSeedOtherResults) {
   }
 }
 
+// The vector path (one pass, NarrowAtan's angles) against the scalar path, which is the model's
+// own code, trial by trial: the draws are the same bits (gaussian_stream.hpp), so every trial's
+// outputs agree to the kernels' rounding: within 8 units of 2^-53, the batch kernels' bound for
+// x_eq (batch_convert_test.cpp), NarrowAtan's angles being within 0.6 ulp of atan (measured here:
+// ≤ 3.5 units, φ).
+TEST(MonteCarlo, VectorTrialsAreTheModelsToTheLastBits) {
+  if (!VectorKernelAvailable(VectorKernel::kAvx2)) GTEST_SKIP() << "no AVX2 + FMA here";
+  PropagationOptions o = Trials(200000, 11);
+  o.keep_samples = true;
+  const auto rails = UncertainRails::Apparatus({kL, 0.002}, {kH, 0.001}, {kD, 0.0005});
+  o.kernel = VectorKernel::kScalar;
+  const auto scalar = Propagate(rails, UncertainBody::Spheroid({kA, 2e-5}, {kB, 2e-5}), {}, o);
+  o.kernel = VectorKernel::kAvx2;
+  const auto vector = Propagate(rails, UncertainBody::Spheroid({kA, 2e-5}, {kB, 2e-5}), {}, o);
+  ASSERT_EQ(scalar.samples.size(), vector.samples.size());
+  const auto ys = scalar.Outputs();
+  for (std::size_t k = 0; k < ys.size(); ++k) {
+    SCOPED_TRACE(ys[k]->name);
+    ASSERT_EQ(scalar.samples[k].size(), vector.samples[k].size());
+    double worst = 0.0;
+    for (std::size_t j = 0; j < scalar.samples[k].size(); ++j) {
+      const double s = scalar.samples[k][j], v = vector.samples[k][j];
+      worst = std::max(worst, std::abs(v - s) / std::abs(s) / 0x1p-53);
+    }
+    EXPECT_LE(worst, 8.0);
+  }
+}
+
 // A draw of one input does not depend on which other inputs are uncertain: with only D uncertain
 // and with D and a, the trials' D values are the same.
 TEST(MonteCarlo, EachInputHasItsOwnStream) {

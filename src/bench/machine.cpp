@@ -14,6 +14,8 @@
 #include <ctime>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
 
 namespace uphill::bench {
 
@@ -30,8 +32,16 @@ Machine DescribeMachine() {
     if (key == "flags" && flags.empty()) flags = " " + value + " ";
   }
   if (m.cpu.empty()) m.cpu = "unknown CPU";
-  const bool avx2 = flags.find(" avx2 ") != std::string::npos, fma = flags.find(" fma ") != std::string::npos;
-  m.cpu += avx2 && fma ? " (AVX2, FMA)" : avx2 ? " (AVX2)" : " (no AVX2)";
+  // The vector extensions the benchmarks' kernels choose from at run time (vector_kernel.hpp: AVX2
+  // with FMA; the Gaussian stream's Philox also AVX-512F), so that a row's speed can be read
+  // against what the machine offered.
+  auto has = [&](const char* flag) { return flags.find(std::string(" ") + flag + " ") != std::string::npos; };
+  std::string simd;
+  const std::pair<const char*, const char*> known[] = {{"avx2", "AVX2"}, {"fma", "FMA"}, {"avx512f", "AVX-512F"}};
+  for (const auto& [flag, name] : known)
+    if (has(flag)) simd += (simd.empty() ? "" : ", ") + std::string(name);
+  if (!has("avx512f")) simd += simd.empty() ? "no AVX2, no AVX-512" : "; no AVX-512";
+  m.cpu += " (" + simd + ")";
   m.cores = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
   if (getloadavg(m.load, 3) != 3) m.load[0] = m.load[1] = m.load[2] = -1;
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "model/libmvec_avx2.hpp"
+#include "internal/batch_kernels_avx2.hpp"
 #include "internal/spheroid_on_rods_closed_forms.hpp"
 
 #define UPHILL_BATCH_AVX2 UPHILL_LIBMVEC_AVX2
@@ -79,11 +80,7 @@ void ScalarDoubleCone(std::size_t n, const double* R, const double* h, const dou
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
 
-// hypot(x, y) as sqrt(x² + y²) with one rounding inside: ≤ 1 ulp more than hypot, and safe here
-// because the model's quantities are far from overflow and underflow (|x|, |y| in 1e-150..1e150).
-inline __m256d Hypot(__m256d x, __m256d y) {
-  return _mm256_sqrt_pd(_mm256_fmadd_pd(x, x, _mm256_mul_pd(y, y)));
-}
+using internal::avx2::Hypot;  // the shared expressions: internal/batch_kernels_avx2.hpp
 
 // Loads n < 4 values padded with `pad` (a harmless in-domain value), so that a short tail goes
 // through the same vector code as full lanes: every element's result depends on its inputs only.
@@ -115,11 +112,7 @@ inline void Avx2RailsTail(std::size_t i, std::size_t m, __m256d B, __m256d T,
                           const RailsArrays& out, double* B_out, double* T_out) {
   Store(B_out, i, m, B);
   Store(T_out, i, m, T);
-  if (out.phi) {
-    const __m256d one = _mm256_set1_pd(1.0);
-    const __m256d sec = _mm256_sqrt_pd(_mm256_fmadd_pd(B, B, one));  // hypot(1, B)
-    Store(out.phi, i, m, _ZGVdN4v_atan(_mm256_div_pd(T, sec)));
-  }
+  if (out.phi) Store(out.phi, i, m, _ZGVdN4v_atan(internal::avx2::PhiArgument(B, T)));
 }
 
 void Avx2RailsFromApparatus(std::size_t n, const double* L, const double* H, const double* D,
@@ -134,8 +127,8 @@ void Avx2RailsFromApparatus(std::size_t n, const double* L, const double* H, con
       const __m256d s = Hypot(h, _mm256_mul_pd(d, half));  // D/2 is exact
       horizontal = _mm256_sqrt_pd(_mm256_mul_pd(_mm256_sub_pd(l, s), _mm256_add_pd(l, s)));
     }
-    const __m256d B = _mm256_div_pd(h, horizontal);
-    const __m256d T = _mm256_div_pd(d, _mm256_mul_pd(two, horizontal));
+    const __m256d B = internal::avx2::TanTheta(h, horizontal);
+    const __m256d T = internal::avx2::TanHalfAlpha(d, horizontal);
     // atan(H/Lh) = atan2(H, Lh) for H ≥ 0, Lh > 0; B is the ratio the model uses anyway, and
     // atan is ~1.4× cheaper than atan2 in libmvec.
     if (out.theta) Store(out.theta, i, m, _ZGVdN4v_atan(B));
@@ -180,12 +173,8 @@ void Avx2Spheroid(std::size_t n, const double* a, const double* b, const double*
         Store(x_max, i, m, _mm256_fmadd_pd(vr, csc, Hypot(va, _mm256_div_pd(vb, T))));
       }
     } else {
-      if (x_eq) {
-        const __m256d A = _mm256_div_pd(_mm256_mul_pd(va, T), vb);
-        Store(x_eq, i, m,
-              _mm256_div_pd(_mm256_mul_pd(va, B), _mm256_mul_pd(A, Hypot(A, B))));
-      }
-      if (x_max) Store(x_max, i, m, Hypot(va, _mm256_div_pd(vb, T)));
+      if (x_eq) Store(x_eq, i, m, internal::avx2::SpheroidXEq(va, vb, B, T));
+      if (x_max) Store(x_max, i, m, internal::avx2::SpheroidXMax(va, vb, T));
     }
   }
 }

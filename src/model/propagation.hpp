@@ -41,8 +41,16 @@
 // the trials' inputs depend only on the seed (not on the machine, the compiler or a library's
 // version; the rare tail deviates up to the C library's log in the last bit), and a draw of D
 // does not change when another input gains or loses its uncertainty. The outputs
-// come from the batch kernel (batch_convert.hpp): the same numbers on every run, to a few ulp the
-// same on another CPU (kScalar and kAvx2 differ in the last bits; options.kernel picks one).
+// come from the batch kernel's expressions (batch_convert.hpp): the same numbers on every run, to
+// a few ulp the same on another CPU (kScalar and kAvx2 differ in the last bits; options.kernel
+// picks one). kScalar is the model's own scalar code. kAvx2 evaluates the angles θ = atan(B),
+// α = 2·atan(T), φ = atan(T/hypot(1, B)) not by libmvec but by NarrowAtan
+// (internal/narrow_atan.hpp): the Taylor polynomial of atan about a centre fixed at the first
+// block (the midpoint of its arguments' bounds), of the degree each block's bounds need for a
+// truncation ≤ 2^-56 relative, within 0.6 ulp of atan in the lab's cases (libmvec: 4 ulp); a
+// block whose arguments are too spread for it uses libmvec. So a trial's angle can depend in its
+// last bit on the block it falls in, never on the machine. For the common case (apparatus with
+// the horizontal L, sphere or spheroid on line rails) the model runs in one pass per block.
 //
 // Values. `value` is the scalar model's (Scene's) value to the bit; the sensitivities come from
 // jets through the same expressions. (The jets' own values can differ in the last bit: Jet
@@ -50,9 +58,11 @@
 //
 // Cost: first order is one evaluation with 8-component jets (microseconds). Monte Carlo runs in
 // blocks of 1024 trials with no per-trial allocation and no virtual dispatch; the coverage
-// interval is found without sorting the M values: a pilot of 2^14 trials places a narrow window
-// around each quantile, later trials are only counted (below) or kept (inside) — exact, with an
-// exact rerun in the (≈ 1e-4 probable) case that a window misses. Memory: ≈ 2 % of M per output.
+// interval is found without sorting the M values: a pilot of 2^12 trials places a window of
+// ± 4.5 standard errors around each quantile, narrowed from the exact order statistics so far
+// after 2^15 trials and after each further factor 8; the trials are only counted (below a
+// window) or kept (inside) — exact, with an exact rerun in the (≈ 1e-4 probable) case that a
+// window misses. Memory: under 1 % of M per output (≈ 3 000 values per window end at M = 10^6).
 // `uphill bench convert` measures the cost per trial against NumPy (docs/benchmarks.md).
 
 // Errors: InputError (model/input_error.hpp) naming the quantity and the rule, for a bad value

@@ -4,9 +4,16 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <utility>
 #include <vector>
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#endif
+
+#include "batch_kernels_avx2.hpp"
 #include "coverage_windows.hpp"
+#include "narrow_atan.hpp"
 #include "model/batch_convert.hpp"
 #include "model/gaussian_stream.hpp"
 #include "model/input_error.hpp"
@@ -18,12 +25,15 @@ namespace {
 // Monte Carlo.
 
 constexpr std::size_t kBlock = 1024;        // trials per block: the working set stays in L2
-constexpr std::uint64_t kPilot = 16 * kBlock;  // trials that place the coverage windows
-// Half-width of a coverage window in probability, in standard errors of the pilot's quantile
-// estimate (sqrt(p(1 − p)/pilot)): 4.5 makes a miss ≈ 7e-6 likely per window end, and a miss
-// costs a rerun (time), never accuracy; wider windows cost time on every run (~1 % of the values
-// are kept per window end).
+constexpr std::uint64_t kPilot = 4 * kBlock;   // trials that place the coverage windows
+// Half-width of a coverage window in probability, in standard errors of the quantile estimate
+// that places it (sqrt(p(1 − p)/m) after m trials): 4.5 makes a miss ≈ 7e-6 likely per window
+// end, and a miss costs a rerun (time), never accuracy; wider windows cost time on every run
+// (the pilot's keep ≈ 2 % of the values per window end, narrowed ones less).
 constexpr double kWindowSigmas = 4.5;
+// The windows are narrowed again (NarrowWindows) after kNarrowEvery·kPilot trials, and after each
+// further factor kNarrowEvery: each time to sqrt(kNarrowEvery) ≈ 2.8 times narrower.
+constexpr std::uint64_t kNarrowEvery = 8;
 
 enum Reason : unsigned char {
   kValid = 0,
@@ -81,12 +91,118 @@ void AccumulateMoments(OutputStats& s, const double* y, std::size_t n) {
   Neumaier(&s.sum2, &s.sum2_c, b);
 }
 
+// φ's argument T/sqrt(1 + B²), the expression of batch_convert.cpp's AVX2 kernels
+// (batch_kernels_avx2.hpp), so that the angle is the only thing the vector path computes anew; and
+// in the same pass the bounds of B, T and the argument (NaNs skipped), for NarrowAtan::DegreeFor.
+struct Bounds {
+  double lo, hi;
+};
+#if defined(__x86_64__) && defined(__GNUC__)
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+void PhiArgumentAvx2(std::size_t n, const double* B, const double* T, double* out, Bounds (&bounds)[3]) {
+  __m256d lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) lo[k] = _mm256_set1_pd(HUGE_VAL), hi[k] = _mm256_set1_pd(-HUGE_VAL);
+  auto extend = [&](int k, __m256d v) {  // a NaN in v yields the second operand: skipped
+    lo[k] = _mm256_min_pd(v, lo[k]);
+    hi[k] = _mm256_max_pd(v, hi[k]);
+  };
+  std::size_t j = 0;
+  for (; j + 4 <= n; j += 4) {
+    const __m256d b = _mm256_loadu_pd(B + j), t = _mm256_loadu_pd(T + j);
+    const __m256d p = avx2::PhiArgument(b, t);
+    _mm256_storeu_pd(out + j, p);
+    extend(0, b);
+    extend(1, t);
+    extend(2, p);
+  }
+  for (int k = 0; k < 3; ++k) {
+    alignas(32) double l[4], h[4];
+    _mm256_store_pd(l, lo[k]);
+    _mm256_store_pd(h, hi[k]);
+    bounds[k] = {std::min(std::min(l[0], l[1]), std::min(l[2], l[3])),
+                 std::max(std::max(h[0], h[1]), std::max(h[2], h[3]))};
+  }
+  for (; j < n; ++j) {
+    out[j] = T[j] / std::sqrt(std::fma(B[j], B[j], 1.0));
+    const double v[3] = {B[j], T[j], out[j]};
+    for (int k = 0; k < 3; ++k) {
+      bounds[k].lo = v[k] < bounds[k].lo ? v[k] : bounds[k].lo;
+      bounds[k].hi = v[k] > bounds[k].hi ? v[k] : bounds[k].hi;
+    }
+  }
+}
+// The common case's model in one pass over a block (OnePass below): per group of four trials B,
+// T, the three angles (NarrowAtan, all three at degree N), x_eq and x_max by the batch kernels'
+// own expressions (batch_kernels_avx2.hpp), nothing going through memory in between. A short
+// tail is padded with the block's first trial.
+template <int N>
+void LineSpheroidOnePassAvx2(std::size_t n, const double* L, const double* H, const double* D, const double* a,
+                             const double* b, const NarrowAtan (&atan)[3], double* const (&out)[5]) {
+  const __m256d one = _mm256_set1_pd(1.0), two = _mm256_set1_pd(2.0);
+  auto group = [&](__m256d l, __m256d h, __m256d d, __m256d va, __m256d vb, __m256d (&y)[5]) {
+    const __m256d B = avx2::TanTheta(h, l), T = avx2::TanHalfAlpha(d, l);
+    y[0] = avx2::Atan<N>(atan[0], B, one);
+    y[1] = avx2::Atan<N>(atan[1], T, two);
+    y[2] = avx2::Atan<N>(atan[2], avx2::PhiArgument(B, T), one);
+    y[3] = avx2::SpheroidXEq(va, vb, B, T);
+    y[4] = avx2::SpheroidXMax(va, vb, T);
+  };
+  std::size_t j = 0;
+  for (; j + 4 <= n; j += 4) {
+    __m256d y[5];
+    group(_mm256_loadu_pd(L + j), _mm256_loadu_pd(H + j), _mm256_loadu_pd(D + j), _mm256_loadu_pd(a + j),
+          _mm256_loadu_pd(b + j), y);
+    for (int k = 0; k < 5; ++k) _mm256_storeu_pd(out[k] + j, y[k]);
+  }
+  if (j < n) {
+    alignas(32) double in[5][4];
+    const double* from[5] = {L, H, D, a, b};
+    for (int k = 0; k < 5; ++k)
+      for (std::size_t t = 0; t < 4; ++t) in[k][t] = from[k][j + t < n ? j + t : 0];
+    __m256d y[5];
+    group(_mm256_load_pd(in[0]), _mm256_load_pd(in[1]), _mm256_load_pd(in[2]), _mm256_load_pd(in[3]),
+          _mm256_load_pd(in[4]), y);
+    for (int k = 0; k < 5; ++k) {
+      alignas(32) double t[4];
+      _mm256_store_pd(t, y[k]);
+      for (std::size_t m = 0; j + m < n; ++m) out[k][j + m] = t[m];
+    }
+  }
+}
+
+// The one pass at degree `degree`, 1 … NarrowAtan::kMaxDegree.
+template <int... N>
+void LineSpheroidOnePassOf(int degree, std::integer_sequence<int, N...>, std::size_t n, const double* L,
+                           const double* H, const double* D, const double* a, const double* b,
+                           const NarrowAtan (&atan)[3], double* const (&out)[5]) {
+  ((degree == N + 1 ? LineSpheroidOnePassAvx2<N + 1>(n, L, H, D, a, b, atan, out) : void()), ...);
+}
+#pragma GCC pop_options
+#endif
+
+// Puts base[r] in place for every rank r of [r_begin, r_end) (distinct, ascending, each inside
+// [first, last)) as std::nth_element would: the middle rank first, then each side within its
+// part, so that the four ends of two coverage windows cost two passes over the pilot, not four.
+void SelectRanks(double* first, double* last, const std::ptrdiff_t* r_begin, const std::ptrdiff_t* r_end,
+                 double* base) {
+  if (r_begin == r_end || first >= last) return;
+  const std::ptrdiff_t* mid = r_begin + (r_end - r_begin) / 2;
+  double* nth = base + *mid;
+  std::nth_element(first, nth, last);
+  SelectRanks(first, nth, r_begin, mid, base);
+  SelectRanks(nth + 1, last, mid + 1, r_end, base);
+}
+
 class MonteCarloRun {
  public:
   MonteCarloRun(const Problem& p, const PropagationOptions& o) : p_(p), o_(o) {
     for (int k = 0; k < kOutCount; ++k)
       if (HasOutput(p.body, k)) outputs_.push_back(k);
-    buffer_.assign(static_cast<std::size_t>(kNumInputs + kOutCount + 3) * kBlock, 0.0);
+    buffer_.assign(static_cast<std::size_t>(kNumInputs + kOutCount + 4) * kBlock, 0.0);
+#if defined(__x86_64__) && defined(__GNUC__)
+    narrow_ = UseAvx2(o.kernel);
+#endif
     for (int i = 0; i < kNumInputs; ++i) std::fill_n(Input(i), kBlock, p.present[i] ? p.value[i] : 0.0);
   }
 
@@ -114,6 +230,7 @@ class MonteCarloRun {
         streams.push_back({i, GaussianStream(o_.seed, static_cast<std::uint32_t>(i))});
 
     const bool windows = !store_all && o_.trials > 4 * kPilot;
+    std::uint64_t narrow_at = kNarrowEvery * kPilot;
     RejectedTrials rejected;
     for (std::uint64_t done = 0; done < o_.trials;) {
       const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(kBlock, o_.trials - done));
@@ -146,6 +263,10 @@ class MonteCarloRun {
       }
       done += n;
       if (windows && done == kPilot) PlaceWindows(pilot, &stats);
+      if (windows && done == narrow_at && done < o_.trials) {
+        NarrowWindows(done - rejected.total(), &stats);
+        narrow_at *= kNarrowEvery;
+      }
     }
     return Finish(stats, rejected, windows, result);
   }
@@ -243,12 +364,15 @@ class MonteCarloRun {
         if (!(L[j] > std::hypot(H[j], D[j] / 2))) mark(j, kImpossibleApparatus);
     }
 
+    if (OnePass(n)) return Compact(n, any_bad, reason, rejected);
     double* B = Scratch(0);
     double* T = Scratch(1);
     RailsArrays rails;
-    rails.theta = Output(kOutTheta);
-    rails.alpha = Output(kOutAlpha);
-    rails.phi = Output(kOutPhi);
+    // The vector path leaves the angles to NarrowAtan (narrow_atan.hpp); from given angles θ and α
+    // are copies either way.
+    rails.theta = narrow_ && apparatus ? nullptr : Output(kOutTheta);
+    rails.alpha = narrow_ && apparatus ? nullptr : Output(kOutAlpha);
+    rails.phi = narrow_ ? nullptr : Output(kOutPhi);
     rails.tan_theta = B;
     rails.tan_half_alpha = T;
     if (apparatus) {
@@ -257,6 +381,18 @@ class MonteCarloRun {
       RailsFromAnglesBatch(n, Input(Index(InputQuantity::kTheta)), Input(Index(InputQuantity::kAlpha)),
                            rails, o_.kernel);
     }
+#if defined(__x86_64__) && defined(__GNUC__)
+    if (narrow_) {
+      double* phi_argument = Scratch(3);
+      Bounds bounds[3];
+      PhiArgumentAvx2(n, B, T, phi_argument, bounds);
+      if (apparatus) {
+        Angle(kOutTheta, n, B, 1.0, bounds[0]);
+        Angle(kOutAlpha, n, T, 2.0, bounds[1]);
+      }
+      Angle(kOutPhi, n, phi_argument, 1.0, bounds[2]);
+    }
+#endif
     const double* across = Input(Index(InputQuantity::kAcross));
     const double* along = Input(Index(InputQuantity::kAlong));
     const double* r = Input(Index(InputQuantity::kRodRadius));
@@ -285,6 +421,11 @@ class MonteCarloRun {
       }
     }
 
+    return Compact(n, any_bad, reason, rejected);
+  }
+
+  // Counts the block's rejected trials by reason and compacts the outputs to the valid ones.
+  std::size_t Compact(std::size_t n, bool any_bad, const unsigned char* reason, RejectedTrials* rejected) {
     if (!any_bad) return n;
     std::size_t bad = 0;
     for (std::size_t j = 0; j < n; ++j) bad += reason[j] != kValid;
@@ -306,6 +447,77 @@ class MonteCarloRun {
     }
     return n - bad;
   }
+  // Output `slot` = scale·atan(x) for the block (vector path): by the Taylor polynomial about a
+  // centre fixed at the first block whose arguments are all > 0 (their midpoint), of the degree
+  // this block's range needs; by libmvec where no degree ≤ NarrowAtan::kMaxDegree suffices. Both
+  // depend only on the argument's own values, never on other inputs' draws.
+  void Angle(int slot, std::size_t n, const double* x, double scale, Bounds range) {
+    const double lo = range.lo, hi = range.hi;
+    if (!has_atan_[slot] && lo > 0.0 && hi >= lo && std::isfinite(hi)) {
+      atan_[slot] = NarrowAtan(0.5 * (lo + hi));
+      has_atan_[slot] = true;
+    }
+    const int degree = has_atan_[slot] ? atan_[slot].DegreeFor(lo, hi) : 0;
+    if (degree > 0) {
+      atan_[slot].Evaluate(n, x, scale, Output(slot), degree);
+    } else {
+      NarrowAtan::Libmvec(n, x, scale, Output(slot));
+    }
+  }
+
+  // The bounds of an input's values in this block: its fill's range, or its exact value.
+  Bounds InputBounds(InputQuantity q) const {
+    const int i = Index(q);
+    return Uncertain(q) ? Bounds{range_[i].min, range_[i].max} : Bounds{p_.value[i], p_.value[i]};
+  }
+
+  // The common case (vector path, apparatus with the horizontal L, sphere or spheroid on line
+  // rails) in one pass: LineSpheroidOnePassAvx2. The angles' degrees come from bounds of B, T and
+  // φ's argument computed from the inputs' bounds by the same expressions: each is monotone in
+  // every input and so are its roundings, so the bounds hold for every computed value. False,
+  // with nothing written, where the case or the block does not allow it (the stage kernels then
+  // run): a block with draws out of the domain, or arguments too spread for NarrowAtan.
+  bool OnePass(std::size_t n) {
+#if defined(__x86_64__) && defined(__GNUC__)
+    if (!narrow_ || p_.given != UncertainRails::Given::kApparatus || p_.convention != LConvention::kHorizontal ||
+        p_.rods || p_.body == BodyKind::kDoubleCone)
+      return false;
+    const Bounds L = InputBounds(InputQuantity::kL), H = InputBounds(InputQuantity::kH),
+                 D = InputBounds(InputQuantity::kD);
+    if (!(L.lo > 0.0) || !(H.lo >= 0.0) || !(D.lo > 0.0)) return false;
+    Bounds arg[3];
+    arg[0] = {H.lo / L.hi, H.hi / L.lo};                  // B = H/L
+    arg[1] = {D.lo / (2 * L.hi), D.hi / (2 * L.lo)};      // T = D/(2L)
+    arg[2] = {arg[1].lo / std::sqrt(std::fma(arg[0].hi, arg[0].hi, 1.0)),
+              arg[1].hi / std::sqrt(std::fma(arg[0].lo, arg[0].lo, 1.0))};  // T/sqrt(1 + B²)
+    // One degree for the three angles, the largest any needs (a higher degree only adds terms
+    // below the rounding): one compiled pass per degree.
+    const int slot[3] = {kOutTheta, kOutAlpha, kOutPhi};
+    NarrowAtan atan[3];
+    int degree = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (!has_atan_[slot[k]] && arg[k].lo > 0.0 && std::isfinite(arg[k].hi)) {
+        atan_[slot[k]] = NarrowAtan(0.5 * (arg[k].lo + arg[k].hi));
+        has_atan_[slot[k]] = true;
+      }
+      const int d = has_atan_[slot[k]] ? atan_[slot[k]].DegreeFor(arg[k].lo, arg[k].hi) : 0;
+      if (d == 0) return false;
+      degree = std::max(degree, d);
+      atan[k] = atan_[slot[k]];
+    }
+    const double* across = Input(Index(InputQuantity::kAcross));
+    const double* along = p_.body == BodyKind::kSphere ? across : Input(Index(InputQuantity::kAlong));
+    double* const out[5] = {Output(kOutTheta), Output(kOutAlpha), Output(kOutPhi), Output(kOutXEq), Output(kOutXMax)};
+    LineSpheroidOnePassOf(degree, std::make_integer_sequence<int, NarrowAtan::kMaxDegree>{}, n,
+                          Input(Index(InputQuantity::kL)), Input(Index(InputQuantity::kH)),
+                          Input(Index(InputQuantity::kD)), across, along, atan, out);
+    return true;
+#else
+    (void)n;
+    return false;
+#endif
+  }
+
   bool streams_empty() const {
     for (int i = 0; i < kNumInputs; ++i)
       if (p_.u[i] > 0.0) return false;
@@ -321,26 +533,70 @@ class MonteCarloRun {
       OutputStats& s = (*stats)[k];
       if (!s.varies) continue;
       const double m = static_cast<double>(v.size());
+      // The window ends' ranks in the pilot (-1: that side stays open), then all four selected.
+      std::ptrdiff_t rank[2][2] = {{-1, -1}, {-1, -1}};
+      double half[2] = {0.0, 0.0};
+      std::vector<std::ptrdiff_t> ranks;
+      for (int e = 0; e < 2; ++e) {
+        s.window[e] = Window{};
+        if (v.empty()) continue;  // every pilot trial rejected: the window keeps everything
+        half[e] = kWindowSigmas * std::sqrt(ends[e] * (1.0 - ends[e]) / m);
+        const double lo_p = ends[e] - half[e], hi_p = ends[e] + half[e];
+        if (lo_p > 0.0) ranks.push_back(rank[e][0] = static_cast<std::ptrdiff_t>(std::floor(lo_p * (m - 1))));
+        if (hi_p < 1.0) ranks.push_back(rank[e][1] = static_cast<std::ptrdiff_t>(std::ceil(hi_p * (m - 1))));
+      }
+      std::sort(ranks.begin(), ranks.end());
+      ranks.erase(std::unique(ranks.begin(), ranks.end()), ranks.end());
+      SelectRanks(v.data(), v.data() + v.size(), ranks.data(), ranks.data() + ranks.size(), v.data());
       for (int e = 0; e < 2; ++e) {
         Window& w = s.window[e];
-        w = Window{};
-        if (v.empty()) continue;  // every pilot trial rejected: the window keeps everything
-        const double half = kWindowSigmas * std::sqrt(ends[e] * (1.0 - ends[e]) / m);
-        const double lo_p = ends[e] - half, hi_p = ends[e] + half;
-        if (lo_p > 0.0) {
-          const auto it = v.begin() + static_cast<std::ptrdiff_t>(std::floor(lo_p * (m - 1)));
-          std::nth_element(v.begin(), it, v.end());
-          w.lo = *it;
-        }
-        if (hi_p < 1.0) {
-          const auto it = v.begin() + static_cast<std::ptrdiff_t>(std::ceil(hi_p * (m - 1)));
-          std::nth_element(v.begin(), it, v.end());
-          w.hi = *it;
-        }
-        w.kept.Reserve(static_cast<std::size_t>(2.5 * half * static_cast<double>(o_.trials)) + 64);
+        if (v.empty()) continue;
+        if (rank[e][0] >= 0) w.lo = v[static_cast<std::size_t>(rank[e][0])];
+        if (rank[e][1] >= 0) w.hi = v[static_cast<std::size_t>(rank[e][1])];
+        w.kept.Reserve(static_cast<std::size_t>(2.5 * half[e] * static_cast<double>(o_.trials)) + 64);
       }
       CountWindows(s.window, v.data(), v.size(), o_.kernel);
       std::vector<double>().swap(v);
+    }
+  }
+
+  // The windows narrowed to p ± kWindowSigmas·sqrt(p(1 − p)/m) from the m valid trials so far,
+  // whose order statistics near the window are known exactly (`below` and the kept values): the
+  // new ends are kept values at those ranks, the kept values outside them are dropped (those
+  // below counted). Exact like the first windows, with the same margin for the final order
+  // statistics, and the later trials keep fewer values: at 10^6 trials about 4 000 per window end
+  // instead of 11 000, so that the keeping and the final selection cost less than half as much.
+  void NarrowWindows(std::uint64_t m, std::vector<OutputStats>* stats) {
+    const double ends[2] = {(1.0 - o_.coverage) / 2, (1.0 + o_.coverage) / 2};
+    const double mm = static_cast<double>(m);
+    for (OutputStats& s : *stats) {
+      if (!s.varies || m < 2) continue;
+      for (int e = 0; e < 2; ++e) {
+        Window& w = s.window[e];
+        const double half = kWindowSigmas * std::sqrt(ends[e] * (1.0 - ends[e]) / mm);
+        double lo = w.lo, hi = w.hi;
+        // The kept value of 0-based rank g among all m, if the window holds it.
+        auto at = [&](double rank, double* end) {
+          const double g = rank - static_cast<double>(w.below);
+          if (g < 0.0 || g >= static_cast<double>(w.kept.size())) return;
+          double* it = w.kept.begin() + static_cast<std::ptrdiff_t>(g);
+          std::nth_element(w.kept.begin(), it, w.kept.end());
+          *end = *it;
+        };
+        if (ends[e] - half > 0.0) at(std::floor((ends[e] - half) * (mm - 1)), &lo);
+        if (ends[e] + half < 1.0) at(std::ceil((ends[e] + half) * (mm - 1)), &hi);
+        double* out = w.kept.begin();
+        for (const double* v = w.kept.begin(); v != w.kept.end(); ++v) {
+          if (*v < lo) {
+            ++w.below;
+          } else if (*v <= hi) {
+            *out++ = *v;
+          }
+        }
+        w.kept.SetEnd(out);
+        w.lo = lo;
+        w.hi = hi;
+      }
     }
   }
 
@@ -385,6 +641,9 @@ class MonteCarloRun {
   std::vector<int> outputs_;
   std::vector<double> buffer_;
   GaussianStream::Range range_[kNumInputs];  // bounds of each uncertain input's current block
+  bool narrow_ = false;  // the vector path: angles by NarrowAtan
+  NarrowAtan atan_[kOutCount];
+  bool has_atan_[kOutCount] = {};
   MonteCarloValue values_[kOutCount];
 };
 
