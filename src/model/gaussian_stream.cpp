@@ -19,18 +19,17 @@ namespace uphill {
 
 namespace {
 
-// Blocks [first, first + count) of the stream (gaussian_stream.hpp), two words each, by
-// Random123's own Philox4x32-10.
+// Blocks [first, first + count) of the stream (gaussian_stream.hpp) by Random123's own
+// Philox4x32-10: block b's outputs c0 … c3 as words[4b … 4b + 3].
 void PhiloxBlocks(std::uint64_t first, std::size_t count, const std::uint32_t key[2], std::uint32_t id,
-                  std::uint32_t lane3, std::uint64_t* words) {
+                  std::uint32_t lane3, std::uint32_t* words) {
   const r123::Philox4x32 philox;
   const r123::Philox4x32::key_type k = {{key[0], key[1]}};
   for (std::size_t b = 0; b < count; ++b) {
     const std::uint64_t j = first + b;
     const r123::Philox4x32::ctr_type c = {{static_cast<std::uint32_t>(j), static_cast<std::uint32_t>(j >> 32), id, lane3}};
     const r123::Philox4x32::ctr_type r = philox(c, k);
-    words[2 * b] = r.v[0] | (std::uint64_t{r.v[1]} << 32);
-    words[2 * b + 1] = r.v[2] | (std::uint64_t{r.v[3]} << 32);
+    for (int l = 0; l < 4; ++l) words[4 * b + l] = r.v[l];
   }
 }
 
@@ -38,12 +37,13 @@ void PhiloxBlocks(std::uint64_t first, std::size_t count, const std::uint32_t ke
 #pragma GCC push_options
 #pragma GCC target("avx2")
 
-// (hi, lo) of the eight 32 × 32-bit products m·x, lane by lane: hi from the two widening
-// multiplies, lo by the low multiply (one instruction where shifting and blending took two).
+// (hi, lo) of the eight 32 × 32-bit products m·x, lane by lane, both from the two widening
+// multiplies by shifts and blends: the multiplier is the scarce unit (on AMD Zen 3 the low
+// multiply instead of the shift and blend for lo measured ≈ 1.5 % slower per Monte Carlo trial).
 inline void MulHiLo(__m256i x, __m256i m, __m256i* hi, __m256i* lo) {
   const __m256i even = _mm256_mul_epu32(x, m);                         // lanes 0, 2, 4, 6
   const __m256i odd = _mm256_mul_epu32(_mm256_srli_epi64(x, 32), m);  // lanes 1, 3, 5, 7
-  *lo = _mm256_mullo_epi32(x, m);
+  *lo = _mm256_blend_epi32(even, _mm256_slli_epi64(odd, 32), 0xAA);
   *hi = _mm256_blend_epi32(_mm256_srli_epi64(even, 32), odd, 0xAA);
 }
 
@@ -54,7 +54,7 @@ inline void MulHiLo(__m256i x, __m256i m, __m256i* hi, __m256i* lo) {
 // would wrap.
 template <int kSets>
 std::size_t PhiloxSetsAvx2(std::uint64_t first, std::size_t count, const std::uint32_t key[2], std::uint32_t id,
-                           std::uint32_t lane3, std::uint64_t* words) {
+                           std::uint32_t lane3, std::uint32_t* words) {
   std::size_t b = 0;
   const __m256i m0 = _mm256_set1_epi32(static_cast<int>(PHILOX_M4x32_0));
   const __m256i m1 = _mm256_set1_epi32(static_cast<int>(PHILOX_M4x32_1));
@@ -62,7 +62,7 @@ std::size_t PhiloxSetsAvx2(std::uint64_t first, std::size_t count, const std::ui
   for (; b + 8 * kSets <= count; b += 8 * kSets) {
     const std::uint64_t j = first + b;
     if (static_cast<std::uint32_t>(j) > 0xFFFFFFFFu - 8 * kSets) {
-      PhiloxBlocks(j, 8 * kSets, key, id, lane3, words + 2 * b);
+      PhiloxBlocks(j, 8 * kSets, key, id, lane3, words + 4 * b);
       continue;
     }
     __m256i x0[kSets], x1[kSets], x2[kSets], x3[kSets];
@@ -87,13 +87,14 @@ std::size_t PhiloxSetsAvx2(std::uint64_t first, std::size_t count, const std::ui
       }
     }
     for (int s = 0; s < kSets; ++s) {
-      // Words 2b = c0 | c1 << 32 and 2b + 1 = c2 | c3 << 32, per block, in block order.
+      // Words 4b … 4b + 3 = c0 … c3, per block, in block order (as the 64-bit lanes c0 | c1 << 32
+      // and c2 | c3 << 32: x86 is little-endian).
       const __m256i a_lo = _mm256_unpacklo_epi32(x0[s], x1[s]);  // blocks 0,1 | 4,5
       const __m256i a_hi = _mm256_unpackhi_epi32(x0[s], x1[s]);  // blocks 2,3 | 6,7
       const __m256i b_lo = _mm256_unpacklo_epi32(x2[s], x3[s]), b_hi = _mm256_unpackhi_epi32(x2[s], x3[s]);
       const __m256i p0 = _mm256_unpacklo_epi64(a_lo, b_lo), q0 = _mm256_unpackhi_epi64(a_lo, b_lo);  // 0|4, 1|5
       const __m256i p1 = _mm256_unpacklo_epi64(a_hi, b_hi), q1 = _mm256_unpackhi_epi64(a_hi, b_hi);  // 2|6, 3|7
-      __m256i* out = reinterpret_cast<__m256i*>(words + 2 * (b + 8 * s));
+      __m256i* out = reinterpret_cast<__m256i*>(words + 4 * (b + 8 * s));
       _mm256_storeu_si256(out + 0, _mm256_permute2x128_si256(p0, q0, 0x20));  // blocks 0, 1
       _mm256_storeu_si256(out + 1, _mm256_permute2x128_si256(p1, q1, 0x20));  // blocks 2, 3
       _mm256_storeu_si256(out + 2, _mm256_permute2x128_si256(p0, q0, 0x31));  // blocks 4, 5
@@ -104,10 +105,10 @@ std::size_t PhiloxSetsAvx2(std::uint64_t first, std::size_t count, const std::ui
 }
 
 void PhiloxBlocksAvx2(std::uint64_t first, std::size_t count, const std::uint32_t key[2], std::uint32_t id,
-                      std::uint32_t lane3, std::uint64_t* words) {
+                      std::uint32_t lane3, std::uint32_t* words) {
   std::size_t b = PhiloxSetsAvx2<3>(first, count, key, id, lane3, words);
-  b += PhiloxSetsAvx2<1>(first + b, count - b, key, id, lane3, words + 2 * b);
-  PhiloxBlocks(first + b, count - b, key, id, lane3, words + 2 * b);
+  b += PhiloxSetsAvx2<1>(first + b, count - b, key, id, lane3, words + 4 * b);
+  PhiloxBlocks(first + b, count - b, key, id, lane3, words + 4 * b);
 }
 
 #pragma GCC pop_options
@@ -124,7 +125,7 @@ void PhiloxBlocksAvx2(std::uint64_t first, std::size_t count, const std::uint32_
 // the round's three-way xors by one ternary-logic instruction each (0x96: a ^ b ^ c). Words in
 // the same order. Falls back to PhiloxBlocks where j's low word would wrap.
 void PhiloxBlocksAvx512(std::uint64_t first, std::size_t count, const std::uint32_t key[2], std::uint32_t id,
-                        std::uint32_t lane3, std::uint64_t* words) {
+                        std::uint32_t lane3, std::uint32_t* words) {
   constexpr int kSets = 4;
   std::size_t b = 0;
   const __m512i m0 = _mm512_set1_epi32(static_cast<int>(PHILOX_M4x32_0));
@@ -133,7 +134,7 @@ void PhiloxBlocksAvx512(std::uint64_t first, std::size_t count, const std::uint3
   for (; b + 16 * kSets <= count; b += 16 * kSets) {
     const std::uint64_t j = first + b;
     if (static_cast<std::uint32_t>(j) > 0xFFFFFFFFu - 16 * kSets) {
-      PhiloxBlocks(j, 16 * kSets, key, id, lane3, words + 2 * b);
+      PhiloxBlocks(j, 16 * kSets, key, id, lane3, words + 4 * b);
       continue;
     }
     __m512i x0[kSets], x1[kSets], x2[kSets], x3[kSets];
@@ -170,14 +171,14 @@ void PhiloxBlocksAvx512(std::uint64_t first, std::size_t count, const std::uint3
       // A 4 × 4 transpose of 128-bit lanes puts the blocks in order.
       const __m512i u0 = _mm512_shuffle_i64x2(p, q, 0x44), u1 = _mm512_shuffle_i64x2(r, t, 0x44);
       const __m512i u2 = _mm512_shuffle_i64x2(p, q, 0xEE), u3 = _mm512_shuffle_i64x2(r, t, 0xEE);
-      std::uint64_t* out = words + 2 * (b + 16 * s);
+      std::uint32_t* out = words + 4 * (b + 16 * s);
       _mm512_storeu_si512(out + 0, _mm512_shuffle_i64x2(u0, u1, 0x88));   // blocks 0 … 3
-      _mm512_storeu_si512(out + 8, _mm512_shuffle_i64x2(u0, u1, 0xDD));   // blocks 4 … 7
-      _mm512_storeu_si512(out + 16, _mm512_shuffle_i64x2(u2, u3, 0x88));  // blocks 8 … 11
-      _mm512_storeu_si512(out + 24, _mm512_shuffle_i64x2(u2, u3, 0xDD));  // blocks 12 … 15
+      _mm512_storeu_si512(out + 16, _mm512_shuffle_i64x2(u0, u1, 0xDD));  // blocks 4 … 7
+      _mm512_storeu_si512(out + 32, _mm512_shuffle_i64x2(u2, u3, 0x88));  // blocks 8 … 11
+      _mm512_storeu_si512(out + 48, _mm512_shuffle_i64x2(u2, u3, 0xDD));  // blocks 12 … 15
     }
   }
-  PhiloxBlocksAvx2(first + b, count - b, key, id, lane3, words + 2 * b);
+  PhiloxBlocksAvx2(first + b, count - b, key, id, lane3, words + 4 * b);
 }
 
 #pragma GCC diagnostic pop
@@ -191,7 +192,7 @@ bool CpuHasAvx512f() {
 
 // Blocks by the widest code the Fill's kernel allows (gaussian_stream.hpp: all give the same words).
 void PhiloxBlocksBy(int simd, std::uint64_t first, std::size_t count, const std::uint32_t key[2],
-                    std::uint32_t id, std::uint32_t lane3, std::uint64_t* words) {
+                    std::uint32_t id, std::uint32_t lane3, std::uint32_t* words) {
 #if UPHILL_NORMALS_AVX2
   if (simd == 2) return PhiloxBlocksAvx512(first, count, key, id, lane3, words);
   if (simd == 1) return PhiloxBlocksAvx2(first, count, key, id, lane3, words);
@@ -201,7 +202,7 @@ void PhiloxBlocksBy(int simd, std::uint64_t first, std::size_t count, const std:
 }
 
 
-// The fast path's two numbers per layer side by side (one 16-byte load per word): x_i·2^-52
+// The fast path's two numbers per layer side by side (one 16-byte load per word): x_i·2^-22
 // (exact: a power-of-two scaling of a normal double) and x_{i+1}.
 struct alignas(16) LayerPair {
   double scale, next;
@@ -210,7 +211,7 @@ struct FastTable {
   LayerPair layer[ziggurat::kLayers];
   constexpr FastTable() : layer() {
     for (int i = 0; i < ziggurat::kLayers; ++i)
-      layer[i] = {ziggurat::kX[i] * 0x1p-52, ziggurat::kX[i + 1]};
+      layer[i] = {ziggurat::kX[i] * 0x1p-22, ziggurat::kX[i + 1]};
   }
 };
 constexpr FastTable kFast;
@@ -218,10 +219,13 @@ constexpr std::uint64_t kLayerMask = ziggurat::kLayers - 1;
 static_assert((ziggurat::kLayers & kLayerMask) == 0 && kLayerMask == 1023,
               "the stream's definition uses 10 bits for the layer, bit 10 for the sign");
 
+// 2m + 1 for the word's position m = ⌊w / 2^11⌋: ⌊w / 2^10⌋ is 2m + (the sign bit); its bit 0 set.
+inline std::uint32_t OddPosition(std::uint32_t w) { return (w >> 10) | 1u; }
+
 // The fast path of gaussian_stream.hpp for one word: *z = ±x, true when accepted.
-inline bool FastPath(std::uint64_t w, double* z) {
+inline bool FastPath(std::uint32_t w, double* z) {
   const LayerPair& p = kFast.layer[w & kLayerMask];
-  const double x = static_cast<double>(w >> 12) * p.scale;  // < 2^52: converted exactly
+  const double x = static_cast<double>(OddPosition(w)) * p.scale;  // < 2^22: converted exactly
   *z = (w >> 10) & 1 ? -x : x;
   return x < p.next;
 }
@@ -237,7 +241,7 @@ inline bool FastPath(std::uint64_t w, double* z) {
 // evicted from the caches, and cost more per trial than a deviate's whole fast path. x_i and
 // x_{i+1} come from kFast (in cache: the fast path reads it), f from the stream's table.
 inline bool WedgeAccepts(std::size_t i, double x, double u) {
-  const double x_i = kFast.layer[i].scale * 0x1p52, x_next = kFast.layer[i].next;  // exact
+  const double x_i = kFast.layer[i].scale * 0x1p22, x_next = kFast.layer[i].next;  // exact
   const double df = ziggurat::kF[i + 1] - ziggurat::kF[i];
   const double y = ziggurat::kF[i] + u * df;
   if (x_next >= 1.0 || x_i <= 1.0) {
@@ -255,11 +259,11 @@ inline bool WedgeAccepts(std::size_t i, double x, double u) {
 void GaussianStream::Refill() {
   const std::size_t left = end_ - pos_;
   std::memmove(buffer_, buffer_ + pos_, left * sizeof buffer_[0]);
-  const std::size_t blocks = (kBuffer - left) / 2;
+  const std::size_t blocks = (kBuffer - left) / 4;
   PhiloxBlocksBy(simd_, next_block_, blocks, key_, id_, 0, buffer_ + left);
   next_block_ += blocks;
   pos_ = 0;
-  end_ = left + 2 * blocks;
+  end_ = left + 4 * blocks;
 }
 
 void GaussianStream::RefillSide() {
@@ -275,11 +279,11 @@ struct GaussianStreamAccess {
   template <bool kScale>
   static void Fill(GaussianStream* s, std::size_t n, double mean, double scale, double* out, VectorKernel kernel,
                    GaussianStream::Range* range);
-  static double SlowPath(GaussianStream* s, std::uint64_t w) {
+  static double SlowPath(GaussianStream* s, std::uint32_t w) {
     for (;;) {
       const std::size_t i = w & kLayerMask;
       const bool negative = (w >> 10) & 1;
-      const double x = static_cast<double>(w >> 12) * kFast.layer[i].scale;
+      const double x = static_cast<double>(OddPosition(w)) * kFast.layer[i].scale;
       if (x < kFast.layer[i].next) return negative ? -x : x;  // a retry's fast path
       if (i == 0) {
         for (;;) {
@@ -292,7 +296,7 @@ struct GaussianStreamAccess {
       }
       const double u = static_cast<double>(s->NextSide() >> 11) * 0x1p-53;
       if (WedgeAccepts(i, x, u)) return negative ? -x : x;
-      w = s->NextSide();
+      w = static_cast<std::uint32_t>(s->NextSide());  // its low 32 bits
     }
   }
 };
@@ -304,7 +308,7 @@ namespace {
 // *range grows to contain every output written (also those to be overwritten: it may be wider
 // than the final values, never narrower).
 template <bool kScale>
-std::size_t FastScalar(const std::uint64_t* w, std::size_t n, double mean, double scale, double* out,
+std::size_t FastScalar(const std::uint32_t* w, std::size_t n, double mean, double scale, double* out,
                        std::uint32_t* rejected, GaussianStream::Range* range) {
   std::size_t count = 0;
   double lo = range->min, hi = range->max;
@@ -324,22 +328,22 @@ std::size_t FastScalar(const std::uint64_t* w, std::size_t n, double mean, doubl
 // No "fma": nothing here may be contracted; the values must be the scalar code's to the bit.
 #pragma GCC target("avx2")
 
-// FastScalar four words at a time, the same operations lane by lane: the 52-bit m becomes a double
-// exactly as 2^52 + m (its bits OR-ed into 2^52's) minus 2^52; bit 10 moved to the sign bit is the
-// negation; the table pair of each lane by one 16-byte load (scalar loads beat AVX2 gathers on
-// current x86 cores).
+// FastScalar four words at a time, the same operations lane by lane, each word widened to a 64-bit
+// lane: the 22-bit 2m + 1 becomes a double exactly as 2^52 + (2m + 1) (its bits OR-ed into 2^52's)
+// minus 2^52; bit 10 moved to the sign bit is the negation; the table pair of each lane by one
+// 16-byte load (scalar loads beat AVX2 gathers on current x86 cores).
 template <bool kScale>
-std::size_t FastAvx2(const std::uint64_t* w, std::size_t n, double mean, double scale, double* out,
+std::size_t FastAvx2(const std::uint32_t* w, std::size_t n, double mean, double scale, double* out,
                      std::uint32_t* rejected, GaussianStream::Range* range) {
   __m256d lo = _mm256_set1_pd(range->min), hi = _mm256_set1_pd(range->max);
-  const __m256i magic = _mm256_set1_epi64x(0x4330000000000000LL);
+  const __m256i magic = _mm256_set1_epi64x(0x4330000000000001LL);  // 2^52, and the 1 of 2m + 1
   const __m256d two52 = _mm256_set1_pd(0x1p52);
   const __m256i sign_bit = _mm256_set1_epi64x(static_cast<long long>(1ULL << 63));
   const __m256d vmean = _mm256_set1_pd(mean), vscale = _mm256_set1_pd(scale);
   const double* table = &kFast.layer[0].scale;
   std::size_t count = 0, j = 0;
   for (; j + 4 <= n; j += 4) {
-    const __m256i word = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(w + j));
+    const __m256i word = _mm256_cvtepu32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(w + j)));
     const __m128d p0 = _mm_load_pd(table + 2 * (w[j] & kLayerMask));
     const __m128d p1 = _mm_load_pd(table + 2 * (w[j + 1] & kLayerMask));
     const __m128d p2 = _mm_load_pd(table + 2 * (w[j + 2] & kLayerMask));
@@ -347,7 +351,7 @@ std::size_t FastAvx2(const std::uint64_t* w, std::size_t n, double mean, double 
     const __m256d p02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(p0), p2, 1);  // s0 n0 s2 n2
     const __m256d p13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(p1), p3, 1);  // s1 n1 s3 n3
     const __m256d lane_scale = _mm256_unpacklo_pd(p02, p13), next = _mm256_unpackhi_pd(p02, p13);
-    const __m256d m = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(_mm256_srli_epi64(word, 12), magic)), two52);
+    const __m256d m = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(_mm256_srli_epi64(word, 10), magic)), two52);
     const __m256d x = _mm256_mul_pd(m, lane_scale);
     const int accepted = _mm256_movemask_pd(_mm256_cmp_pd(x, next, _CMP_LT_OQ));
     __m256d z = _mm256_xor_pd(x, _mm256_castsi256_pd(_mm256_and_si256(_mm256_slli_epi64(word, 53), sign_bit)));
@@ -391,7 +395,7 @@ void GaussianStreamAccess::Fill(GaussianStream* s, std::size_t n, double mean, d
   for (std::size_t k = 0; k < n;) {
     if (s->pos_ == s->end_) s->Refill();
     const std::size_t c = std::min(s->end_ - s->pos_, n - k);
-    const std::uint64_t* w = s->buffer_ + s->pos_;
+    const std::uint32_t* w = s->buffer_ + s->pos_;
 #if UPHILL_NORMALS_AVX2
     // The fast path stays four-wide with AVX-512 too: eight-wide needs gathers, which cost more.
     const std::size_t r = s->simd_ > 0 ? FastAvx2<kScale>(w, c, mean, scale, out + k, rejected, range)

@@ -9,9 +9,9 @@
 //       probabilistically symmetric 95 % coverage interval [y_(r), y_(r+q)], q = pM rounded,
 //       r = (M − q)/2 rounded up (JCGM 101 §7.7), from exact order statistics.
 //       Mean and u come from the shifted sums S1 = Σ(y − s), S2 = Σ(y − s)², s = the first valid
-//       trial's value (a sample, so |ȳ − s| is a few u), as plain sums over each block of 1024
+//       trial's value (a sample, so |ȳ − s| is a few u), as plain sums over each block of 2048
 //       trials added up with Neumaier's compensation: u² = (S2 − S1²/M)/(M − 1) then loses
-//       relative accuracy ≈ 2^-53·(1024 + (ȳ − s)²/u²)·a few, i.e. u is good to ~1e-12 or better
+//       relative accuracy ≈ 2^-53·(2048 + (ȳ − s)²/u²)·a few, i.e. u is good to ~1e-12 or better
 //       (the statistical error, 1/sqrt(2M), is ~1e-3); the mean to ~1e-13·u.
 //
 // The two agree when the model is close to linear over ± a few u; where they do not, the first-
@@ -57,7 +57,7 @@
 // division multiplies by a reciprocal.)
 //
 // Cost: first order is one evaluation with 8-component jets (microseconds). Monte Carlo runs in
-// blocks of 1024 trials with no per-trial allocation and no virtual dispatch; the coverage
+// blocks of 2048 trials with no per-trial allocation and no virtual dispatch; the coverage
 // interval is found without sorting the M values: a pilot of 2^12 trials places a window of
 // ± 4.5 standard errors around each quantile, narrowed from the exact order statistics so far
 // after 2^15 trials and after each further factor 8; the trials are only counted (below a

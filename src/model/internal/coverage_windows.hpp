@@ -57,8 +57,8 @@ struct Window {
 
 // The shifted sums of one block, Σ(y − shift) and Σ(y − shift)², which the Monte Carlo's moments
 // take in the same pass over the values (monte_carlo.cpp). Each is a plain floating-point sum of
-// at most one block's terms (kBlock = 1024), in an order that depends on the kernel: relative
-// error ≤ ~1024·2^-53 of Σ|y − shift| (resp. Σ(y − shift)²) per block, before the blocks'
+// at most one block's terms (kBlock = 2048), in an order that depends on the kernel: relative
+// error ≤ ~2048·2^-53 of Σ|y − shift| (resp. Σ(y − shift)²) per block, before the blocks'
 // compensated total.
 struct BlockSums {
   double shift = 0.0;

@@ -39,8 +39,9 @@ class NarrowAtan {
 
   double centre() const { return centre_; }
 
-  // The smallest degree 1 … kMaxDegree whose truncation bound over [lo, hi] is ≤ 2^-56·atan(lo),
-  // or 0 when there is none (the interval is too wide, or lo ≤ 0, or not finite): the caller then
+  // The smallest degree 1 … kMaxDegree whose truncation bound over [lo, hi] is ≤ 2^-56·a, a a
+  // lower bound of atan(lo) (below it by at most 2c(c − lo)²/(1 + c²)², c the centre; atan(lo)
+  // itself where that bound is poor), or 0 when there is none (the interval is too wide, or lo ≤ 0, or not finite): the caller then
   // uses another atan.
   int DegreeFor(double lo, double hi) const;
 
