@@ -247,6 +247,7 @@ VideoTrial TrackTrial(const Experiment& experiment, const ExperimentRow& row, st
     const TrackResult track = TrackVideo(video_path, scene, calibration, options);
     trial.partial = track.partial;
     trial.partial_reason = track.partial_reason;
+    trial.tracker_cpu_seconds = track.tracker_cpu_seconds;
     tell(VideoProgress::Stage::kAnalysing);
     // The entry is written into a staging folder and renamed into place whole. The analysis
     // reads the track as the cache keeps it (the CSV's millimetres), so that a fresh run and a

@@ -52,6 +52,7 @@ struct VideoTrial {
   std::string error;    // non-empty: the video could not be analysed (file, rule); nothing below
   bool from_cache = false;
   int frames = 0, found = 0;
+  double tracker_cpu_seconds = 0;  // the tracker's own CPU time, decoding excluded (0 from the cache)
   bool partial = false;
   std::string partial_reason;
   std::optional<MeasuredValue> rest;           // x of the final rest, m: the trial's Y

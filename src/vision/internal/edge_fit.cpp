@@ -1,10 +1,10 @@
 #include "edge_fit.hpp"
 
-#include <ceres/ceres.h>
-
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+
+#include "edge_rays_fit.hpp"
 
 namespace uphill::internal {
 namespace {
@@ -15,37 +15,7 @@ using Eigen::Vector3d;
 constexpr double kStep = 0.5;             // px between profile samples
 constexpr double kNarrowHalfWidth = 2.5;  // px, second pass around the first fit
 constexpr double kInlierPx = 1.0;         // |residual| below this: inlier
-constexpr double kLossScalePx = 0.5;      // Cauchy scale
-constexpr double kBiasPriorPx = 0.5;      // the edge-bias parameter's prior width
 constexpr double kMinGradient = 2.0;      // grey levels per px: weaker is no edge
-
-// Residual of one edge point, in pixels: angle between its viewing ray and the centre's
-// direction minus the outline's half angle, minus the edge bias (all in the space where the body
-// is a sphere of radius a).
-struct EdgeResidual {
-  Vector3d ray;  // scaled-space direction of the edge point's viewing ray (unit)
-  Vector3d eye;  // scaled-space camera centre
-  double a, px_per_rad;
-  template <typename T>
-  bool operator()(const T* p, T* residual) const {
-    const T c[3] = {p[0] - eye.x(), T(-eye.y()), p[1] - eye.z()};  // C has y = 0, unchanged by scaling
-    const T norm = ceres::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    const T cross[3] = {ray.y() * c[2] - ray.z() * c[1], ray.z() * c[0] - ray.x() * c[2],
-                        ray.x() * c[1] - ray.y() * c[0]};
-    const T sin_part = ceres::sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]);
-    const T cos_part = ray.x() * c[0] + ray.y() * c[1] + ray.z() * c[2];
-    residual[0] = (ceres::atan2(sin_part, cos_part) - ceres::asin(T(a) / norm)) * px_per_rad - p[2];
-    return true;
-  }
-};
-
-struct BiasPrior {
-  template <typename T>
-  bool operator()(const T* p, T* residual) const {
-    residual[0] = p[2] / kBiasPriorPx;
-    return true;
-  }
-};
 
 double Bilinear(const cv::Mat& img, double x, double y) {
   const int i = static_cast<int>(std::floor(x)), j = static_cast<int>(std::floor(y));
@@ -165,42 +135,23 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
   }
 
   // Viewing rays of the edge points, in the scaled space.
-  const std::vector<Vector2d> normalised = UndistortPixels(g.cal.camera, edges);
-  std::vector<Vector3d> rays;
-  rays.reserve(normalised.size());
-  for (const Vector2d& m : normalised) {
+  EdgeRays problem;
+  problem.eye = g.eye_s;
+  problem.a = g.a;
+  problem.px_per_rad = g.PxPerRad(x, z);
+  problem.rays.reserve(edges.size());
+  for (const Vector2d& m : UndistortPixels(g.cal.camera, edges)) {
     Vector3d r = g.to_apparatus * Vector3d(m.x(), m.y(), 1.0);
     r.y() *= g.s;
-    rays.push_back(r.normalized());
+    problem.rays.push_back(r.normalized());
   }
-  const double px_per_rad = g.PxPerRad(x, z);
-  double p[3] = {x, z, 0.0};
-  ceres::CauchyLoss loss(kLossScalePx);  // one loss for all residuals, owned here
-  ceres::Problem::Options problem_options;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
-  for (const Vector3d& r : rays)
-    problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<EdgeResidual, 1, 3>(new EdgeResidual{r, g.eye_s, g.a, px_per_rad}), &loss, p);
-  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BiasPrior, 1, 3>(new BiasPrior), nullptr, p);
-  ceres::Solver::Options solver;
-  solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  solver.max_num_iterations = 30;
-  solver.num_threads = 1;
-  solver.logging_type = ceres::SILENT;
-  // The centre's metres are near 0.5: a relative step of 1e-9 is about 1e-6 px, far below the
-  // edge points' scatter; tighter only adds iterations.
-  solver.function_tolerance = 1e-9;
-  solver.parameter_tolerance = 1e-9;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver, &problem, &summary);
-  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !InFront(p[0], p[1])) return fit;
+  const EdgeRaysSolution solution = FitEdgeRays(problem, x, z);
+  if (!solution.finite || !InFront(solution.x, solution.z)) return fit;
 
   double sum2 = 0;
   int votes = 0;
-  for (size_t k = 0; k < rays.size(); ++k) {
-    double res = 0;
-    EdgeResidual{rays[k], g.eye_s, g.a, px_per_rad}(p, &res);
+  for (size_t k = 0; k < problem.rays.size(); ++k) {
+    const double res = EdgeRayResidualPx(problem, problem.rays[k], solution.x, solution.z, solution.bias);
     if (std::abs(res) < kInlierPx) {
       ++fit.inliers;
       sum2 += res * res;
@@ -208,8 +159,8 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
     }
   }
   fit.ok = fit.inliers >= 3;
-  fit.x = p[0];
-  fit.z = p[1];
+  fit.x = solution.x;
+  fit.z = solution.z;
   fit.rms_px = fit.inliers ? std::sqrt(sum2 / fit.inliers) : 0;
   if (polarity_ == 0 && fit.inliers > 0) polarity_ = votes >= 0 ? 1 : -1;
   return fit;

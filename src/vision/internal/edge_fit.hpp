@@ -1,5 +1,5 @@
 // The tracker's fast path: the body's outline located as edges of the linear luminance and
-// fitted with Ceres.
+// fitted to them (ceres::TinySolver, edge_rays_fit.hpp).
 //
 // Rays from the predicted centre's image cross `points` tangent points of the predicted outline
 // (the cone of rays tangent to the body, outline_fit.hpp's OutlineGeometry). Along each, the
@@ -11,18 +11,16 @@
 // centroid is the outline at mid-exposure (up to the outline's curvature over the sweep, about
 // blur²/(16·radius) at the sides, the same on opposite sides); in the camera's encoded grey the
 // ramp bends and its centroid moves toward the darker side by a fraction of the blur. Rays
-// through the near rail's band are not used. The centre (x, z) and a uniform edge bias (prior
-// N(0, 0.5 px)) are fitted to the edge points' viewing rays with a Cauchy loss (scale 0.5 px):
-// the angle between each ray and the centre's direction minus the outline's half angle, in
-// pixels. A second, narrow pass (±2.5 px) around the first fit when it moved more than a pixel or
-// lost edges.
+// through the near rail's band are not used. The centre (x, z) and a uniform edge bias are
+// fitted to the edge points' viewing rays with a Cauchy loss (edge_rays_fit.hpp). A second,
+// narrow pass (±2.5 px) around the first fit when it moved more than a pixel or lost edges.
 //
 // What it assumes, and the tracker checks before trusting it (ball_tracker.cpp, "fast path"):
 // the body differs from its surroundings in luminance all round, the motion blur is short
 // against the radius, the body has no inner edges near its outline, the shutter is global. Where
 // these hold it is about 0.02–0.1 px RMS on the synthetic and ray-traced clips of `uphill bench
-// track` at a cost of one small Ceres solve (3 parameters, ≤ 96 residuals) per frame; where they
-// do not, its edges are wrong (a painted band's edge, a body as bright as its table).
+// track` at a cost of one small solve (3 parameters, ≤ 97 residuals) per frame; where they do
+// not, its edges are wrong (a painted band's edge, a body as bright as its table).
 #pragma once
 
 #include <Eigen/Core>
