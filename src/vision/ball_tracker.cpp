@@ -783,7 +783,12 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
       return finish(fit, q, !predicted);
     }
   }
-  if (!predicted) m.history.clear();
+  // Predicted past the path's ends (beyond the fall-off point the rails no longer carry it,
+  // before x_low it has reached O) and not found: it fell or was taken off, and following its
+  // prediction further costs full-model fits of an empty scene. The search along the path still
+  // runs every frame.
+  const bool off_the_path = predicted && (centre.x() > m.x_hi || centre.x() < m.x_lo);
+  if (!predicted || off_the_path) m.history.clear();
   return {};
 }
 
