@@ -118,9 +118,10 @@ struct BallTracker::Impl {
   }
   double MetresPerPx(double x, double z) const { return 1.0 / (geometry.cal.camera.fx / (Vector3d(x, 0, z) - geometry.eye).norm()); }
 
-  // The centre and velocity predicted at time t from the history: least squares through the last
-  // samples, a parabola in time from four on (constant acceleration), a line through two or three.
-  bool Predict(long f, double t, Vector2d* centre, Vector2d* velocity) const {
+  // The centre, velocity and acceleration predicted at time t from the history: least squares
+  // through the last samples, a parabola in time from four on (constant acceleration), a line
+  // through two or three (no acceleration).
+  bool Predict(long f, double t, Vector2d* centre, Vector2d* velocity, Vector2d* acceleration) const {
     if (history.empty() || f - history.back().first > kHistoryGap) return false;
     const size_t n = history.size();
     const int degree = n >= 4 ? 2 : n >= 2 ? 1 : 0;
@@ -138,11 +139,13 @@ struct BallTracker::Impl {
     const double dt = t - t_last;
     *centre = Vector2d::Zero();
     *velocity = Vector2d::Zero();
+    *acceleration = Vector2d::Zero();
     for (int k = 0; k <= degree; ++k) {
       *centre += coef.row(k).transpose() * std::pow(dt, k);
       if (k >= 1) *velocity += coef.row(k).transpose() * (k * std::pow(dt, k - 1));
     }
-    return centre->allFinite() && velocity->allFinite();
+    if (degree == 2) *acceleration = 2 * coef.row(2).transpose();
+    return centre->allFinite() && velocity->allFinite() && acceleration->allFinite();
   }
 
   // The body's region (smeared silhouette, a radius around it, and its shadow below it), px.
@@ -164,7 +167,9 @@ struct BallTracker::Impl {
     return Vector2d(1, slope).normalized();
   }
 
-  FitRequest Request(const Vector2d& centre, const Vector2d& velocity, bool moving_known, double half_width) const {
+  // `acceleration` bends the smear over the exposure (smeared_outline.hpp); zero when unknown.
+  FitRequest Request(const Vector2d& centre, const Vector2d& velocity, bool moving_known, double half_width,
+                     const Vector2d& acceleration = Vector2d::Zero()) const {
     FitRequest q;
     q.centre = centre;
     q.velocity = velocity;
@@ -176,6 +181,7 @@ struct BallTracker::Impl {
     const double m_per_px = MetresPerPx(centre.x(), centre.y());
     if (moving_known) {
       q.smear = velocity * Exposure();
+      q.bend = 0.5 * acceleration * Exposure() * Exposure();
       // How well the exposure is known: given, measured on enough frames, or the guess.
       const double relative = options.exposure ? 0.1 : exposures.size() >= 5 ? 0.15 : 0.5;
       q.smear_sigma = relative * q.smear.norm() + 0.5 * m_per_px;
@@ -391,9 +397,10 @@ struct BallTracker::Impl {
     if (history.size() > kHistory) history.pop_front();
   }
 
-  // The velocity at time t of frame f from the accepted centres of the frames around it (a
-  // parabola in time through up to four on each side); false with fewer than two on each side.
-  bool VelocityAround(long f, double t, Vector2d* velocity) const {
+  // The velocity and acceleration at time t of frame f from the accepted centres of the frames
+  // around it (a parabola in time through up to four on each side); false with fewer than two on
+  // each side.
+  bool VelocityAround(long f, double t, Vector2d* velocity, Vector2d* acceleration) const {
     std::vector<Sample> near;
     int before = 0, after = 0;
     for (auto it = samples.lower_bound(f - 4); it != samples.end() && it->first <= f + 4; ++it) {
@@ -410,7 +417,8 @@ struct BallTracker::Impl {
     }
     const Eigen::MatrixXd coef = a.colPivHouseholderQr().solve(y);
     *velocity = coef.row(1).transpose();
-    return velocity->allFinite();
+    *acceleration = 2 * coef.row(2).transpose();
+    return velocity->allFinite() && acceleration->allFinite();
   }
 
   // Whether the background is known everywhere around the body centred at `centre` (its region,
@@ -447,8 +455,8 @@ struct BallTracker::Impl {
   // with whatever is known by then).
   void FitAgain(bool all) {
     for (auto it = pending.begin(); it != pending.end();) {
-      Vector2d velocity;
-      const bool motion = VelocityAround(it->frame, it->t, &velocity);
+      Vector2d velocity, acceleration;
+      const bool motion = VelocityAround(it->frame, it->t, &velocity, &acceleration);
       const bool background_known = BackgroundKnownAround(it->centre);
       const bool ready = (motion || all) && (all || background_known);
       if (!ready) {
@@ -462,8 +470,8 @@ struct BallTracker::Impl {
         it = pending.erase(it);
         continue;
       }
-      if (!motion) velocity = Vector2d::Zero();
-      FitRequest q = Request(it->centre, velocity, motion, kNarrowHalfWidthPx + 1.5);
+      if (!motion) velocity = acceleration = Vector2d::Zero();
+      FitRequest q = Request(it->centre, velocity, motion, kNarrowHalfWidthPx + 1.5, acceleration);
       const FitOutcome fit = Measure({it->window, it->origin, it->gain}, q);
       if (Accept(fit, 0.45)) {
         BallObservation o = Observe(fit, q);
@@ -650,8 +658,8 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
   const long f = ++m.frame_index;
   const double t = f / m.options.fps;
 
-  Vector2d centre, velocity;
-  const bool predicted = m.Predict(f, t, &centre, &velocity);
+  Vector2d centre, velocity, acceleration;
+  const bool predicted = m.Predict(f, t, &centre, &velocity, &acceleration);
   if (m.unconfirmed && !predicted) m.Withdraw();  // not found again while it could be predicted
   if (predicted && m.row_delay > 0) {
     // The reference time: the mid-exposure of the predicted centre's row.
@@ -725,7 +733,13 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
       const internal::EdgeFitOutcome e =
           m.edges->Measure(frame, centre.x(), centre.y(), m.options.search_half_width_px + 0.3 * step_px);
       const double off = e.ok ? (m.geometry.Project(e.x, e.z) - m.geometry.Project(centre.x(), centre.y())).norm() : 1e9;
-      if (m.Trusted(e) && off < std::max(4.0, 0.5 * m.RadiusPx(centre.x(), centre.y()) + step_px)) {
+      // Where the prediction missed by more than its usual error (the body just released, or
+      // speeding up faster than the last frames said), the edge's ramp may be longer than the
+      // blur predicted, run off the search window, and its truncated centroid lag toward the
+      // prediction (0.7 px at 10 px per frame under a 360° shutter): the model measures the frame.
+      const bool blur_holds = off < 1.0 + 0.1 * step_px;
+      const bool trusted = m.Trusted(e) && off < std::max(4.0, 0.5 * m.RadiusPx(centre.x(), centre.y()) + step_px);
+      if (trusted && blur_holds) {
         m.distrusted = 0;
         const BallObservation o = m.ObserveEdges(e);
         m.Remember(f, t, o);
@@ -733,13 +747,13 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
         m.FitAgain(false);
         return o;
       }
-      if (++m.distrusted >= kFastDistrust) m.needs_model = true;
+      if (!trusted && ++m.distrusted >= kFastDistrust) m.needs_model = true;
     }
   }
   if (predicted) {
     const double step_px = velocity.norm() / m.options.fps / m.MetresPerPx(centre.x(), centre.y());
     const FitRequest q = m.Request(centre, velocity, m.history.size() >= 2,
-                                   m.options.search_half_width_px + 0.3 * step_px);
+                                   m.options.search_half_width_px + 0.3 * step_px, acceleration);
     const FitOutcome fit = m.confident_model_frame == f - 1 && m.history.size() >= 3
                                ? m.MeasureNear({frame, {0, 0}, gain}, q)
                                : m.Measure({frame, {0, 0}, gain}, q);
@@ -770,7 +784,8 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
     const cv::Rect window = predicted ? cv::Rect() : m.BodyRegion(guess, Vector2d::Zero());
     if (!predicted && m.rejected.Unchanged(frame, window)) continue;
     const Vector2d v = predicted ? velocity : Vector2d::Zero();
-    const FitRequest q = m.Request(guess, v, predicted && m.history.size() >= 2, 2 * m.options.search_half_width_px);
+    const FitRequest q = m.Request(guess, v, predicted && m.history.size() >= 2, 2 * m.options.search_half_width_px,
+                                   predicted ? acceleration : Vector2d::Zero());
     const FitOutcome fit = m.Measure({frame, {0, 0}, gain}, q);
     if (!m.Accept(fit, 0.6)) {
       if (!predicted) m.rejected.Remember(frame, window);

@@ -25,7 +25,9 @@
 // R centred at C projects to the boundary of the cone of rays at the angle asin(R/|C − O|) about
 // the direction of C − O (O the camera centre); the spheroid (symmetry axis along y) is the same
 // in the space where y is scaled by a/b. During the exposure the centre moves by D (fitted, with
-// the prediction V·E as prior), so a pixel sees the body for a fraction of its exposure: the
+// the prediction V·E as prior) along a path bent by the predicted acceleration (A = ½·a·E²: a ball
+// speeding up spends longer near the start of its smear; without it the centre of a 3-radius
+// blur came out 0.2 px ahead of the mid-exposure), so a pixel sees the body for a fraction of its exposure: the
 // coverage of internal/smeared_outline.hpp, blurred by the optics' point spread. Rays from the
 // predicted centre across the predicted smeared outline are sampled in linear light and the
 // model I = (1 − c)·g·B + c·F is fitted with Ceres to all of them at once (centre, smear, a
@@ -39,7 +41,10 @@
 // the exposure. There the outline's edges in linear luminance, fitted with Ceres (internal/edge_fit.hpp,
 // one small solve), measure it as well as the model above at a fraction of the cost, so each
 // frame near the prediction is first tried that way. The model takes over for the frame when
-// the predicted smear is longer than a quarter radius, when a rolling shutter is set, or when
+// the predicted smear is longer than a quarter radius, when a rolling shutter is set, when the
+// edge fit lands more than 1 px + a tenth of the step from the prediction (the prediction's speed
+// lagged, as just after the release: the blurred edge's ramp may then run off the search window
+// and its truncated centroid lag toward the prediction), or when
 // the edge fit is not trusted (edges found on less than 85 % of the rays, RMS above 0.3 px,
 // luminance contrast below 20 levels of 255); and for the rest of the clip when the edge fit disagrees with
 // the model where the body is found (by more than 0.5 px: a body as grey as its table, a painted

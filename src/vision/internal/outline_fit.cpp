@@ -20,6 +20,7 @@ constexpr double kRayLossFactor = 1.5;  // Cauchy scale: this many times a good 
 
 struct RaySamples {
   Vector2d offset = Vector2d::Zero();  // centre shift of this ray's rows, m
+  Vector2d bend = Vector2d::Zero();    // A of smeared_outline.hpp, m
   int pieces = 1;
   std::vector<Vector3d> dirs;          // unit, scaled space
   std::vector<double> along;           // position along the window, −1 … 1
@@ -136,7 +137,7 @@ class RayCost : public ceres::CostFunction {
   // (when not null).
   void Compute(const double* p, double* residuals, double* jacobian, RayColours* solved) const {
     const size_t n = ray_.dirs.size();
-    const SmearNodes nodes(body_, p, ray_.offset, ray_.pieces);
+    const SmearNodes nodes(body_, p, ray_.offset, ray_.pieces, ray_.bend);
     std::vector<double> c(n);
     std::vector<SmearGradient> grad(jacobian ? n : 0);
     for (size_t i = 0; i < n; ++i) c[i] = nodes.Coverage(ray_.dirs[i], grad.empty() ? nullptr : &grad[i]);
@@ -222,8 +223,9 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   const int n = q.rays;
   std::vector<Vector3d> points = g.OutlinePoints(x, z, n);
   points.emplace_back(x, 0, z);
-  points.emplace_back(x - 0.5 * q.smear.x(), 0, z - 0.5 * q.smear.y());
-  points.emplace_back(x + 0.5 * q.smear.x(), 0, z + 0.5 * q.smear.y());
+  // The smear's ends, C(∓½) = C ∓ D/2 + A/4.
+  points.emplace_back(x - 0.5 * q.smear.x() + 0.25 * q.bend.x(), 0, z - 0.5 * q.smear.y() + 0.25 * q.bend.y());
+  points.emplace_back(x + 0.5 * q.smear.x() + 0.25 * q.bend.x(), 0, z + 0.5 * q.smear.y() + 0.25 * q.bend.y());
   const std::vector<Vector2d> image = ProjectApparatusPoints(g.cal.camera, g.cal.pose, points);
   const Vector2d centre = image[n], smear_px = image[n + 2] - image[n + 1];
   double radius_px = 0;
@@ -287,6 +289,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
     const Ray& ray = rays[k];
     RaySamples samples;
     samples.offset = ray.offset;
+    samples.bend = q.bend;
     samples.pieces = pieces;
     const double length = ray.s1 - ray.s0;
     const double step = std::clamp(length / 40, 0.5, 3.0);

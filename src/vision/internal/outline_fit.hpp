@@ -21,7 +21,8 @@
 // 4 times the expected χ² of a good ray) gives it no say.
 //
 // Parameters (smeared_outline.hpp's order): the centre (x, z) at the reference time, the smear D
-// over the exposure, a uniform edge shift b. Priors: b ~ N(0, 0.3 px), D ~ N(D_pred, σ_D).
+// over the exposure, a uniform edge shift b. Priors: b ~ N(0, 0.3 px), D ~ N(D_pred, σ_D). The
+// path's bend over the exposure (the motion's acceleration) is the caller's prediction, held.
 //
 // Accuracy: see ball_tracker.hpp. Cost: rays × samples × (pieces + 1) outline evaluations per
 // Jacobian; at most 6 Ceres iterations per pass; one pass where the model measured the previous
@@ -56,6 +57,7 @@ struct FitRequest {
   Eigen::Vector2d centre;               // (x, z) at the reference time, m
   Eigen::Vector2d smear = {0, 0};        // D predicted, m
   double smear_sigma = 0;               // σ_D, m (per component)
+  Eigen::Vector2d bend = {0, 0};        // A = ½·a·E² (smeared_outline.hpp), m: held, not fitted
   Eigen::Vector2d velocity = {0, 0};    // m/s, for the rolling shutter's row delays
   double row_delay = 0;                 // s per row (readout / rows); 0: global shutter
   double reference_row = 0;             // the row whose time is the reference

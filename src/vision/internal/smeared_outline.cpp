@@ -101,15 +101,17 @@ int SmearPieces(double blur_px, double radius_px) {
   return std::clamp(static_cast<int>(std::ceil(std::abs(blur_px) / h)), 1, 32);
 }
 
-SmearNodes::SmearNodes(const SmearedBody& body, const double* p, const Eigen::Vector2d& offset, int pieces)
+SmearNodes::SmearNodes(const SmearedBody& body, const double* p, const Eigen::Vector2d& offset, int pieces,
+                       const Eigen::Vector2d& bend)
     : body_(body), shift_(p[kEdgeShift]) {
   const int m = std::max(1, pieces);
   nodes_.resize(m + 1);
   for (int n = 0; n <= m; ++n) {
     Node& node = nodes_[n];
     node.tau = -0.5 + static_cast<double>(n) / m;
-    const Vector3d v(p[kCentreX] + offset.x() + node.tau * p[kSmearX] - body.eye.x(), -body.eye.y(),
-                     p[kCentreZ] + offset.y() + node.tau * p[kSmearZ] - body.eye.z());
+    const double tau2 = node.tau * node.tau;
+    const Vector3d v(p[kCentreX] + offset.x() + node.tau * p[kSmearX] + tau2 * bend.x() - body.eye.x(), -body.eye.y(),
+                     p[kCentreZ] + offset.y() + node.tau * p[kSmearZ] + tau2 * bend.y() - body.eye.z());
     node.norm = v.norm();
     node.w = v / node.norm;
     const double sin_b = std::min(body.a / node.norm, 1.0 - 1e-12);

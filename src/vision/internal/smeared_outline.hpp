@@ -9,10 +9,14 @@
 // signed distance of d from the outline, in pixels, is δ = (θ − β)·p − b (p pixels per radian,
 // b a uniform outward shift of the edges in pixels, a fit parameter; positive outside).
 //
-// Motion over the exposure: C(τ) = C_ray + D·τ for τ ∈ [−½, ½] (τ the fraction of the exposure,
-// D the displacement of the centre during the exposure, C_ray the centre at the mid-exposure of
-// the ray's rows: with a rolling shutter each row has its own exposure window, and the caller
-// shifts C_ray by the velocity times the row's delay; within one ray the delay is taken constant).
+// Motion over the exposure: C(τ) = C_ray + D·τ + A·τ² for τ ∈ [−½, ½] (τ the fraction of the
+// exposure, D the displacement of the centre during the exposure, C_ray the centre at the
+// mid-exposure of the ray's rows: with a rolling shutter each row has its own exposure window, and
+// the caller shifts C_ray by the velocity times the row's delay; within one ray the delay is taken
+// constant). A = ½·a·E² is the bend of a path accelerated by a over the exposure E, given by the
+// caller (not fitted): a ball rolling down steep rails gains speed during a long exposure, so it
+// spends longer near the start of its smear than near the end, and a straight smear (A = 0) fitted
+// to it puts the centre ahead of the mid-exposure by a fraction of A (0.2 px on a 3-radius blur).
 //
 // Coverage: c(d) = ∫_{−½}^{½} Φ(−δ(d, τ)/σ) dτ, σ the point spread (px, Gaussian across the
 // edge), Φ the normal CDF. Computed by splitting [−½, ½] into M equal pieces on which δ is taken
@@ -49,8 +53,9 @@ int SmearPieces(double blur_px, double radius_px);
 class SmearNodes {
  public:
   // params: (x, z, D_x, D_z, b) as SmearParameter; offset: added to the centre's (x, z) (the
-  // rolling shutter's shift of this ray's rows).
-  SmearNodes(const SmearedBody& body, const double* params, const Eigen::Vector2d& offset, int pieces);
+  // rolling shutter's shift of this ray's rows); bend: A of the header, m.
+  SmearNodes(const SmearedBody& body, const double* params, const Eigen::Vector2d& offset, int pieces,
+             const Eigen::Vector2d& bend = Eigen::Vector2d::Zero());
 
   // Coverage of the unit direction d (scaled space), and its gradient when grad != nullptr.
   double Coverage(const Eigen::Vector3d& d, SmearGradient* grad) const;
