@@ -302,17 +302,18 @@ TEST(VisionTrack, SpheroidCleanClip) {
 // D = 20 mm), the 1-inch ball released at x0 = 700 mm and smeared over up to 3 radii by the end
 // while it still gains speed. Truth: the renderer's centre at mid-exposure (frame/fps); the blur
 // is the average of 64 renders spread evenly over the exposure along the true (accelerated)
-// motion, independent of the tracker's smear model. The body is drawn in one flat colour, the
-// model's own assumption, so that what is tested is the smear's geometry and timing: before the
-// smear followed the acceleration over the exposure (and the fast path gave way at the release)
-// this clip measured 0.25 px RMS with the centre 0.2 px ahead of the truth on the longest blurs
-// and 0.7 px behind it on the first moving frames. A shaded ball adds the error of a limb colour
-// taken as constant along the smear (0.4 px on this clip): not modelled yet.
+// motion, independent of the tracker's smear model. The ball is matte and shaded by a light from
+// above (Lambert's law with ambient light, clamped at the terminator: not the quadratic in the
+// normal the tracker learns). What is tested is the smear's geometry and timing and the body's
+// shading across it: with one limb colour per ray this clip measured 0.39 px RMS (0.07 px for the
+// same ball in one flat colour), and before the smear followed the acceleration over the
+// exposure (and the fast path gave way at the release) the centre came out 0.2 px ahead of the
+// truth on the longest blurs and 0.7 px behind it on the first moving frames.
 TEST(VisionTrack, FastBallUnderA360DegreeShutterIsMeasuredAtMidExposure) {
   ClipSetup setup = DefaultClipSetup(1280, 720);
   setup.scene = Scene(Body::Sphere(0.0127), Rails::FromApparatus(1.0, 0.25, 0.02, LConvention::kHorizontal),
                       setup.scene.rod_radius());
-  setup.apparatus.flat_body = true;
+  setup.apparatus.body_finish = ClipApparatus::Finish::kMatte;
   // The side view from half its distance: the ball ~25 px in radius, as in the fast POV-Ray clips.
   const Eigen::Vector3d target(0.42, 0, 0.10);
   setup.calibration = SideViewCamera(1280, 720, target.x(), target.z());

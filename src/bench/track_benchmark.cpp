@@ -162,7 +162,14 @@ void RunMatrix(const TrackBenchmarkOptions& f, Section& section, std::unique_ptr
 }  // namespace
 
 void RunTrackBenchmark(const TrackBenchmarkOptions& f, std::ostream& out) {
-  Section section = StartSection("track", f.common.command, kMethod);
+  // A run of some of the robustness conditions keeps its own section, so that the last run of the
+  // whole matrix (hours of rendering) stays beside it.
+  std::string name = "track";
+  if (f.only_matrix && !f.conditions.empty()) {
+    name += " --only-matrix --conditions ";
+    for (size_t i = 0; i < f.conditions.size(); ++i) name += (i ? "," : "") + f.conditions[i];
+  }
+  Section section = StartSection(name, f.common.command, kMethod);
   section.versions.emplace_back("OpenCV (C++)", CV_VERSION);
   // One core's work: OpenCV's parallel loops off; FFmpeg's decoder threads are counted by the
   // process clock (OPENCV_FFMPEG_CAPTURE_OPTIONS reaches only the demuxer in OpenCV 4.6).

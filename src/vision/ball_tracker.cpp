@@ -38,6 +38,11 @@ constexpr double kFastMinAgreement = 0.85;  // share of the searched rays that a
 constexpr double kFastMaxDisagreementPx = 0.5;  // edge fit against the model, at acquisition
 constexpr int kFastDistrust = 3;            // untrusted fast fits in a row: the clip needs the model
 constexpr int kLearnEvery = 8;              // on the fast path, frames between background updates
+// A model fit whose smear measures the exposure: its inlier rays fit within 1.5 noise levels and
+// are at least this share of the rays (a half: on ray-traced footage a ball's shadow, the rails'
+// reflections and the highlight leave 55-75 % of the rays inliers, and the exposure is the
+// median over the frames).
+constexpr double kExposureMinAgreement = 0.5;
 
 struct Sample {
   double t, x, z;  // s (clip time of the reported centre), m
@@ -51,6 +56,7 @@ struct BallTracker::Impl {
   internal::OutlineGeometry geometry;
   cv::Mat occluder;                                 // CV_8U: the near rail's band
   std::unique_ptr<internal::BackgroundModel> background;
+  std::unique_ptr<internal::BodyShading> shading;   // learnt from the first frames at rest
   std::deque<std::pair<long, Sample>> history;      // last found (frame, sample)
   long frame_index = -1;
   double x_lo = 0, x_hi = 0;                        // searchable part of the path
@@ -388,6 +394,14 @@ struct BallTracker::Impl {
     return o;
   }
 
+  // A frame where the body rests (found near a prediction that barely moves) is a sharp view of
+  // its shading.
+  void LearnShading(const cv::Mat& frame, const BallObservation& o, const Vector2d& velocity) {
+    if (shading->ready() || history.size() < 3 || !o.found) return;
+    if (velocity.norm() / options.fps / MetresPerPx(o.x, o.z) > 0.05) return;
+    shading->Learn(frame, background->table(), geometry, o.x, o.z);
+  }
+
   void Remember(long f, double t, const BallObservation& o) {
     // Found again from the unconfirmed frame's track (still in the history): confirmed.
     if (unconfirmed && f > unconfirmed->frame && !history.empty() && history.front().first <= unconfirmed->frame)
@@ -589,6 +603,8 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
     cv::polylines(m.occluder, polyline, false, cv::Scalar(1),
                   std::max(1, static_cast<int>(std::ceil(2 * (max_halfwidth + 2.5)))), cv::LINE_8, 4);
   g.occluder = &m.occluder;
+  m.shading = std::make_unique<internal::BodyShading>(g.s);
+  g.shading = m.shading.get();
   m.edges = std::make_unique<internal::EdgeFit>(
       m.geometry, kEdgePoints, options.transfer == VideoTransfer::kLinear ? internal::Transfer::kLinear : internal::Transfer::kSrgb);
 
@@ -682,7 +698,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
     std::vector<double> sorted(m.noises.begin(), m.noises.end());
     std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
     m.noise = sorted[sorted.size() / 2];
-    const bool confident = fit.misfit < 1.5 && fit.inliers >= 0.75 * fit.rays_fitted;
+    const bool confident = fit.misfit < 1.5 && fit.inliers >= kExposureMinAgreement * fit.rays_fitted;
     if (fit.rays_without_background == 0) m.confident_model_frame = f;
     const Vector2d fitted_velocity = q.velocity;
     const Vector2d smear(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]);
@@ -710,6 +726,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
         edge_fallback = true;
       }
     }
+    m.LearnShading(frame, o, q.velocity);
     m.Remember(f, t, o);
     if (m.history.size() == 1 && fit.rays_without_background > 0) {
       if (m.unconfirmed) m.Withdraw();
@@ -726,10 +743,17 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
   // The fast path: the edge fit, where the scene does not need the model (see the header).
   if (predicted && !m.needs_model && m.row_delay == 0) {
     const double px = 1 / m.MetresPerPx(centre.x(), centre.y());
-    const double blur_px = velocity.norm() * m.Exposure() * px, step_px = velocity.norm() / m.options.fps * px;
-    // With the exposure a guess (180°) the edge fit's own checks decide up to twice the limit.
+    // With the exposure not yet known, and the body's shading known (so that the model measures
+    // a long smear better than the edge fit), the blur is taken at its longest (a 360° shutter):
+    // a longer blur than the fast path allows biases its edges (0.6 px on the first moving frames
+    // of a shaded ball under a 360° shutter), and the model measures the exposure meanwhile.
+    // Otherwise it is guessed (180°) and the edge fit's own checks decide up to twice the limit.
     const bool exposure_known = m.options.exposure || m.exposures.size() >= 3;
-    if (blur_px <= (exposure_known ? 1 : 2) * kFastMaxBlur * m.RadiusPx(centre.x(), centre.y())) {
+    const bool cautious = !exposure_known && m.shading->ready();
+    const double exposure = cautious ? 1 / m.options.fps : m.Exposure();
+    const double blur_px = velocity.norm() * exposure * px, step_px = velocity.norm() / m.options.fps * px;
+    const double limit = (exposure_known || cautious ? 1 : 2) * kFastMaxBlur;
+    if (blur_px <= limit * m.RadiusPx(centre.x(), centre.y())) {
       const internal::EdgeFitOutcome e =
           m.edges->Measure(frame, centre.x(), centre.y(), m.options.search_half_width_px + 0.3 * step_px);
       const double off = e.ok ? (m.geometry.Project(e.x, e.z) - m.geometry.Project(centre.x(), centre.y())).norm() : 1e9;
@@ -742,6 +766,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
       if (trusted && blur_holds) {
         m.distrusted = 0;
         const BallObservation o = m.ObserveEdges(e);
+        m.LearnShading(frame, o, velocity);
         m.Remember(f, t, o);
         if (f % kLearnEvery == 0 && m.scene_suspect == 0) m.background->Learn(frame, m.BodyRegion(Vector2d(e.x, e.z), velocity * m.Exposure()));
         m.FitAgain(false);

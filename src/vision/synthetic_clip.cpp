@@ -192,8 +192,8 @@ struct ClipRenderer::Impl {
         const Vector3d n =
             Vector3d(q.x() / (across * across), q.y() / (along * along), q.z() / (across * across)).normalized();
         const Rgb paint{0.10, 0.14, 0.72};
-        if (apparatus.flat_body) return paint * 0.6;
-        const double spec = 0.75 * highlight(n, 40);
+        if (apparatus.body_finish == ClipApparatus::Finish::kFlat) return paint * 0.6;
+        const double spec = apparatus.body_finish == ClipApparatus::Finish::kMatte ? 0.0 : 0.75 * highlight(n, 40);
         return paint * lambert(n) + Rgb{spec, spec, spec};
       }
       case kRodMinus:

@@ -49,9 +49,11 @@ struct ClipApparatus {
   double min_rod_radius = 0.003;   // rods are drawn at least this thick, m
   double table_z = -0.03;          // height of the table, m (below O)
   double wall_y = 0.6;             // the wall behind the apparatus, m
-  // The body of one flat colour (no shading, no highlight): what the tracker's smear model
-  // assumes, for testing the smear's geometry and timing apart from the body's shading.
-  bool flat_body = false;
+  // The body's paint: glossy (Lambertian shading under a light from above, and a highlight),
+  // matte (the shading alone) or flat (one colour, no shading: for testing the smear's geometry
+  // and timing apart from the body's appearance).
+  enum class Finish { kGlossy, kMatte, kFlat };
+  Finish body_finish = Finish::kGlossy;
 };
 
 // A ready-made setting: the default clip of tools/make_video and of the tests. Sphere of radius

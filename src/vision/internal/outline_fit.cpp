@@ -17,9 +17,15 @@ using Eigen::Vector3d;
 constexpr double kEdgeShiftPriorPx = 0.3;
 constexpr double kShadowPrior = 0.05;    // σ of the background's factor along a ray
 constexpr double kRayLossFactor = 1.5;  // Cauchy scale: this many times a good ray's χ²
+// A smear longer than this many radii is fitted with the body's shading (body_shading.hpp).
+constexpr double kShadedSmear = 0.25;
+constexpr double kShadeMovePx = 0.3;
 
 struct RaySamples {
   Vector2d offset = Vector2d::Zero();  // centre shift of this ray's rows, m
+  // The body's relative colour over the part of it that passed over each sample (S_i below), at
+  // the fit's starting point; empty: one colour per ray.
+  std::vector<cv::Vec3d> shade;
   Vector2d bend = Vector2d::Zero();    // A of smeared_outline.hpp, m
   int pieces = 1;
   std::vector<Vector3d> dirs;          // unit, scaled space
@@ -28,40 +34,46 @@ struct RaySamples {
 };
 
 // Per-ray linear least squares for what is not geometry, given the coverages c_i:
-//   known background:  I_i = (1 − c_i)·(σ0 + σ1·t_i)·B_i + c_i·F   (σ: the body's shadow and
-//                      the light's unevenness on this ray, weakly held at 1; F the limb colour)
-//   unknown:           I_i = (1 − c_i)·(B0 + B1·t_i) + c_i·F         (per channel)
-// t_i the sample's position along the window. Returns the background term of each sample and F.
+//   known background:  I_i = (1 − c_i)·(σ0 + σ1·t_i)·B_i + c_i·S_i·F   (σ: the body's shadow and
+//                      the light's unevenness on this ray, weakly held at 1; F the body's colour)
+//   unknown:           I_i = (1 − c_i)·(B0 + B1·t_i) + c_i·S_i·F         (per channel)
+// t_i the sample's position along the window; S_i (per channel) the body's relative colour over
+// the part of it that passed over the sample (smeared_outline.hpp, body_shading.hpp) on a shaded
+// ray, else 1 (F is then the limb's colour). Returns the background term of each sample and F.
 struct RayColours {
   std::vector<cv::Vec3d> back;  // (σ0 + σ1·t)·B, or B0 + B1·t, per sample
   cv::Vec3d body;
   bool ok = false;
 };
 
-RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, double noise) {
+RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, const std::vector<cv::Vec3d>& shade,
+                        double noise) {
   RayColours out;
   const size_t n = c.size();
   out.back.resize(n);
+  // The body's column of sample i in channel ch.
+  const auto body = [&](size_t i, int ch) { return shade.empty() ? c[i] : c[i] * shade[i][ch]; };
   if (!ray.back.empty()) {
     Eigen::Matrix<double, 5, 5> a = Eigen::Matrix<double, 5, 5>::Zero();
     Eigen::Matrix<double, 5, 1> y = Eigen::Matrix<double, 5, 1>::Zero();
-    // The normal equations of the rows (u·B_ch, u·t·B_ch, c at 2 + ch) of every sample and
-    // channel, summed by their structure (u = 1 − c, t the position along the ray).
+    // The normal equations of the rows (u·B_ch, u·t·B_ch, k_ch at 2 + ch) of every sample and
+    // channel, summed by their structure (u = 1 − c, t the position along the ray, k the body's
+    // column).
     for (size_t i = 0; i < n; ++i) {
-      const double u = 1 - c[i], t = ray.along[i], ci = c[i];
+      const double u = 1 - c[i], t = ray.along[i];
       double bb = 0, bi = 0;
       for (int ch = 0; ch < 3; ++ch) {
-        const double b = ray.back[i][ch], image = ray.image[i][ch];
+        const double b = ray.back[i][ch], image = ray.image[i][ch], k = body(i, ch);
         bb += b * b;
         bi += b * image;
-        a(0, 2 + ch) += u * b * ci;
-        a(1, 2 + ch) += u * t * b * ci;
-        y(2 + ch) += ci * image;
+        a(0, 2 + ch) += u * b * k;
+        a(1, 2 + ch) += u * t * b * k;
+        a(2 + ch, 2 + ch) += k * k;
+        y(2 + ch) += k * image;
       }
       a(0, 0) += u * u * bb;
       a(0, 1) += u * u * t * bb;
       a(1, 1) += u * u * t * t * bb;
-      a(2, 2) += ci * ci, a(3, 3) += ci * ci, a(4, 4) += ci * ci;
       y(0) += u * bi;
       y(1) += u * t * bi;
     }
@@ -80,35 +92,53 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, dou
     out.ok = true;
     return out;
   }
-  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d y = Eigen::Matrix3d::Zero();  // column per channel
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d row(1 - c[i], (1 - c[i]) * ray.along[i], c[i]);
-    a += row * row.transpose();
-    for (int ch = 0; ch < 3; ++ch) y.col(ch) += row * static_cast<double>(ray.image[i][ch]);
+  // Per channel: (B0, B1, F); the design is the same for the three unless the body is shaded.
+  const int designs = shade.empty() ? 1 : 3;
+  cv::Vec3d mean(0, 0, 0);
+  for (size_t i = 0; i < n; ++i) mean += cv::Vec3d(ray.image[i]);
+  mean /= static_cast<double>(n);
+  for (int design = 0; design < designs; ++design) {
+    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d y = Eigen::Matrix3d::Zero();  // column per channel
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d row(1 - c[i], (1 - c[i]) * ray.along[i], body(i, design));
+      a += row * row.transpose();
+      for (int ch = 0; ch < 3; ++ch) y.col(ch) += row * static_cast<double>(ray.image[i][ch]);
+    }
+    a(1, 1) += 1e-6 * (a(0, 0) + 1e-12);
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(a);
+    const Eigen::Matrix3d x = ldlt.solve(y);
+    if (!x.allFinite() || a(2, 2) < 1e-9 || ldlt.rcond() < 1e-9) {
+      for (size_t i = 0; i < n; ++i) out.back[i] = mean;
+      out.ok = false;
+      return out;
+    }
+    for (int ch = design; ch < (designs == 1 ? 3 : design + 1); ++ch) {
+      for (size_t i = 0; i < n; ++i) out.back[i][ch] = x(0, ch) + x(1, ch) * ray.along[i];
+      out.body[ch] = x(2, ch);
+    }
   }
-  a(1, 1) += 1e-6 * (a(0, 0) + 1e-12);
-  const Eigen::LDLT<Eigen::Matrix3d> ldlt(a);
-  const Eigen::Matrix3d x = ldlt.solve(y);
-  if (!x.allFinite() || a(2, 2) < 1e-9 || ldlt.rcond() < 1e-9) {
-    cv::Vec3d mean(0, 0, 0);
-    for (size_t i = 0; i < n; ++i) mean += cv::Vec3d(ray.image[i]);
-    for (size_t i = 0; i < n; ++i) out.back[i] = mean / static_cast<double>(n);
-    return out;
-  }
-  for (size_t i = 0; i < n; ++i)
-    for (int ch = 0; ch < 3; ++ch) out.back[i][ch] = x(0, ch) + x(1, ch) * ray.along[i];
-  out.body = cv::Vec3d(x(2, 0), x(2, 1), x(2, 2));
   out.ok = true;
   return out;
 }
 
 class RayCost : public ceres::CostFunction {
  public:
-  RayCost(const SmearedBody& body, RaySamples ray, double inv_noise)
+  // shaded: S_i from the body's shading at the parameters `start`, held through the solve (it
+  // changes with the centre by a fraction of the shading's change over a radius, while the
+  // coverage changes across the whole edge; and it costs as much as the coverage to evaluate).
+  RayCost(const SmearedBody& body, RaySamples ray, double inv_noise, bool shaded, const double* start)
       : body_(body), ray_(std::move(ray)), inv_noise_(inv_noise) {
     set_num_residuals(static_cast<int>(3 * ray_.dirs.size()));
     mutable_parameter_block_sizes()->push_back(kSmearParameters);
+    if (shaded) Shade(start);
+  }
+
+  // S_i at the parameters p.
+  void Shade(const double* p) {
+    const SmearNodes nodes(body_, p, ray_.offset, ray_.pieces, ray_.bend);
+    ray_.shade.resize(ray_.dirs.size());
+    for (size_t i = 0; i < ray_.dirs.size(); ++i) nodes.Coverage(ray_.dirs[i], nullptr, &ray_.shade[i]);
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
@@ -141,11 +171,12 @@ class RayCost : public ceres::CostFunction {
     std::vector<double> c(n);
     std::vector<SmearGradient> grad(jacobian ? n : 0);
     for (size_t i = 0; i < n; ++i) c[i] = nodes.Coverage(ray_.dirs[i], grad.empty() ? nullptr : &grad[i]);
-    RayColours colours = SolveColours(ray_, c, 1.0 / inv_noise_);
+    const std::vector<cv::Vec3d>& shade = ray_.shade;
+    RayColours colours = SolveColours(ray_, c, shade, 1.0 / inv_noise_);
     for (size_t i = 0; i < n; ++i) {
       const cv::Vec3d I = ray_.image[i];
       const cv::Vec3d& B = colours.back[i];
-      const cv::Vec3d F = colours.ok ? colours.body : B;
+      const cv::Vec3d F = !colours.ok ? B : shade.empty() ? colours.body : colours.body.mul(shade[i]);
       for (int ch = 0; ch < 3; ++ch) {
         residuals[3 * i + ch] = (I[ch] - B[ch] - c[i] * (F[ch] - B[ch])) * inv_noise_;
         if (!grad.empty()) {
@@ -237,6 +268,9 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   body.eye = g.eye_s;
   body.px_per_rad = g.PxPerRad(x, z);
   body.sigma_px = g.sigma_px;
+  // The body's shading, where it is known and the smear is long enough for it to matter.
+  const bool shaded = g.shading && g.shading->ready() && smear_px.norm() > kShadedSmear * radius_px;
+  if (shaded) body.shading = g.shading;
 
   // Rays: windows and their three undistorted anchors (start, middle, end).
   struct Ray {
@@ -334,7 +368,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
         }
     }
     const double loss_scale = std::sqrt(kRayLossFactor * 3.0 * samples.dirs.size());
-    auto* cost = new RayCost(body, std::move(samples), inv_noise);
+    auto* cost = new RayCost(body, std::move(samples), inv_noise, shaded, params);
     costs.push_back(cost);
     problem.AddResidualBlock(cost, new ceres::CauchyLoss(loss_scale), params);
   }
@@ -360,6 +394,13 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   solver.parameter_tolerance = 1e-7;
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
+  // The shading held at the start: solved again with it where the fit moved the centre by more
+  // than kShadeMovePx.
+  if (shaded && (g.Project(params[kCentreX], params[kCentreZ]) - centre).norm() > kShadeMovePx &&
+      std::isfinite(params[kCentreX]) && std::isfinite(params[kCentreZ])) {
+    for (RayCost* cost : costs) cost->Shade(params);
+    ceres::Solve(solver, &problem, &summary);
+  }
   for (double v : params)
     if (!std::isfinite(v)) return out;
   if (!InFront(g, params[kCentreX], params[kCentreZ])) return out;

@@ -46,6 +46,7 @@ struct OutlineGeometry {
   Eigen::Vector3d eye, eye_s;    // camera centre, and scaled
   double sigma_px = 0.7;         // point spread
   const cv::Mat* occluder = nullptr;  // CV_8U frame-size mask of hidden pixels
+  const BodyShading* shading = nullptr;  // the body's appearance, once learnt (may be null)
 
   // Tangent points of the body centred at (x, 0, z), apparatus frame (n of them).
   std::vector<Eigen::Vector3d> OutlinePoints(double x, double z, int n) const;

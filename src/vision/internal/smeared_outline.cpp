@@ -130,7 +130,7 @@ double SmearNodes::DistanceAtMiddle(const Vector3d& d) const {
   return 0.5 * (delta(nodes_[lo]) + delta(nodes_[hi]));
 }
 
-double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad) const {
+double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, cv::Vec3d* shade) const {
   const double p = body_.px_per_rad, sigma = body_.sigma_px;
   const size_t count = nodes_.size();
   // u_n = −δ_n/σ at every node, and ∂δ_n/∂(x, z) (the same for D scaled by τ_n).
@@ -152,9 +152,12 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad) const {
   const size_t pieces = count - 1;
   double coverage = 0;
   double du[33] = {0};
+  double cdf[33];
   NodeCdf left(u[0]);
+  cdf[0] = left.cdf;
   for (size_t j = 0; j < pieces; ++j) {
     const NodeCdf right(u[j + 1]);
+    cdf[j + 1] = right.cdf;
     double d0, d1;
     coverage += MeanCdf(left, right, &d0, &d1);
     du[j] += d0;
@@ -162,6 +165,20 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad) const {
     left = right;
   }
   coverage /= static_cast<double>(pieces);
+  if (shade) {
+    *shade = cv::Vec3d(1, 1, 1);
+    if (body_.shading) {
+      cv::Vec3d sum(0, 0, 0);
+      double weight = 0;
+      for (size_t n = 0; n < count; ++n) {
+        if (cdf[n] < 1e-6) continue;
+        const double w = cdf[n] * (n == 0 || n == pieces ? 0.5 : 1.0);
+        sum += w * body_.shading->At(d, nodes_[n].w * nodes_[n].norm, body_.a);
+        weight += w;
+      }
+      if (weight > 0) *shade = sum / weight;
+    }
+  }
   if (grad) {
     grad->fill(0.0);
     for (size_t n = 0; n < count; ++n) {

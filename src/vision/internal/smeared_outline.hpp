@@ -31,7 +31,10 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <opencv2/core.hpp>
 #include <vector>
+
+#include "body_shading.hpp"
 
 namespace uphill::internal {
 
@@ -44,6 +47,7 @@ struct SmearedBody {
   Eigen::Vector3d eye = Eigen::Vector3d::Zero();  // camera centre, scaled space
   double px_per_rad = 1;                          // pixels per radian near the body
   double sigma_px = 0.7;                          // point spread across the edge, px
+  const BodyShading* shading = nullptr;           // the body's appearance (ready), or none
 };
 
 // Pieces M for a blur of `blur_px` on a body of `radius_px` (see the header).
@@ -58,7 +62,11 @@ class SmearNodes {
              const Eigen::Vector2d& bend = Eigen::Vector2d::Zero());
 
   // Coverage of the unit direction d (scaled space), and its gradient when grad != nullptr.
-  double Coverage(const Eigen::Vector3d& d, SmearGradient* grad) const;
+  // shade (when not null, and the body has a shading): the body's mean relative colour over the
+  // part of it that passed over d (body_shading.hpp), the average over the nodes weighted by their
+  // coverage Φ (trapezoidal in τ); 1 where the body does not reach d. Its derivatives are not
+  // given: it changes slowly with the parameters next to the coverage.
+  double Coverage(const Eigen::Vector3d& d, SmearGradient* grad, cv::Vec3d* shade = nullptr) const;
 
   // The signed distance δ (px) of d from the outline at the window's middle (τ = 0).
   double DistanceAtMiddle(const Eigen::Vector3d& d) const;
