@@ -45,8 +45,12 @@ class BodyShading {
  public:
   static constexpr int kViews = 4;  // views fitted before the shading is used
 
+  using Coefficients = Eigen::Matrix<double, 9, 3>;  // rows: the basis above; columns: B, G, R
+
   // s: the y scaling of the scaled space (smeared_outline.hpp), a/b.
   explicit BodyShading(double s) : s_(s) {}
+  // A shading given by its coefficients, ready at once (a test's known shading).
+  BodyShading(double s, const Coefficients& coefficients) : s_(s), ready_(true), coefficients_(coefficients) {}
 
   // One sharp view of the body resting with its centre at (x, 0, z) in `bgr` (8-bit BGR, `table`
   // its linear light). Views after kViews are ignored; the fit is made at the kViews-th.
@@ -74,7 +78,7 @@ class BodyShading {
   double misfit_ = 0;
   cv::Vec3d colour_ = cv::Vec3d(0, 0, 0);  // the views' mean colour, linear
   std::vector<std::pair<Basis, cv::Vec3d>> samples_;  // (basis at the normal, relative colour)
-  Eigen::Matrix<double, 9, 3> coefficients_ = Eigen::Matrix<double, 9, 3>::Zero();
+  Coefficients coefficients_ = Coefficients::Zero();
 };
 
 }  // namespace uphill::internal
