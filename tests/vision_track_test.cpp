@@ -301,7 +301,7 @@ TEST(VisionTrack, SpheroidCleanClip) {
 // A fast ball under a long exposure (issue 10's 360° shutter at 30 fps): steep rails (H = 250 mm,
 // D = 20 mm), the 1-inch ball released at x0 = 700 mm and smeared over up to 3 radii by the end
 // while it still gains speed. Truth: the renderer's centre at mid-exposure (frame/fps); the blur
-// is the average of 64 renders spread evenly over the exposure along the true (accelerated)
+// is the average of 32 renders spread evenly over the exposure along the true (accelerated)
 // motion, independent of the tracker's smear model. The ball is matte and shaded by a light from
 // above (Lambert's law with ambient light, clamped at the terminator: not the quadratic in the
 // normal the tracker learns). What is tested is the smear's geometry and timing and the body's
@@ -325,7 +325,7 @@ TEST(VisionTrack, FastBallUnderA360DegreeShutterIsMeasuredAtMidExposure) {
   s.frames = 30;
   s.release_time = 0.2;
   s.exposure = 1.0 / 30;
-  s.blur_samples = 64;
+  s.blur_samples = 32;
   s.noise_sigma = 1;
   const ClipRun run = RenderAndTrack(renderer, setup.scene, motion, s, "fast360.avi");
   ExpectAccurate(run.errors, 28, 0.1);
