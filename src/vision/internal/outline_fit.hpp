@@ -12,7 +12,11 @@
 // c_i the coverage of the sample's viewing ray, g·B_i the background at the sample (the
 // background model times this frame's gain) and F_k the body's colour at this ray's limb, a
 // nuisance solved in closed form for every evaluation (variable projection; Kaufman's Jacobian,
-// which drops ∂F/∂c). So the channel in which the fit sees the edge is, ray by ray, the colour
+// which drops ∂F/∂c). On a smear longer than a quarter radius, once the body's shading is learnt
+// (body_shading.hpp), the body's term is c_i·S_i·F_k instead: S_i its mean relative colour over
+// the part of it that passed over the sample, evaluated at the fit's start and held through the
+// solve (solved once more from where the centre went if it moved by over 0.3 px). So the channel
+// in which the fit sees the edge is, ray by ray, the colour
 // difference between the body's limb and what lies behind it: a body as grey as the table but of
 // another hue, or a table with grain, costs nothing. Where the background is not yet known at
 // every sample of a ray (the body rested there since the first frame) the ray's background is a
