@@ -143,6 +143,7 @@ void RunMatrix(const TrackBenchmarkOptions& f, Section& section, std::unique_ptr
   m.cache = f.footage_cache;
   m.conditions = f.conditions;
   m.fresh = f.fresh;
+  m.positions = f.positions;
   m.python = f.common.python;
   m.script = f.script.empty() ? FindUpward("tools/bench/track_peers.py") : f.script;
   m.why_not_peers = PeerUnavailable(f.no_python ? "--no-python" : "", f.common.python, m.script,

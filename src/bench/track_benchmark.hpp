@@ -22,6 +22,7 @@ struct TrackBenchmarkOptions {
   bool no_matrix = false, only_matrix = false;
   std::vector<std::string> conditions;  // empty: the whole matrix
   std::string footage_cache;            // "": vision::FootageCacheRoot()
+  std::string positions;                // "": no per-frame files (TrackMatrixOptions::positions)
 };
 
 void RunTrackBenchmark(const TrackBenchmarkOptions& options, std::ostream& out);

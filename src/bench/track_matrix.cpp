@@ -11,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "bench/support.hpp"
+#include "io/atomic_file.hpp"
 #include "io/csv_table.hpp"
 #include "model/input_error.hpp"
 #include "vision/ball_tracker.hpp"
@@ -37,7 +38,26 @@ std::string Fixed(const char* format, double v) {
 struct Position {
   bool found = false;
   double u = 0, v = 0, x = 0, z = 0;
+  bool full_model = false;
 };
+
+// TrackMatrixOptions::positions: one clip's frames, tracked and true, side by side.
+void WritePositions(const std::string& path, const std::vector<ClipTruth>& truth,
+                    const std::vector<Position>& found) {
+  std::string text = "frame,found,full_model,u,v,x_mm,z_mm,u_true,v_true,x_true_mm,z_true_mm,visibility\n";
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const ClipTruth& t = truth[i];
+    const Position p = i < found.size() ? found[i] : Position{};
+    const auto number = [&](double v) { return p.found ? Fixed("%.4f", v) : std::string(); };
+    text += std::to_string(t.frame) + "," + (p.found ? "1," : "0,") + (p.full_model ? "1," : "0,") + number(p.u) +
+            "," + number(p.v) + "," + number(p.x * 1e3) + "," + number(p.z * 1e3) + "," +
+            (t.present ? Fixed("%.4f", t.u) + "," + Fixed("%.4f", t.v) + "," + Fixed("%.4f", t.x * 1e3) + "," +
+                             Fixed("%.4f", t.z * 1e3)
+                       : std::string(",,,")) +
+            "," + Fixed("%.3f", t.visibility) + "\n";
+  }
+  WriteFileAtomically(path, text);
+}
 
 struct Score {
   double rms_px = NAN, rms_mm = NAN;
@@ -177,7 +197,7 @@ std::unique_ptr<TrackMatrixRecord> RunTrackMatrix(const TrackMatrixOptions& o, s
       const TrackResult track = TrackVideo(run.files.video, c.scene, run.calibrated);
       for (size_t i = 0; i < track.rows.size() && i < positions.size(); ++i) {
         const BallObservation& b = track.rows[i].ball;
-        positions[i] = {b.found, b.u, b.v, b.x, b.z};
+        positions[i] = {b.found, b.u, b.v, b.x, b.z, b.full_model};
       }
       run.uphill_says = track.partial ? "partial: " + track.partial_reason : "complete";
       run.ms_per_frame = track.rows.empty() ? 0 : 1e3 * track.tracker_cpu_seconds / track.rows.size();
@@ -196,6 +216,10 @@ std::unique_ptr<TrackMatrixRecord> RunTrackMatrix(const TrackMatrixOptions& o, s
       run.uphill_says = std::string("error: ") + e.what();
     }
     run.uphill = Compare(run.truth, positions);
+    if (!o.positions.empty()) {
+      fs::create_directories(o.positions);
+      WritePositions((fs::path(o.positions) / (c.name + ".csv")).string(), run.truth, positions);
+    }
     runs.push_back(run);
   }
 

@@ -29,6 +29,7 @@ struct TrackMatrixOptions {
   bool fresh = false;                   // render again
   std::string python, script;           // the peers (script "" = skip them, why_not says why)
   std::string why_not_peers;
+  std::string positions;  // folder for each clip's frames against the truth ("" = none); see below
 };
 
 // The tables (kept alive until the section is recorded) and the notes of the run.
@@ -38,6 +39,9 @@ struct TrackMatrixRecord {
   std::vector<std::string> notes;
 };
 
+// With `positions` set, each clip's frames are written to <positions>/<condition>.csv: frame,
+// found, full_model, the tracker's u, v (px) and x, z (mm), and the renderer's true u_true,
+// v_true, x_true, z_true and visibility, so that an error can be followed frame by frame.
 // Renders or reuses the clips, tracks them, runs the peers, prints both tables to `out` as rows
 // are measured. Throws std::runtime_error when povray or ffmpeg is missing (the clips cannot be made).
 std::unique_ptr<TrackMatrixRecord> RunTrackMatrix(const TrackMatrixOptions& options, std::ostream& out);

@@ -117,6 +117,8 @@ void AddTrack(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& 
   cmd->add_flag("--only-matrix", o->only_matrix, "only the robustness table");
   cmd->add_option("--conditions", o->conditions, "robustness conditions to run (default: all)")->delimiter(',');
   cmd->add_option("--footage-cache", o->footage_cache, "ray-traced clips (default ~/.cache/uphill/clips)");
+  cmd->add_option("--positions", o->positions,
+                  "folder to write each ray-traced clip's frames in, tracked against the truth (<condition>.csv)");
   cmd->callback([o, argv] {
     o->common.command = CommandLine(*argv);
 #if UPHILL_VISION_PROGRAM
