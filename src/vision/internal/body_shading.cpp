@@ -35,11 +35,18 @@ BodyShading::Basis BodyShading::BasisAt(const Eigen::Vector3d& d, const Eigen::V
     n = kReliable * across - kReliableCos * d;
   }
   n.y() *= s_;  // back from the scaled space: normals scale by the inverse transpose
-  n.normalize();
+  n = turn_.transpose() * n.normalized();
   Basis basis;
   basis << 1, n.x(), n.y(), n.z(), n.x() * n.y(), n.y() * n.z(), n.x() * n.z(), n.x() * n.x() - n.y() * n.y(),
       3 * n.z() * n.z() - 1;
   return basis;
+}
+
+BodyShading BodyShading::Turned(const Eigen::Vector3d& omega) const {
+  BodyShading turned(*this);
+  const double angle = omega.norm();
+  if (angle > 0) turned.turn_ = Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix();
+  return turned;
 }
 
 cv::Vec3d BodyShading::At(const Eigen::Vector3d& d, const Eigen::Vector3d& v, double a) const {

@@ -19,7 +19,12 @@ constexpr double kShadowPrior = 0.05;    // σ of the background's factor along 
 constexpr double kRayLossFactor = 1.5;  // Cauchy scale: this many times a good ray's χ²
 // A smear longer than this many radii is fitted with the body's shading (body_shading.hpp).
 constexpr double kShadedSmear = 0.25;
-constexpr double kShadeMovePx = 0.3;
+// The turn of the body's light in a frame (BodyShading::Turned): σ of its prior, rad (the light's
+// direction seen from the body turns by tens of degrees as it crosses the apparatus under a lamp a
+// metre away), the Gauss–Newton steps (the centre held), the step of its numerical derivative.
+constexpr double kTurnPrior = 0.2;
+constexpr int kTurnSteps = 1;
+constexpr double kTurnStep = 0.01;
 
 struct RaySamples {
   Vector2d offset = Vector2d::Zero();  // centre shift of this ray's rows, m
@@ -142,7 +147,7 @@ class RayCost : public ceres::CostFunction {
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    Compute(parameters[0], residuals, jacobians ? jacobians[0] : nullptr, nullptr);
+    Compute(parameters[0], ray_.shade, residuals, jacobians ? jacobians[0] : nullptr, nullptr);
     return true;
   }
 
@@ -151,7 +156,7 @@ class RayCost : public ceres::CostFunction {
     const size_t n = ray_.dirs.size();
     std::vector<double> r(3 * n);
     RayColours colours;
-    Compute(p, r.data(), nullptr, &colours);
+    Compute(p, ray_.shade, r.data(), nullptr, &colours);
     double sum = 0;
     for (double v : r) sum += v * v;
     *mean_square = sum / static_cast<double>(r.size());
@@ -162,16 +167,27 @@ class RayCost : public ceres::CostFunction {
 
   size_t samples() const { return ray_.dirs.size(); }
 
+  // The residuals at p (appended to r), the shade evaluated afresh from the body's shading.
+  void FreshResiduals(const double* p, std::vector<double>* r) const {
+    const size_t n = ray_.dirs.size();
+    const SmearNodes nodes(body_, p, ray_.offset, ray_.pieces, ray_.bend);
+    std::vector<cv::Vec3d> shade(n);
+    for (size_t i = 0; i < n; ++i) nodes.Coverage(ray_.dirs[i], nullptr, &shade[i]);
+    const size_t at = r->size();
+    r->resize(at + 3 * n);
+    Compute(p, shade, r->data() + at, nullptr, nullptr);
+  }
+
  private:
-  // The residuals at p, their Jacobian (row-major, when not null) and the colours solved there
-  // (when not null).
-  void Compute(const double* p, double* residuals, double* jacobian, RayColours* solved) const {
+  // The residuals at p with the shade S_i (empty: none), their Jacobian (row-major, when not
+  // null) and the colours solved there (when not null).
+  void Compute(const double* p, const std::vector<cv::Vec3d>& shade, double* residuals, double* jacobian,
+               RayColours* solved) const {
     const size_t n = ray_.dirs.size();
     const SmearNodes nodes(body_, p, ray_.offset, ray_.pieces, ray_.bend);
     std::vector<double> c(n);
     std::vector<SmearGradient> grad(jacobian ? n : 0);
     for (size_t i = 0; i < n; ++i) c[i] = nodes.Coverage(ray_.dirs[i], grad.empty() ? nullptr : &grad[i]);
-    const std::vector<cv::Vec3d>& shade = ray_.shade;
     RayColours colours = SolveColours(ray_, c, shade, 1.0 / inv_noise_);
     for (size_t i = 0; i < n; ++i) {
       const cv::Vec3d I = ray_.image[i];
@@ -193,6 +209,50 @@ class RayCost : public ceres::CostFunction {
   RaySamples ray_;
   double inv_noise_;
 };
+
+double Median(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+// A ray whose mean square (units of the noise²) is below this is an inlier.
+double InlierLimit(const std::vector<double>& squares) { return kRayLossFactor * std::max(1.0, Median(squares)); }
+
+std::vector<double> MeanSquares(const std::vector<RayCost*>& rays, const double* p) {
+  std::vector<double> squares(rays.size());
+  double contrast;
+  for (size_t k = 0; k < rays.size(); ++k) rays[k]->Assess(p, &contrast, &squares[k]);
+  return squares;
+}
+
+// The turn of the light (BodyShading::Turned) that best explains the rays at p, the centre held:
+// Gauss–Newton from the prior mean, its Jacobian by forward differences (each column a fresh
+// shade of every sample). *turned (the shading the rays read) is left turned by the result.
+Vector3d FitShadingTurn(const BodyShading& learnt, BodyShading* turned, const std::vector<const RayCost*>& rays,
+                        const double* p, const Vector3d& prior) {
+  const auto residuals = [&](const Vector3d& omega, std::vector<double>* r) {
+    *turned = learnt.Turned(omega);
+    r->clear();
+    for (const RayCost* ray : rays) ray->FreshResiduals(p, r);
+    return Eigen::Map<const Eigen::VectorXd>(r->data(), static_cast<Eigen::Index>(r->size()));
+  };
+  Vector3d omega = prior;
+  std::vector<double> r0, r1;
+  const double inv_prior = 1 / (kTurnPrior * kTurnPrior);
+  for (int step = 0; step < kTurnSteps; ++step) {
+    const Eigen::Map<const Eigen::VectorXd> e0 = residuals(omega, &r0);
+    Eigen::MatrixXd jacobian(e0.size(), 3);
+    for (int axis = 0; axis < 3; ++axis)
+      jacobian.col(axis) = (residuals(omega + kTurnStep * Vector3d::Unit(axis), &r1) - e0) / kTurnStep;
+    const Eigen::Matrix3d a = jacobian.transpose() * jacobian + inv_prior * Eigen::Matrix3d::Identity();
+    const Vector3d b = jacobian.transpose() * e0 + inv_prior * (omega - prior);
+    const Vector3d next = omega - a.ldlt().solve(b);
+    if (!next.allFinite()) break;
+    omega = next;
+  }
+  *turned = learnt.Turned(omega);
+  return omega;
+}
 
 // The priors: b ~ N(0, 0.3 px), D ~ N(D_pred, σ_D).
 struct PriorCost {
@@ -249,6 +309,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   const double right = std::min(g.cal.camera.width - 2.0, view.origin.x + bgr.cols - 2.0);
   const double bottom = std::min(g.cal.camera.height - 2.0, view.origin.y + bgr.rows - 2.0);
   FitOutcome out;
+  out.shading_turn = q.shading_turn;
   const double x = q.centre.x(), z = q.centre.y();
   if (!InFront(g, x, z)) return out;
   const int n = q.rays;
@@ -270,7 +331,8 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   body.sigma_px = g.sigma_px;
   // The body's shading, where it is known and the smear is long enough for it to matter.
   const bool shaded = g.shading && g.shading->ready() && smear_px.norm() > kShadedSmear * radius_px;
-  if (shaded) body.shading = g.shading;
+  BodyShading turned = shaded ? g.shading->Turned(q.shading_turn) : BodyShading(1.0);
+  if (shaded) body.shading = &turned;
 
   // Rays: windows and their three undistorted anchors (start, middle, end).
   struct Ray {
@@ -394,10 +456,15 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   solver.parameter_tolerance = 1e-7;
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
-  // The shading held at the start: solved again with it where the fit moved the centre by more
-  // than kShadeMovePx.
-  if (shaded && (g.Project(params[kCentreX], params[kCentreZ]) - centre).norm() > kShadeMovePx &&
-      std::isfinite(params[kCentreX]) && std::isfinite(params[kCentreZ])) {
+  // The shading learnt where the body rested, turned to this frame's light, then the centre
+  // solved again with it.
+  if (shaded && q.fit_shading_turn && std::isfinite(params[kCentreX]) && std::isfinite(params[kCentreZ])) {
+    const std::vector<double> squares = MeanSquares(costs, params);
+    const double limit = InlierLimit(squares);
+    std::vector<const RayCost*> inliers;
+    for (size_t k = 0; k < costs.size(); ++k)
+      if (squares[k] < limit) inliers.push_back(costs[k]);
+    out.shading_turn = FitShadingTurn(*g.shading, &turned, inliers, params, q.shading_turn);
     for (RayCost* cost : costs) cost->Shade(params);
     ceres::Solve(solver, &problem, &summary);
   }
@@ -407,10 +474,8 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
 
   std::vector<double> squares(costs.size()), contrasts(costs.size());
   for (size_t k = 0; k < costs.size(); ++k) costs[k]->Assess(params, &contrasts[k], &squares[k]);
-  std::vector<double> sorted = squares;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const double median = sorted[sorted.size() / 2];
-  const double limit = kRayLossFactor * std::max(1.0, median);
+  const double median = Median(squares);
+  const double limit = InlierLimit(squares);
   double sum = 0;
   std::vector<double> inlier_contrasts;
   for (size_t k = 0; k < costs.size(); ++k)

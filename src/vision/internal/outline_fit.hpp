@@ -15,7 +15,11 @@
 // which drops ∂F/∂c). On a smear longer than a quarter radius, once the body's shading is learnt
 // (body_shading.hpp), the body's term is c_i·S_i·F_k instead: S_i its mean relative colour over
 // the part of it that passed over the sample, evaluated at the fit's start and held through the
-// solve (solved once more from where the centre went if it moved by over 0.3 px). So the channel
+// solve. The shading is read turned by the light's turn ω (BodyShading::Turned: a lamp a metre
+// away is seen from the body in another direction once it has crossed the apparatus; on the
+// ray-traced fast clips the centre otherwise lags by up to 1 px on the longest smears): after the
+// solve, ω is fitted to the inlier rays with the centre held (one Gauss–Newton step from the
+// request's ω, prior σ 0.2 rad), and the centre solved once more with S_i from there. So the channel
 // in which the fit sees the edge is, ray by ray, the colour
 // difference between the body's limb and what lies behind it: a body as grey as the table but of
 // another hue, or a table with grain, costs nothing. Where the background is not yet known at
@@ -70,6 +74,8 @@ struct FitRequest {
   int rays = 64;
   double noise = 0.01;                  // expected RMS of a sample's residual, linear units
   bool fit_edge_shift = true;           // false: b held at 0 (a first pass far from the edges)
+  Eigen::Vector3d shading_turn = Eigen::Vector3d::Zero();  // the light's turn, prior mean (BodyShading::Turned)
+  bool fit_shading_turn = true;         // false: the turn held at its prior mean (a first pass)
 };
 
 // The picture a fit reads: a whole frame (origin 0, 0) or a window of one kept for a later refit,
@@ -88,6 +94,7 @@ struct FitOutcome {
   double misfit = 0;    // RMS of the inlier rays' residuals in units of `noise`
   double contrast = 0;  // median |F − B| of the inliers, linear units
   double noise = 0;     // RMS residual of the inlier rays, linear units (for the next frame)
+  Eigen::Vector3d shading_turn = Eigen::Vector3d::Zero();  // fitted on a shaded smear, else the prior's
 };
 
 FitOutcome FitOutline(const OutlineGeometry& geometry, const FrameView& view, const BackgroundModel& background,
