@@ -355,6 +355,11 @@ TEST(VisionTrack, BadInputIsNamed) {
   // A double cone is not tracked.
   const Scene cone(Body::DoubleCone(0.05, 0.1), setup.scene.rails());
   EXPECT_THROW(BallTracker(cone, setup.calibration), InputError);
+  // A readout both given and to be measured.
+  TrackerOptions both;
+  both.readout = 0.02;
+  both.measure_readout = true;
+  ExpectInputError([&] { BallTracker(setup.scene, setup.calibration, both); }, {"--readout", "auto"});
 }
 
 }  // namespace

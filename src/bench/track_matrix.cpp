@@ -156,7 +156,8 @@ const char* const kTrackMatrixMethod =
     "y = 0. render: wall time to ray-trace the clip on this machine (CPU seconds in brackets). ms/frame: uphill's "
     "tracker alone (its thread's CPU time); vs decode: frames per CPU-second of decoding and tracking against "
     "decoding alone (VideoCapture::read, process CPU time; goal >= 80%); model: share of the frames found that the "
-    "full model (background, colours, smear) measured rather than the fast edge fit.";
+    "full model (background, colours, smear) measured rather than the fast edge fit. The rolling-shutter clip is "
+    "tracked with --readout auto (a phone: its readout measured from the clip; the note gives it).";
 
 std::unique_ptr<TrackMatrixRecord> RunTrackMatrix(const TrackMatrixOptions& o, std::ostream& out) {
   auto record = std::make_unique<TrackMatrixRecord>();
@@ -194,7 +195,13 @@ std::unique_ptr<TrackMatrixRecord> RunTrackMatrix(const TrackMatrixOptions& o, s
     // Tracking.
     std::vector<Position> positions(run.truth.size());
     try {
-      const TrackResult track = TrackVideo(run.files.video, c.scene, run.calibrated);
+      // A phone's rolling shutter: the user knows it is one, not its readout (measured).
+      TrackVideoOptions options;
+      options.tracker.measure_readout = c.shutter.readout > 0;
+      const TrackResult track = TrackVideo(run.files.video, c.scene, run.calibrated, options);
+      if (track.measured_readout_frames > 0)
+        run.calibration_note += Fixed(", readout measured %.1f ms", 1e3 * track.readout) +
+                                " (true " + Fixed("%.1f ms)", 1e3 * c.shutter.readout);
       for (size_t i = 0; i < track.rows.size() && i < positions.size(); ++i) {
         const BallObservation& b = track.rows[i].ball;
         positions[i] = {b.found, b.u, b.v, b.x, b.z, b.full_model};

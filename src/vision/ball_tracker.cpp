@@ -43,6 +43,10 @@ constexpr int kLearnEvery = 8;              // on the fast path, frames between 
 // reflections and the highlight leave 55-75 % of the rays inliers, and the exposure is the
 // median over the frames).
 constexpr double kExposureMinAgreement = 0.5;
+// The rolling shutter's readout, where measured: the row delay probed ± this share of a frame time
+// over the picture's height; measured on up to kReadoutFrames frames, used from kReadoutMinFrames.
+constexpr double kReadoutProbe = 0.25;
+constexpr size_t kReadoutFrames = 15, kReadoutMinFrames = 5;
 
 struct Sample {
   double t, x, z;  // s (clip time of the reported centre), m
@@ -65,6 +69,7 @@ struct BallTracker::Impl {
   std::deque<double> noises;                        // of the last accepted frames
   double row_delay = 0;                             // s per row
   std::vector<double> exposures;                    // per-frame measurements |D|/|V|
+  std::vector<double> row_delays;                   // per-frame measurements of the row delay, s
   std::vector<double> scene_residuals;              // recent steady levels
   int scene_suspect = 0;
   long scene_suspect_from = -1;
@@ -117,6 +122,25 @@ struct BallTracker::Impl {
       return e[e.size() / 2];
     }
     return 0.5 / options.fps;  // a 180° shutter, the usual default of video cameras
+  }
+
+  // Whether this frame's fit measures the row delay (TrackerOptions::measure_readout): until
+  // kReadoutFrames have, where a whole frame's readout would shear the body by over a pixel.
+  bool ProbesReadout(const Vector2d& centre, const Vector2d& velocity) const {
+    if (!options.measure_readout || row_delays.size() >= kReadoutFrames || velocity.isZero()) return false;
+    const double px_per_s = velocity.norm() / MetresPerPx(centre.x(), centre.y());
+    return px_per_s * 2 * RadiusPx(centre.x(), centre.y()) / options.fps / geometry.cal.camera.height > 1;
+  }
+
+  // A frame's measured row delay; the median of all so far is used from kReadoutMinFrames on.
+  void MeasuredRowDelay(double delay) {
+    const double most = 1 / options.fps / geometry.cal.camera.height;
+    if (!(delay > -0.5 * most && delay < 1.5 * most)) return;  // a fit that did not see the shear
+    row_delays.push_back(delay);
+    if (row_delays.size() < kReadoutMinFrames) return;
+    std::vector<double> d = row_delays;
+    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+    row_delay = std::clamp(d[d.size() / 2], 0.0, 0.999 * most);
   }
 
   double RadiusPx(double x, double z) const {
@@ -185,6 +209,7 @@ struct BallTracker::Impl {
     q.shading_turn = shading_turn;
     q.half_width_px = half_width;
     q.row_delay = row_delay;
+    if (ProbesReadout(centre, velocity)) q.row_delay_probe = kReadoutProbe / options.fps / geometry.cal.camera.height;
     q.reference_row = geometry.Project(centre.x(), centre.y()).y();
     const double m_per_px = MetresPerPx(centre.x(), centre.y());
     if (moving_known) {
@@ -567,6 +592,8 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
     throw InputError("--exposure", "must be > 0 and at most the frame time 1/fps");
   if (!(options.readout >= 0 && options.readout < 1.0 / options.fps))
     throw InputError("--readout", "must be >= 0 and below the frame time 1/fps");
+  if (options.measure_readout && options.readout > 0)
+    throw InputError("--readout", "give the readout or have it measured (auto), not both");
   if (!(options.point_spread_px >= 0.2 && options.point_spread_px <= 5))
     throw InputError("point_spread_px", "must be in [0.2, 5] px");
   Impl& m = *impl_;
@@ -648,6 +675,11 @@ std::optional<BallTracker::Exposure> BallTracker::ExposureEstimate() const {
   return Exposure{impl_->Exposure(), static_cast<int>(impl_->exposures.size())};
 }
 
+std::optional<BallTracker::Readout> BallTracker::ReadoutEstimate() const {
+  if (impl_->row_delays.size() < kReadoutMinFrames) return std::nullopt;
+  return Readout{impl_->row_delay * impl_->geometry.cal.camera.height, static_cast<int>(impl_->row_delays.size())};
+}
+
 std::optional<long> BallTracker::SceneChangedAt() const { return impl_->scene_changed_at; }
 
 std::vector<std::pair<long, BallObservation>> BallTracker::TakeRevisions() {
@@ -698,6 +730,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
     const bool needs_model_before = m.needs_model;
     BallObservation o = m.Observe(fit, q);
     m.shading_turn = fit.shading_turn;
+    if (fit.row_delay_sigma > 0) m.MeasuredRowDelay(fit.row_delay);
     m.noises.push_back(std::clamp(fit.noise, 1e-3, 0.2));
     if (m.noises.size() > 15) m.noises.pop_front();
     std::vector<double> sorted(m.noises.begin(), m.noises.end());
@@ -746,7 +779,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
   };
 
   // The fast path: the edge fit, where the scene does not need the model (see the header).
-  if (predicted && !m.needs_model && m.row_delay == 0) {
+  if (predicted && !m.needs_model && m.row_delay == 0 && !m.ProbesReadout(centre, velocity)) {
     const double px = 1 / m.MetresPerPx(centre.x(), centre.y());
     // With the exposure not yet known, and the body's shading known (so that the model measures
     // a long smear better than the edge fit), the blur is taken at its longest (a 360° shutter):

@@ -58,8 +58,12 @@
 // global shutter). A rolling shutter (TrackerOptions::readout > 0: row r is exposed r·readout/H
 // after row 0) shears the body: each ray's rows have their own window, and the centre is reported
 // at the mid-exposure of the row where it lies, BallObservation::time_offset after the frame's
-// timestamp. The exposure time is a camera setting (TrackerOptions::exposure); when unknown it is
-// measured from the fitted smear against the track's speed (ExposureEstimate()).
+// timestamp. When the readout is unknown (TrackerOptions::measure_readout) it is measured from the
+// outline's shear on the frames where the body moves fast enough for a whole frame's readout to
+// shear it by a pixel: each such frame's fit gives the row delay its rays prefer (outline_fit.hpp,
+// the centre held) and, from five frames on, their median is used (ReadoutEstimate()). The
+// exposure time is a camera setting (TrackerOptions::exposure); when unknown it is measured from
+// the fitted smear against the track's speed (ExposureEstimate()).
 //
 // Accuracy (tests/vision_track_test.cpp, tests/vision_povray_test.cpp, `uphill bench track`):
 // see docs/track.md for the measured table; the camera and scene calibration's own errors add to
@@ -99,6 +103,7 @@ struct TrackerOptions {
   double fps = 30;                         // frames per second (the video's)
   std::optional<double> exposure;          // s; unset: measured from the smear
   double readout = 0;                      // s from the first to the last row; 0: global shutter
+  bool measure_readout = false;            // a rolling shutter of unknown readout: measured (readout 0)
   VideoTransfer transfer = VideoTransfer::kSrgb;
   double point_spread_px = 0.7;            // σ of the optics' blur across an edge
 };
@@ -145,6 +150,14 @@ class BallTracker {
     int frames = 0;
   };
   std::optional<Exposure> ExposureEstimate() const;
+
+  // The rolling shutter's readout measured so far (TrackerOptions::measure_readout): s from the
+  // first to the last row, and the frames it is the median of; unset before the first.
+  struct Readout {
+    double seconds = 0;
+    int frames = 0;
+  };
+  std::optional<Readout> ReadoutEstimate() const;
 
   // Set when the picture outside the body changed beyond noise, lighting and exposure (the camera
   // moved, or the scene was disturbed) at this frame: the calibration no longer holds. The tracker

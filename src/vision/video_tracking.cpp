@@ -198,6 +198,18 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
     result.measured_exposure_frames = e->frames;
   }
   result.readout = tracker_options.readout;
+  if (const auto r = tracker.ReadoutEstimate()) {
+    result.readout = r->seconds;
+    result.measured_readout_frames = r->frames;
+    // The frames measured before the readout was: their centre is where the body was when the
+    // centre's row was exposed too (the shear about that row leaves it in place), so their time
+    // is that row's.
+    for (TrackRow& row : result.rows)
+      if (row.ball.found && row.ball.time_offset == 0) {
+        row.ball.time_offset = row.ball.v * result.readout / calibration.camera.height;
+        row.t += row.ball.time_offset;
+      }
+  }
   result.transfer = tracker_options.transfer;
   const long read = static_cast<long>(result.rows.size());
   // A scene change (the camera moved): no position from that frame on, the calibration no longer
@@ -277,6 +289,7 @@ void WriteTrack(const std::string& csv_path, const TrackResult& result, const Tr
                                  {"transfer", result.transfer == VideoTransfer::kLinear ? "linear" : "sRGB"},
                                  {"readout_s", result.readout},
                                  {"partial", result.partial}};
+  if (result.measured_readout_frames > 0) side["readout_measured_frames"] = result.measured_readout_frames;
   if (result.exposure) side["exposure_s"] = *result.exposure;
   else if (result.measured_exposure) {
     side["exposure_s"] = *result.measured_exposure;

@@ -49,7 +49,8 @@ struct TrackResult {
   // the smear, the rolling shutter's readout, the transfer curve.
   std::optional<double> exposure, measured_exposure;
   int measured_exposure_frames = 0;
-  double readout = 0;
+  double readout = 0;  // as used: given, or measured (measured_readout_frames > 0)
+  int measured_readout_frames = 0;
   VideoTransfer transfer = VideoTransfer::kSrgb;
   std::vector<long> exposure_changes;  // frames where the exposure jumped
 };

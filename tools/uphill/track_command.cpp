@@ -87,7 +87,8 @@ void Run(const TrackFlags& f) {
   options.overlay_path = f.overlay;
   if (!f.init.empty()) options.tracker.init_uv = ParsePixel(f.init);
   if (!f.exposure.empty()) options.tracker.exposure = ParseQuantity(f.exposure, Dimension::kTime, "--exposure");
-  if (!f.readout.empty()) options.tracker.readout = ParseQuantity(f.readout, Dimension::kTime, "--readout");
+  if (f.readout == "auto") options.tracker.measure_readout = true;
+  else if (!f.readout.empty()) options.tracker.readout = ParseQuantity(f.readout, Dimension::kTime, "--readout");
   if (f.transfer == "linear") options.tracker.transfer = VideoTransfer::kLinear;
   else if (f.transfer != "srgb") throw InputError("--transfer", "must be srgb or linear (got '" + f.transfer + "')");
   const bool bar = !f.quiet && isatty(STDERR_FILENO);
@@ -147,7 +148,8 @@ void AddTrackCommand(CLI::App& app) {
   cmd->add_option("--exposure", flags->exposure,
                   "exposure time per frame, with unit (e.g. 8.33ms); default: measured from the motion blur");
   cmd->add_option("--readout", flags->readout,
-                  "rolling shutter: time from the first to the last row, with unit (e.g. 25ms); default 0 (global shutter)");
+                  "rolling shutter: time from the first to the last row, with unit (e.g. 25ms), or auto (measured from "
+                  "the ball's shear: a phone); default 0 (global shutter)");
   cmd->add_option("--transfer", flags->transfer, "the video's transfer curve: srgb (cameras, default) or linear");
   cmd->add_option("--overlay", flags->overlay, "write the video with the fitted outline drawn (.mp4)");
   cmd->add_flag("--analyse", flags->analyse, "then analyse the track (release, rest, fall-off, model fit)");

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace uphill::internal {
@@ -25,9 +26,14 @@ constexpr double kShadedSmear = 0.25;
 constexpr double kTurnPrior = 0.2;
 constexpr int kTurnSteps = 1;
 constexpr double kTurnStep = 0.01;
+constexpr double kSharedRows = 0.5;  // a rolling shutter's samples this many rows apart share nodes
 
 struct RaySamples {
-  Vector2d offset = Vector2d::Zero();  // centre shift of this ray's rows, m
+  // A rolling shutter: each sample's row − the reference row (empty: a global shutter), the
+  // velocity V (m/s) and the rows' delay δ (s per row); sample i sees the body shifted by V·Δrow·δ.
+  std::vector<double> rows;
+  Vector2d velocity = Vector2d::Zero();
+  double row_delay = 0;
   // The body's relative colour over the part of it that passed over each sample (S_i below), at
   // the fit's starting point; empty: one colour per ray.
   std::vector<cv::Vec3d> shade;
@@ -141,9 +147,8 @@ class RayCost : public ceres::CostFunction {
 
   // S_i at the parameters p.
   void Shade(const double* p) {
-    const SmearNodes nodes(body_, p, ray_.offset, ray_.pieces, ray_.bend);
     ray_.shade.resize(ray_.dirs.size());
-    for (size_t i = 0; i < ray_.dirs.size(); ++i) nodes.Coverage(ray_.dirs[i], nullptr, &ray_.shade[i]);
+    ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { nodes.Coverage(ray_.dirs[i], nullptr, &ray_.shade[i]); });
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
@@ -170,24 +175,57 @@ class RayCost : public ceres::CostFunction {
   // The residuals at p (appended to r), the shade evaluated afresh from the body's shading.
   void FreshResiduals(const double* p, std::vector<double>* r) const {
     const size_t n = ray_.dirs.size();
-    const SmearNodes nodes(body_, p, ray_.offset, ray_.pieces, ray_.bend);
     std::vector<cv::Vec3d> shade(n);
-    for (size_t i = 0; i < n; ++i) nodes.Coverage(ray_.dirs[i], nullptr, &shade[i]);
+    ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { nodes.Coverage(ray_.dirs[i], nullptr, &shade[i]); });
     const size_t at = r->size();
     r->resize(at + 3 * n);
     Compute(p, shade, r->data() + at, nullptr, nullptr);
   }
 
+  // The sum of squared residuals (units of the noise²) at p.
+  double ChiSquare(const double* p) const {
+    std::vector<double> r(3 * ray_.dirs.size());
+    Compute(p, ray_.shade, r.data(), nullptr, nullptr);
+    double sum = 0;
+    for (double v : r) sum += v * v;
+    return sum;
+  }
+
+  // The rows' delay (s per row) from here on, instead of the request's.
+  void SetRowDelay(double row_delay) { ray_.row_delay = row_delay; }
+
  private:
+  // visit(i, nodes) for every sample i with the smear's nodes it sees: the ray's, or with a
+  // rolling shutter its own row's (shared by the samples within kSharedRows of a row: the body
+  // moves by V·δ per row, 0.05 px at 2000 px/s and a phone's 25 ms over 1080 rows).
+  template <typename Visit>
+  void ForEachSample(const double* p, Visit visit) const {
+    if (ray_.rows.empty()) {
+      const SmearNodes nodes(body_, p, Vector2d::Zero(), ray_.pieces, ray_.bend);
+      for (size_t i = 0; i < ray_.dirs.size(); ++i) visit(i, nodes);
+      return;
+    }
+    std::optional<SmearNodes> nodes;
+    double row = 0;
+    for (size_t i = 0; i < ray_.dirs.size(); ++i) {
+      if (!nodes || std::abs(ray_.rows[i] - row) > kSharedRows) {
+        row = ray_.rows[i];
+        nodes.emplace(body_, p, ray_.velocity * (row * ray_.row_delay), ray_.pieces, ray_.bend);
+      }
+      visit(i, *nodes);
+    }
+  }
+
   // The residuals at p with the shade S_i (empty: none), their Jacobian (row-major, when not
   // null) and the colours solved there (when not null).
   void Compute(const double* p, const std::vector<cv::Vec3d>& shade, double* residuals, double* jacobian,
                RayColours* solved) const {
     const size_t n = ray_.dirs.size();
-    const SmearNodes nodes(body_, p, ray_.offset, ray_.pieces, ray_.bend);
     std::vector<double> c(n);
     std::vector<SmearGradient> grad(jacobian ? n : 0);
-    for (size_t i = 0; i < n; ++i) c[i] = nodes.Coverage(ray_.dirs[i], grad.empty() ? nullptr : &grad[i]);
+    ForEachSample(p, [&](size_t i, const SmearNodes& nodes) {
+      c[i] = nodes.Coverage(ray_.dirs[i], grad.empty() ? nullptr : &grad[i]);
+    });
     RayColours colours = SolveColours(ray_, c, shade, 1.0 / inv_noise_);
     for (size_t i = 0; i < n; ++i) {
       const cv::Vec3d I = ray_.image[i];
@@ -336,7 +374,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
 
   // Rays: windows and their three undistorted anchors (start, middle, end).
   struct Ray {
-    Vector2d origin, dir, offset;
+    Vector2d origin, dir;
     double s0, s1;
     double limb;  // a point surely inside the body (if the prediction holds), px along the ray
   };
@@ -349,11 +387,10 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
     if (r < 2) continue;
     Ray ray;
     ray.dir = radial / r;
-    // The rolling shutter: this ray's rows are exposed (row − reference)·delay later.
-    const double delay = (image[k].y() - q.reference_row) * q.row_delay;
-    ray.offset = q.velocity * delay;
+    // The rolling shutter: the window follows the body's shift at the tangent point's row.
+    const Vector2d offset = q.velocity * ((image[k].y() - q.reference_row) * q.row_delay);
     double shift = 0;
-    if (delay != 0) shift = (g.Project(x + ray.offset.x(), z + ray.offset.y()) - centre).dot(ray.dir);
+    if (q.row_delay != 0) shift = (g.Project(x + offset.x(), z + offset.y()) - centre).dot(ray.dir);
     const double along = 0.5 * std::abs(smear_px.dot(ray.dir));
     const double across = 0.5 * std::abs(smear_px.x() * ray.dir.y() - smear_px.y() * ray.dir.x());
     const double inward = std::min(0.85 * r, along + r - std::sqrt(std::max(0.0, r * r - across * across)));
@@ -384,7 +421,9 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   for (size_t k = 0; k < rays.size(); ++k) {
     const Ray& ray = rays[k];
     RaySamples samples;
-    samples.offset = ray.offset;
+    const bool rolling = q.row_delay > 0 || q.row_delay_probe > 0;
+    samples.velocity = q.velocity;
+    samples.row_delay = q.row_delay;
     samples.bend = q.bend;
     samples.pieces = pieces;
     const double length = ray.s1 - ray.s0;
@@ -405,6 +444,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
       d.y() *= g.s;
       samples.dirs.push_back(d.normalized());
       samples.along.push_back(2 * t - 1);
+      if (rolling) samples.rows.push_back(p.y() - q.reference_row);
       samples.image.push_back(SampleLinear(bgr, background.table(), p.x() - view.origin.x, p.y() - view.origin.y));
       if (known && background.Known(p.x(), p.y())) samples.back.push_back(background.At(p.x(), p.y()) * gain);
       else known = false;
@@ -425,7 +465,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
           const auto cut = [j](auto& v) {
             if (!v.empty()) v.erase(v.begin(), v.begin() + j + 1);
           };
-          cut(samples.dirs), cut(samples.along), cut(samples.image), cut(samples.back);
+          cut(samples.dirs), cut(samples.along), cut(samples.image), cut(samples.back), cut(samples.rows);
           break;
         }
     }
@@ -491,6 +531,23 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   out.misfit = std::sqrt(sum / out.inliers);
   out.noise = q.noise * std::sqrt(median);
   std::copy(std::begin(params), std::end(params), out.p.begin());
+  if (q.row_delay_probe > 0) {
+    // The rolling shutter's row delay that the inlier rays prefer, the centre and smear held (a
+    // shear about the reference row barely moves them): the vertex of the parabola through their
+    // χ² at three delays. Far from the minimum the χ² is no parabola and the vertex overshoots;
+    // probed again from there it lands (tests/vision_rolling_shutter_test.cpp).
+    double chi2[3] = {0, 0, 0};
+    for (int j = 0; j < 3; ++j) {
+      for (RayCost* cost : costs) cost->SetRowDelay(q.row_delay + (j - 1) * q.row_delay_probe);
+      for (size_t k = 0; k < costs.size(); ++k)
+        if (squares[k] < limit) chi2[j] += costs[k]->ChiSquare(params);
+    }
+    const double curvature = (chi2[0] - 2 * chi2[1] + chi2[2]) / (q.row_delay_probe * q.row_delay_probe);
+    if (curvature > 0) {
+      out.row_delay = q.row_delay - (chi2[2] - chi2[0]) / (2 * q.row_delay_probe * curvature);
+      out.row_delay_sigma = std::sqrt(2 / curvature);  // χ² = Σ r²: its Hessian is 2·JᵀJ
+    }
+  }
   out.ok = true;
   return out;
 }
