@@ -38,11 +38,12 @@
 // ellipse, which perspective shifts.
 //
 // Model only what the scene needs (the fast path): most frames of most clips are a body that
-// differs from its surroundings in luminance, moving less than a quarter of its radius during
+// differs from its surroundings in luminance, moving less than a third of its radius during
 // the exposure. There the outline's edges in linear luminance, fitted with Ceres (internal/edge_fit.hpp,
 // one small solve), measure it as well as the model above at a fraction of the cost, so each
 // frame near the prediction is first tried that way. The model takes over for the frame when
-// the predicted smear is longer than a quarter radius, when a rolling shutter is set, when the
+// the predicted smear is longer than 0.375 radius (half a radius while the exposure is only
+// guessed), when a rolling shutter is set, when the
 // edge fit lands more than 1 px + a tenth of the step from the prediction (the prediction's speed
 // lagged, as just after the release: the blurred edge's ramp may then run off the search window
 // and its truncated centroid lag toward the prediction), or when
