@@ -18,6 +18,7 @@
 #include "internal/body_shading.hpp"
 #include "internal/linear_light.hpp"
 #include "internal/outline_fit.hpp"
+#include "outline_geometry_support.hpp"
 #include "vision/camera.hpp"
 
 namespace uphill::internal {
@@ -30,20 +31,7 @@ constexpr double kRadius = 0.025;  // m; about 37 px at 0.6 m with fx = 900 px
 const Vector3d kAlbedo(0.8, 0.4, 0.2);  // B, G, R
 const Vector3d kLight = Vector3d(0.3, -1.0, 0.6).normalized();  // towards the light, from the camera's side
 
-OutlineGeometry Geometry() {
-  OutlineGeometry g;
-  g.cal.camera.width = 640;
-  g.cal.camera.height = 480;
-  g.cal.camera.fx = g.cal.camera.fy = 900;
-  g.cal.camera.cx = 320, g.cal.camera.cy = 240;
-  g.cal.camera.distortion = {-0.1, 0.0, 0.0, 0.0};
-  g.cal.pose = LookAtPose(Vector3d(0.40, -0.6, 0.15), Vector3d(0.40, 0, 0.10));
-  g.a = kRadius;
-  g.s = 1;
-  g.eye = g.eye_s = CameraCentre(g.cal.pose);
-  g.to_apparatus = g.cal.pose.rotation.transpose();
-  return g;
-}
+OutlineGeometry Geometry() { return TestOutlineGeometry(kRadius); }
 
 using Paint = std::function<Vector3d(const Vector3d& normal, const Vector3d& view)>;
 

@@ -17,6 +17,7 @@
 
 #include "internal/background_model.hpp"
 #include "internal/outline_fit.hpp"
+#include "outline_geometry_support.hpp"
 #include "vision/camera.hpp"
 
 namespace uphill::internal {
@@ -27,22 +28,12 @@ using Eigen::Vector3d;
 
 constexpr double kRadius = 0.0127;     // m: the 1-inch ball of the fast clips
 constexpr double kFps = 30, kExposure = 0.5 / kFps;
-constexpr int kWidth = 640, kHeight = 480;
+constexpr int kWidth = 640, kHeight = 480;  // TestOutlineGeometry's camera
 const Vector3d kCentre(0.40, 0, 0.10);  // m, at the reference row's mid-exposure
 const Vector2d kVelocity(-1.2, -0.3);   // m/s in (x, z): about 40 px per frame
 
 OutlineGeometry Geometry(const cv::Mat* occluder) {
-  OutlineGeometry g;
-  g.cal.camera.width = kWidth;
-  g.cal.camera.height = kHeight;
-  g.cal.camera.fx = g.cal.camera.fy = 900;
-  g.cal.camera.cx = 320, g.cal.camera.cy = 240;
-  g.cal.camera.distortion = {-0.1, 0.0, 0.0, 0.0};
-  g.cal.pose = LookAtPose(Vector3d(0.40, -0.6, 0.15), Vector3d(0.40, 0, 0.10));
-  g.a = kRadius;
-  g.s = 1;
-  g.eye = g.eye_s = CameraCentre(g.cal.pose);
-  g.to_apparatus = g.cal.pose.rotation.transpose();
+  OutlineGeometry g = TestOutlineGeometry(kRadius);
   g.occluder = occluder;
   return g;
 }
