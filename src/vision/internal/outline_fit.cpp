@@ -248,13 +248,15 @@ class RayCost : public ceres::CostFunction {
   double inv_noise_;
 };
 
-double Median(std::vector<double> values) {
+// The upper of the two middle values for an even count (internal::Median of track_series.hpp
+// averages them), which is what the rays' inlier limit is set from.
+double UpperMedian(std::vector<double> values) {
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
   return values[values.size() / 2];
 }
 
 // A ray whose mean square (units of the noise²) is below this is an inlier.
-double InlierLimit(const std::vector<double>& squares) { return kRayLossFactor * std::max(1.0, Median(squares)); }
+double InlierLimit(const std::vector<double>& squares) { return kRayLossFactor * std::max(1.0, UpperMedian(squares)); }
 
 std::vector<double> MeanSquares(const std::vector<RayCost*>& rays, const double* p) {
   std::vector<double> squares(rays.size());
@@ -514,7 +516,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
 
   std::vector<double> squares(costs.size()), contrasts(costs.size());
   for (size_t k = 0; k < costs.size(); ++k) costs[k]->Assess(params, &contrasts[k], &squares[k]);
-  const double median = Median(squares);
+  const double median = UpperMedian(squares);
   const double limit = InlierLimit(squares);
   double sum = 0;
   std::vector<double> inlier_contrasts;
