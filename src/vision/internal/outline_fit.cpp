@@ -175,11 +175,12 @@ class RayCost : public ceres::CostFunction {
   // The residuals at p (appended to r), the shade evaluated afresh from the body's shading.
   void FreshResiduals(const double* p, std::vector<double>* r) const {
     const size_t n = ray_.dirs.size();
+    std::vector<double> c(n);
     std::vector<cv::Vec3d> shade(n);
-    ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { nodes.Coverage(ray_.dirs[i], nullptr, &shade[i]); });
+    ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { c[i] = nodes.Coverage(ray_.dirs[i], nullptr, &shade[i]); });
     const size_t at = r->size();
     r->resize(at + 3 * n);
-    Compute(p, shade, r->data() + at, nullptr, nullptr);
+    Residuals(c, {}, shade, r->data() + at, nullptr, nullptr);
   }
 
   // The sum of squared residuals (units of the noise²) at p.
@@ -226,6 +227,14 @@ class RayCost : public ceres::CostFunction {
     ForEachSample(p, [&](size_t i, const SmearNodes& nodes) {
       c[i] = nodes.Coverage(ray_.dirs[i], grad.empty() ? nullptr : &grad[i]);
     });
+    Residuals(c, grad, shade, residuals, jacobian, solved);
+  }
+
+  // The residuals given the samples' coverages c, and their Jacobian from the coverages'
+  // gradients (when asked for).
+  void Residuals(const std::vector<double>& c, const std::vector<SmearGradient>& grad,
+                 const std::vector<cv::Vec3d>& shade, double* residuals, double* jacobian, RayColours* solved) const {
+    const size_t n = ray_.dirs.size();
     RayColours colours = SolveColours(ray_, c, shade, 1.0 / inv_noise_);
     for (size_t i = 0; i < n; ++i) {
       const cv::Vec3d I = ray_.image[i];
