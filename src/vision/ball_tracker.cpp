@@ -65,7 +65,7 @@ struct BallTracker::Impl {
   cv::Mat occluder;                                 // CV_8U: the near rail's band
   std::unique_ptr<internal::BackgroundModel> background;
   std::unique_ptr<internal::BodyShading> shading;   // learnt from the first frames at rest
-  Eigen::Vector3d shading_turn = Eigen::Vector3d::Zero();  // its light's turn in the last model fit
+  double light_inverse_distance = 0;                // 1/m: its lamp's, in the last model fit
   std::deque<std::pair<long, Sample>> history;      // last found (frame, sample)
   long frame_index = -1;
   double x_lo = 0, x_hi = 0;                        // searchable part of the path
@@ -210,7 +210,7 @@ struct BallTracker::Impl {
     q.velocity = velocity;
     q.rays = options.rays;
     q.noise = noise;
-    q.shading_turn = shading_turn;
+    q.light_inverse_distance = light_inverse_distance;
     q.half_width_px = half_width;
     q.row_delay = row_delay;
     if (ProbesReadout(centre, velocity)) q.row_delay_probe = kReadoutProbe / options.fps / geometry.cal.camera.height;
@@ -247,7 +247,7 @@ struct BallTracker::Impl {
     // outline onto an inner edge than move it. Again from where it went while it moves more
     // than a pixel (the windows follow), then a narrow pass around the result.
     q.fit_edge_shift = false;
-    q.fit_shading_turn = false;
+    q.fit_light = false;
     FitOutcome first;
     for (int pass = 0; pass < 3; ++pass) {
       first = internal::FitOutline(geometry, view, *background, q);
@@ -260,7 +260,7 @@ struct BallTracker::Impl {
       q.half_width_px = std::max(kNarrowHalfWidthPx + 1, 0.5 * q.half_width_px);
     }
     q.smear = Vector2d(first.p[internal::kSmearX], first.p[internal::kSmearZ]);
-    q.fit_shading_turn = true;
+    q.fit_light = true;
     q.half_width_px = kNarrowHalfWidthPx;
     FitOutcome second = internal::FitOutline(geometry, view, *background, q);
     return second.ok ? second : first;
@@ -733,7 +733,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
   auto finish = [&](const FitOutcome& fit, const FitRequest& q, bool acquired) {
     const bool needs_model_before = m.needs_model;
     BallObservation o = m.Observe(fit, q);
-    m.shading_turn = fit.shading_turn;
+    m.light_inverse_distance = fit.light_inverse_distance;
     if (fit.row_delay_sigma > 0) m.MeasuredRowDelay(fit.row_delay);
     m.noises.push_back(std::clamp(fit.noise, 1e-3, 0.2));
     if (m.noises.size() > 15) m.noises.pop_front();

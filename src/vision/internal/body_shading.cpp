@@ -49,6 +49,17 @@ BodyShading BodyShading::Turned(const Eigen::Vector3d& omega) const {
   return turned;
 }
 
+BodyShading BodyShading::LitFrom(const Eigen::Vector3d& centre, double inverse_distance) const {
+  const Eigen::Vector3d light = Eigen::Vector3d::UnitZ();  // overhead
+  const Eigen::Vector3d seen = light - inverse_distance * (centre - learnt_at_);
+  if (seen.norm() < 1e-9) return *this;
+  // The rotation taking the light's direction from where the shading was learnt to where it is
+  // seen from now (the shortest one).
+  const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(light, seen);
+  const Eigen::AngleAxisd turn(q);
+  return Turned(turn.angle() * turn.axis());
+}
+
 cv::Vec3d BodyShading::At(const Eigen::Vector3d& d, const Eigen::Vector3d& v, double a) const {
   const Eigen::Vector3d c = coefficients_.transpose() * BasisAt(d, v, a);
   // A quadratic may dip below zero where the views were darkest; a colour is not negative.
@@ -86,6 +97,7 @@ void BodyShading::Learn(const cv::Mat& bgr, const std::array<float, 256>& table,
   for (int ch = 0; ch < 3; ++ch)
     if (!(mean[ch] > 1e-4)) return;  // a channel the body does not reflect: nothing to learn
   colour_ += mean / kViews;
+  learnt_at_ += Eigen::Vector3d(x, 0, z) / kViews;
   for (auto& [basis, colour] : view) {
     for (int ch = 0; ch < 3; ++ch) colour[ch] /= mean[ch];
     samples_.emplace_back(basis, colour);

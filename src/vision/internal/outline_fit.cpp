@@ -20,12 +20,13 @@ constexpr double kShadowPrior = 0.05;    // σ of the background's factor along 
 constexpr double kRayLossFactor = 1.5;  // Cauchy scale: this many times a good ray's χ²
 // A smear longer than this many radii is fitted with the body's shading (body_shading.hpp).
 constexpr double kShadedSmear = 0.25;
-// The turn of the body's light in a frame (BodyShading::Turned): σ of its prior, rad (the light's
-// direction seen from the body turns by tens of degrees as it crosses the apparatus under a lamp a
-// metre away), the Gauss–Newton steps (the centre held), the step of its numerical derivative.
-constexpr double kTurnPrior = 0.2;
-constexpr int kTurnSteps = 1;
-constexpr double kTurnStep = 0.01;
+// The lamp's inverse distance in a frame (BodyShading::LitFrom): σ of its prior about the previous
+// frame's, 1/m (a lamp a metre or two away; the first frames, where the body has barely moved,
+// leave it at its prior), the Gauss–Newton steps (the centre held), the step of its numerical
+// derivative.
+constexpr double kLightPrior = 0.5;
+constexpr int kLightSteps = 1;
+constexpr double kLightStep = 0.02;
 constexpr double kSharedRows = 0.5;  // a rolling shutter's samples this many rows apart share nodes
 
 struct RaySamples {
@@ -274,33 +275,30 @@ std::vector<double> MeanSquares(const std::vector<RayCost*>& rays, const double*
   return squares;
 }
 
-// The turn of the light (BodyShading::Turned) that best explains the rays at p, the centre held:
-// Gauss–Newton from the prior mean, its Jacobian by forward differences (each column a fresh
-// shade of every sample). *turned (the shading the rays read) is left turned by the result.
-Vector3d FitShadingTurn(const BodyShading& learnt, BodyShading* turned, const std::vector<const RayCost*>& rays,
-                        const double* p, const Vector3d& prior) {
-  const auto residuals = [&](const Vector3d& omega, std::vector<double>* r) {
-    *turned = learnt.Turned(omega);
+// The lamp's inverse distance (BodyShading::LitFrom) that best explains the rays at p, the centre
+// held: Gauss–Newton from the prior mean, its derivative by a forward difference (a fresh shade of
+// every sample). *lit (the shading the rays read) is left lit by the result.
+double FitLightDistance(const BodyShading& learnt, BodyShading* lit, const std::vector<const RayCost*>& rays,
+                        const double* p, double prior) {
+  const Vector3d centre(p[kCentreX], 0, p[kCentreZ]);
+  const auto residuals = [&](double kappa, std::vector<double>* r) {
+    *lit = learnt.LitFrom(centre, kappa);
     r->clear();
     for (const RayCost* ray : rays) ray->FreshResiduals(p, r);
     return Eigen::Map<const Eigen::VectorXd>(r->data(), static_cast<Eigen::Index>(r->size()));
   };
-  Vector3d omega = prior;
+  double kappa = prior;
   std::vector<double> r0, r1;
-  const double inv_prior = 1 / (kTurnPrior * kTurnPrior);
-  for (int step = 0; step < kTurnSteps; ++step) {
-    const Eigen::Map<const Eigen::VectorXd> e0 = residuals(omega, &r0);
-    Eigen::MatrixXd jacobian(e0.size(), 3);
-    for (int axis = 0; axis < 3; ++axis)
-      jacobian.col(axis) = (residuals(omega + kTurnStep * Vector3d::Unit(axis), &r1) - e0) / kTurnStep;
-    const Eigen::Matrix3d a = jacobian.transpose() * jacobian + inv_prior * Eigen::Matrix3d::Identity();
-    const Vector3d b = jacobian.transpose() * e0 + inv_prior * (omega - prior);
-    const Vector3d next = omega - a.ldlt().solve(b);
-    if (!next.allFinite()) break;
-    omega = next;
+  const double inv_prior = 1 / (kLightPrior * kLightPrior);
+  for (int step = 0; step < kLightSteps; ++step) {
+    const Eigen::Map<const Eigen::VectorXd> e0 = residuals(kappa, &r0);
+    const Eigen::VectorXd slope = (residuals(kappa + kLightStep, &r1) - e0) / kLightStep;
+    const double next = kappa - (slope.dot(e0) + inv_prior * (kappa - prior)) / (slope.squaredNorm() + inv_prior);
+    if (!std::isfinite(next)) break;
+    kappa = next;
   }
-  *turned = learnt.Turned(omega);
-  return omega;
+  *lit = learnt.LitFrom(centre, kappa);
+  return kappa;
 }
 
 // The priors: b ~ N(0, 0.3 px), D ~ N(D_pred, σ_D).
@@ -358,7 +356,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   const double right = std::min(g.cal.camera.width - 2.0, view.origin.x + bgr.cols - 2.0);
   const double bottom = std::min(g.cal.camera.height - 2.0, view.origin.y + bgr.rows - 2.0);
   FitOutcome out;
-  out.shading_turn = q.shading_turn;
+  out.light_inverse_distance = q.light_inverse_distance;
   const double x = q.centre.x(), z = q.centre.y();
   if (!InFront(g, x, z)) return out;
   const int n = q.rays;
@@ -380,8 +378,8 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   body.sigma_px = g.sigma_px;
   // The body's shading, where it is known and the smear is long enough for it to matter.
   const bool shaded = g.shading && g.shading->ready() && smear_px.norm() > kShadedSmear * radius_px;
-  BodyShading turned = shaded ? g.shading->Turned(q.shading_turn) : BodyShading(1.0);
-  if (shaded) body.shading = &turned;
+  BodyShading lit = shaded ? g.shading->LitFrom(Vector3d(x, 0, z), q.light_inverse_distance) : BodyShading(1.0);
+  if (shaded) body.shading = &lit;
 
   // Rays: windows and their three undistorted anchors (start, middle, end).
   struct Ray {
@@ -509,13 +507,13 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   ceres::Solve(solver, &problem, &summary);
   // The shading learnt where the body rested, turned to this frame's light, then the centre
   // solved again with it.
-  if (shaded && q.fit_shading_turn && std::isfinite(params[kCentreX]) && std::isfinite(params[kCentreZ])) {
+  if (shaded && q.fit_light && std::isfinite(params[kCentreX]) && std::isfinite(params[kCentreZ])) {
     const std::vector<double> squares = MeanSquares(costs, params);
     const double limit = InlierLimit(squares);
     std::vector<const RayCost*> inliers;
     for (size_t k = 0; k < costs.size(); ++k)
       if (squares[k] < limit) inliers.push_back(costs[k]);
-    out.shading_turn = FitShadingTurn(*g.shading, &turned, inliers, params, q.shading_turn);
+    out.light_inverse_distance = FitLightDistance(*g.shading, &lit, inliers, params, q.light_inverse_distance);
     for (RayCost* cost : costs) cost->Shade(params);
     ceres::Solve(solver, &problem, &summary);
   }

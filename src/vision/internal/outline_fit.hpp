@@ -15,12 +15,12 @@
 // which drops ∂F/∂c). On a smear longer than a quarter radius, once the body's shading is learnt
 // (body_shading.hpp), the body's term is c_i·S_i·F_k instead: S_i its mean relative colour over
 // the part of it that passed over the sample, evaluated at the fit's start and held through the
-// solve. The shading is read turned by the light's turn ω (BodyShading::Turned: a lamp a metre
-// away is seen from the body in another direction once it has crossed the apparatus; on the
-// ray-traced fast clips the centre otherwise lags by up to 1 px on the longest smears): after the
-// solve, ω is fitted to the inlier rays with the centre held (one Gauss–Newton step from the
-// request's ω, prior σ 0.2 rad), and the centre solved once more with S_i from there. So the channel
-// in which the fit sees the edge is, ray by ray, the colour
+// solve. The shading is read as lit by a lamp at a finite distance (BodyShading::LitFrom: a lamp
+// a metre away is seen from the body in another direction once it has crossed the apparatus; on
+// the ray-traced fast clips the centre otherwise lags by up to 1 px on the longest smears): after
+// the solve, the lamp's inverse distance κ is fitted to the inlier rays with the centre held (one
+// Gauss–Newton step from the request's κ, prior σ 0.5 /m), and the centre solved once more with
+// S_i from there. So the channel in which the fit sees the edge is, ray by ray, the colour
 // difference between the body's limb and what lies behind it: a body as grey as the table but of
 // another hue, or a table with grain, costs nothing. Where the background is not yet known at
 // every sample of a ray (the body rested there since the first frame) the ray's background is a
@@ -75,8 +75,8 @@ struct FitRequest {
   int rays = 64;
   double noise = 0.01;                  // expected RMS of a sample's residual, linear units
   bool fit_edge_shift = true;           // false: b held at 0 (a first pass far from the edges)
-  Eigen::Vector3d shading_turn = Eigen::Vector3d::Zero();  // the light's turn, prior mean (BodyShading::Turned)
-  bool fit_shading_turn = true;         // false: the turn held at its prior mean (a first pass)
+  double light_inverse_distance = 0;    // 1/m: the lamp's, prior mean (BodyShading::LitFrom)
+  bool fit_light = true;                // false: held at its prior mean (a first pass)
 };
 
 // The picture a fit reads: a whole frame (origin 0, 0) or a window of one kept for a later refit,
@@ -95,7 +95,7 @@ struct FitOutcome {
   double misfit = 0;    // RMS of the inlier rays' residuals in units of `noise`
   double contrast = 0;  // median |F − B| of the inliers, linear units
   double noise = 0;     // RMS residual of the inlier rays, linear units (for the next frame)
-  Eigen::Vector3d shading_turn = Eigen::Vector3d::Zero();  // fitted on a shaded smear, else the prior's
+  double light_inverse_distance = 0;  // 1/m: fitted on a shaded smear, else the prior's
   // With FitRequest::row_delay_probe: the row delay the inlier rays prefer (s per row), the fit's
   // centre and smear held, and its standard error; row_delay_sigma 0: not estimated.
   double row_delay = 0, row_delay_sigma = 0;
