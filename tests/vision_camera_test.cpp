@@ -143,6 +143,28 @@ TEST(CameraModel, LookAtPoseLooksAtTheTargetWithUpUpward) {
   EXPECT_NE(InputErrorOf([] { LookAtPose({0, 0, 1}, {0, 0, 1}); }).find("differ"), std::string::npos);
 }
 
+// Truth: the closed form. With k1 < 0 alone the radial mapping r + k1·r³ stops growing where its
+// derivative 1 + 3·k1·r² vanishes, r = sqrt(−1/(3·k1)); beyond, a point projects back toward the
+// centre of the picture (the fold the tracker must not draw a rail through).
+TEST(CameraModel, LensModelReachIsWhereTheRadialMappingStopsGrowing) {
+  EXPECT_TRUE(std::isinf(LensModelReach(Camera1280({}))));
+  EXPECT_TRUE(std::isinf(LensModelReach(Camera1280({-0.12, 0.06, 0, 0, 0}))));  // 1 − 0.36r² + 0.3r⁴ > 0
+  const CameraIntrinsics barrel = Camera1280({-0.12, 0, 0, 0, 0});
+  const double reach = LensModelReach(barrel);
+  EXPECT_NEAR(reach, std::sqrt(1 / 0.36), 1e-3);  // 1.667, the step of the search
+  // The ray-traced footage's lens (k3 < 0) folds too: a point at 1.3× the reach lands nearer the
+  // centre than one at the reach.
+  const CameraIntrinsics footage{1920, 1080, 1728, 1728, 971.02, 531.82, {-0.12, 0.06, 0.0007, -0.0004, -0.015}};
+  const double folds = LensModelReach(footage);
+  ASSERT_TRUE(std::isfinite(folds));
+  const Eigen::Vector2d centre(footage.cx, footage.cy);
+  const double at_reach = (ProjectCameraPoint(footage, {folds, 0, 1}) - centre).norm();
+  const double beyond = (ProjectCameraPoint(footage, {1.3 * folds, 0, 1}) - centre).norm();
+  EXPECT_LT(beyond, at_reach);
+  std::printf("  reach: barrel %.3f, the footage's lens %.3f (%.0f px from the centre at most)\n", reach, folds,
+              at_reach);
+}
+
 TEST(CameraModel, PointsBehindTheCameraAreRefused) {
   const CameraIntrinsics c = Camera1280({});
   EXPECT_NE(InputErrorOf([&] { ProjectCameraPoint(c, {0, 0, -1}); }).find("in front of the camera"),

@@ -69,6 +69,7 @@ struct BallTracker::Impl {
   std::deque<std::pair<long, Sample>> history;      // last found (frame, sample)
   long frame_index = -1;
   double x_lo = 0, x_hi = 0;                        // searchable part of the path
+  double lens_reach = 0;                            // LensModelReach of the camera
   double noise = 0.01;                              // residual RMS of a sample, linear units
   std::deque<double> noises;                        // of the last accepted frames
   double row_delay = 0;                             // s per row
@@ -280,6 +281,9 @@ struct BallTracker::Impl {
     return Measure(view, wide);
   }
 
+  // Whether the lens model maps the camera-frame point where it is (LensModelReach).
+  bool WithinLens(const Vector3d& pc) const { return pc.z() > 0 && pc.head<2>().norm() < lens_reach * pc.z(); }
+
   // Candidates along the path between x0 and x1, best first: the predicted outline's inside
   // against its outside (against the background where it is known).
   std::vector<Vector2d> Candidates(const cv::Mat& frame, double gain, double x0, double x1) const {
@@ -296,6 +300,7 @@ struct BallTracker::Impl {
     for (int i = 0; i < count; ++i) {
       const double xc = x0 + (x1 - x0) * (i + 0.5) / count;
       const double zc = scene.At(xc).z;
+      if (!WithinLens(geometry.cal.pose.rotation * Vector3d(xc, 0, zc) + geometry.cal.pose.translation)) continue;
       std::vector<Vector3d> pts = geometry.OutlinePoints(xc, zc, n);
       pts.emplace_back(xc, 0, zc);
       const std::vector<Vector2d> image = ProjectApparatusPoints(geometry.cal.camera, geometry.cal.pose, pts);
@@ -625,10 +630,15 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
   std::vector<cv::Point> polyline;
   double max_halfwidth = 0;
   const double x_end = 1.5 * scene.x_max() + 0.2;
+  // Only where the lens model holds: beyond its reach a rail point far outside the picture would
+  // be drawn inside it (a k3 < 0 lens folds back; a band across the picture hid most of the
+  // body's outline on the ray-traced fast clips' true camera, and the ball was lost).
+  m.lens_reach = LensModelReach(calibration.camera);
+  const auto within_lens = [&](const Vector3d& pc) { return m.WithinLens(pc); };
   for (int i = 0; i <= 400; ++i) {
     const Vector3d p = axis * (x_end * i / 400.0);
     const Vector3d pc = calibration.pose.rotation * p + calibration.pose.translation;
-    if (pc.z() <= 0.05) continue;
+    if (pc.z() <= 0.05 || !within_lens(pc)) continue;
     const Vector2d q = ProjectCameraPoint(calibration.camera, pc);
     if (std::abs(q.x()) > 1e5 || std::abs(q.y()) > 1e5) continue;
     polyline.emplace_back(static_cast<int>(std::lround(q.x() * 16)), static_cast<int>(std::lround(q.y() * 16)));
@@ -653,7 +663,7 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
     const double x = m.x_lo + (m.x_hi - m.x_lo) * i / steps;
     const double z = scene.At(x).z;
     const Vector3d cam = calibration.pose.rotation * Vector3d(x, 0, z) + calibration.pose.translation;
-    if (cam.z() <= 2 * g.a) continue;
+    if (cam.z() <= 2 * g.a || !within_lens(cam)) continue;
     const Vector2d q = g.Project(x, z);
     if (std::abs(q.x()) > 4 * width || std::abs(q.y()) > 4 * height) continue;
     const double r = m.RadiusPx(x, z) * std::max(1.0, 1.0 / g.s);

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -209,6 +210,23 @@ void ValidateIntrinsics(const CameraIntrinsics& c, const std::string& context) {
                          std::to_string(n));
   for (double d : c.distortion)
     if (!std::isfinite(d)) throw InputError(context + ".distortion", "coefficients must be finite");
+}
+
+double LensModelReach(const CameraIntrinsics& camera) {
+  const std::vector<double>& d = camera.distortion;
+  const auto k = [&](std::size_t i) { return i < d.size() ? d[i] : 0.0; };
+  const auto mapped = [&](double r) {
+    const double r2 = r * r, r4 = r2 * r2, r6 = r4 * r2;
+    return r * (1 + k(0) * r2 + k(1) * r4 + k(4) * r6) / (1 + k(5) * r2 + k(6) * r4 + k(7) * r6);
+  };
+  constexpr double kStep = 1e-3, kLimit = 5;
+  double previous = 0;
+  for (double r = kStep; r <= kLimit; r += kStep) {
+    const double m = mapped(r);
+    if (!(m > previous)) return r - kStep;
+    previous = m;
+  }
+  return std::numeric_limits<double>::infinity();
 }
 
 Eigen::Vector2d ProjectCameraPoint(const CameraIntrinsics& camera, const Eigen::Vector3d& point) {

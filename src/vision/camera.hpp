@@ -48,6 +48,13 @@ Eigen::Vector2d ProjectApparatusPoint(const CameraIntrinsics& camera, const Came
 // the direction of its viewing ray is (x, y, 1).
 Eigen::Vector2d UndistortPixel(const CameraIntrinsics& camera, const Eigen::Vector2d& raw);
 
+// How far from the optical axis the lens model holds: the normalised radius r = |(x, y)|/z up to
+// which its radial mapping r·(1 + k1·r² + k2·r⁴ + k3·r⁶)/(1 + k4·r² + k5·r⁴ + k6·r⁶) still grows
+// with r (infinity where it always does; searched to r = 5, 79°, in steps of 1e-3). Beyond it the
+// polynomial folds back: a point far outside the picture "projects" inside it, so whoever projects
+// points that may lie outside the view (a rail's whole length) keeps to r below this.
+double LensModelReach(const CameraIntrinsics& camera);
+
 // The camera's centre in the apparatus frame (metres): −rotationᵀ·translation.
 Eigen::Vector3d CameraCentre(const CameraPose& pose);
 
