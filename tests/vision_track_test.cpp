@@ -152,6 +152,30 @@ TEST_F(DefaultView, BlurNoiseFlickerAndH264WithinThreeTenthsOfAPixel) {
   ExpectAccurate(RenderAndTrack(*renderer_, setup_->scene, motion, s, "noisy.mp4").errors, 27, 0.3);
 }
 
+// With a rolling shutter each row's time is the frame's plus the centre row's delay, also on the
+// frames whose time the container does not give (FFmpeg gives none for the last frames of an
+// H.264 stream with B-frames: they are extrapolated from the frame before). Truth: the frame
+// rate and the readout given, t = frame/fps + v·readout/height.
+TEST_F(DefaultView, RowTimesOfARollingShutterHoldOnFramesWithoutTimestamps) {
+  ClipSettings s;
+  s.frames = 12;
+  s.release_time = -0.9;
+  s.noise_sigma = 2;
+  const Motion motion(setup_->scene, setup_->x0);
+  TrackVideoOptions options;
+  options.tracker.readout = 0.02;
+  const ClipRun run = RenderAndTrack(*renderer_, setup_->scene, motion, s, "rows.mp4", options);
+  EXPECT_GT(run.track.extrapolated_times, 0) << "the case needs frames without timestamps";
+  int checked = 0;
+  for (const TrackRow& r : run.track.rows) {
+    if (!r.ball.found) continue;
+    EXPECT_NEAR(r.ball.time_offset, r.ball.v * 0.02 / 720, 1e-4) << "frame " << r.frame;
+    EXPECT_NEAR(r.t, r.frame / 30.0 + r.ball.time_offset, 1e-3) << "frame " << r.frame;
+    ++checked;
+  }
+  EXPECT_EQ(checked, s.frames);
+}
+
 TEST_F(DefaultView, InitialGuessAndLostBallKeepTheirRows) {
   // Released beyond X: it rolls up the rails and drops between them; the last frames have no ball.
   const double x_eq = *setup_->scene.x_eq(), x_max = setup_->scene.x_max();

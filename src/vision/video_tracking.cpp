@@ -158,6 +158,7 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
   }
 
   const double period = result.fps > 0 ? 1.0 / result.fps : 1.0 / 30.0;
+  double last_frame_time = 0;  // the container's (or extrapolated) time of the previous frame
   cv::Mat frame;
   bool read_error = false;
   while (true) {
@@ -171,10 +172,14 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
     TrackRow row;
     row.frame = static_cast<int>(result.rows.size());
     double t = capture.get(cv::CAP_PROP_POS_MSEC) * 1e-3;
-    if (!result.rows.empty() && !(t > result.rows.back().t)) {
-      t = result.rows.back().t + period;
+    // A container gives no time for some frames (FFmpeg: the last frames of an H.264 stream with
+    // B-frames): one period after the previous frame's, not after its row time (a rolling
+    // shutter's row delay is added below, once).
+    if (!result.rows.empty() && !(t > last_frame_time)) {
+      t = last_frame_time + period;
       ++result.extrapolated_times;
     }
+    last_frame_time = t;
     row.t = t;
     const double cpu0 = ThreadCpuSeconds();
     row.ball = tracker.Track(frame);

@@ -5,7 +5,8 @@
 // Time: the container's timestamp of each frame (CAP_PROP_POS_MSEC), which keeps dropped or
 // variable-rate frames honest. OpenCV reports 0 for the last frames that FFmpeg drains from its
 // decoder at the end of some files; a timestamp that does not increase is replaced by the
-// previous one + 1/fps (and counted in TrackResult::extrapolated_times).
+// previous frame's timestamp + 1/fps (the frame's, not its row time under a rolling shutter;
+// counted in TrackResult::extrapolated_times).
 //
 // Time: see ball_tracker.hpp: each row's t is the frame's timestamp plus the rolling shutter's
 // delay of the row where the centre lies (0 for a global shutter): the centre's mid-exposure.
