@@ -130,7 +130,7 @@ TEST(BodyShading, TurnedShadingIsTheBallUnderTheTurnedLight) {
 }
 
 // A lamp overhead, 1 m above where the ball rested: the shading lit from there (LitFrom, the lamp's
-// inverse distance 1/m) is the ball lit by that lamp from its new place, 30 cm along the rails.
+// inverse distance 1/m) is the ball lit by that lamp from its new place, 12 cm along the rails.
 // Truth: the irradiance of a hemispherical (sky-like) light, in closed form (1 + n·ℓ)/2 with ℓ
 // the direction to the lamp from the ball's centre, plus ambient.
 TEST(BodyShading, LitFromTheLampOverheadIsTheBallUnderThatLamp) {

@@ -41,7 +41,7 @@
 // does not model (the highlight, reflections), and pushed the centre of the 3-radius smears 0.17
 // px across the path on average (RMS 0.33 px); with the overhead lamp, 0.09 px (RMS 0.26 px), the
 // lamp fitted at 0.6–0.7 m (truly 0.8 m above the ball, and the fill light's turn is folded in).
-
+//
 // Values are relative: each view divided by its mean over the disc, channel by channel, so that
 // the body's colour F of each ray of the smear model scales them (gain, flicker, the ray's own
 // light).

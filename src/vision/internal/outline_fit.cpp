@@ -505,8 +505,8 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   solver.parameter_tolerance = 1e-7;
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
-  // The shading learnt where the body rested, turned to this frame's light, then the centre
-  // solved again with it.
+  // The shading learnt where the body rested, lit from where this frame sees the lamp, then the
+  // centre solved again with it.
   if (shaded && q.fit_light && std::isfinite(params[kCentreX]) && std::isfinite(params[kCentreZ])) {
     const std::vector<double> squares = MeanSquares(costs, params);
     const double limit = InlierLimit(squares);
