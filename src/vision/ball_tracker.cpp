@@ -634,11 +634,10 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
   // be drawn inside it (a k3 < 0 lens folds back; a band across the picture hid most of the
   // body's outline on the ray-traced fast clips' true camera, and the ball was lost).
   m.lens_reach = LensModelReach(calibration.camera);
-  const auto within_lens = [&](const Vector3d& pc) { return m.WithinLens(pc); };
   for (int i = 0; i <= 400; ++i) {
     const Vector3d p = axis * (x_end * i / 400.0);
     const Vector3d pc = calibration.pose.rotation * p + calibration.pose.translation;
-    if (pc.z() <= 0.05 || !within_lens(pc)) continue;
+    if (pc.z() <= 0.05 || !m.WithinLens(pc)) continue;
     const Vector2d q = ProjectCameraPoint(calibration.camera, pc);
     if (std::abs(q.x()) > 1e5 || std::abs(q.y()) > 1e5) continue;
     polyline.emplace_back(static_cast<int>(std::lround(q.x() * 16)), static_cast<int>(std::lround(q.y() * 16)));
@@ -663,7 +662,7 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
     const double x = m.x_lo + (m.x_hi - m.x_lo) * i / steps;
     const double z = scene.At(x).z;
     const Vector3d cam = calibration.pose.rotation * Vector3d(x, 0, z) + calibration.pose.translation;
-    if (cam.z() <= 2 * g.a || !within_lens(cam)) continue;
+    if (cam.z() <= 2 * g.a || !m.WithinLens(cam)) continue;
     const Vector2d q = g.Project(x, z);
     if (std::abs(q.x()) > 4 * width || std::abs(q.y()) > 4 * height) continue;
     const double r = m.RadiusPx(x, z) * std::max(1.0, 1.0 / g.s);

@@ -53,13 +53,22 @@ bool HasPlainLensModel(const CameraIntrinsics& c) {
   return n == 0 || n == 4 || n == 5 || n == 8;
 }
 
+// Distortion coefficient i in OpenCV's order (0 where the camera has fewer).
+double Coefficient(const CameraIntrinsics& c, std::size_t i) { return i < c.distortion.size() ? c.distortion[i] : 0.0; }
+
+// The radial factor (1 + k1·r² + k2·r⁴ + k3·r⁶)/(1 + k4·r² + k5·r⁴ + k6·r⁶) at r² = r2.
+double RadialFactor(const CameraIntrinsics& c, double r2) {
+  const auto k = [&](std::size_t i) { return Coefficient(c, i); };
+  const double r4 = r2 * r2, r6 = r4 * r2;
+  return (1 + k(0) * r2 + k(1) * r4 + k(4) * r6) / (1 + k(5) * r2 + k(6) * r4 + k(7) * r6);
+}
+
 Eigen::Vector2d ProjectWithPlainLensModel(const CameraIntrinsics& c, const Eigen::Vector3d& p) {
   const double x = p.x() / p.z(), y = p.y() / p.z();
   if (c.distortion.empty()) return {c.fx * x + c.cx, c.fy * y + c.cy};
-  const std::vector<double>& d = c.distortion;
-  const auto k = [&](std::size_t i) { return i < d.size() ? d[i] : 0.0; };
-  const double r2 = x * x + y * y, r4 = r2 * r2, r6 = r4 * r2;
-  const double radial = (1 + k(0) * r2 + k(1) * r4 + k(4) * r6) / (1 + k(5) * r2 + k(6) * r4 + k(7) * r6);
+  const auto k = [&](std::size_t i) { return Coefficient(c, i); };
+  const double r2 = x * x + y * y;
+  const double radial = RadialFactor(c, r2);
   const double xd = x * radial + 2 * k(2) * x * y + k(3) * (r2 + 2 * x * x);
   const double yd = y * radial + k(2) * (r2 + 2 * y * y) + 2 * k(3) * x * y;
   return {c.fx * xd + c.cx, c.fy * yd + c.cy};
@@ -213,16 +222,10 @@ void ValidateIntrinsics(const CameraIntrinsics& c, const std::string& context) {
 }
 
 double LensModelReach(const CameraIntrinsics& camera) {
-  const std::vector<double>& d = camera.distortion;
-  const auto k = [&](std::size_t i) { return i < d.size() ? d[i] : 0.0; };
-  const auto mapped = [&](double r) {
-    const double r2 = r * r, r4 = r2 * r2, r6 = r4 * r2;
-    return r * (1 + k(0) * r2 + k(1) * r4 + k(4) * r6) / (1 + k(5) * r2 + k(6) * r4 + k(7) * r6);
-  };
   constexpr double kStep = 1e-3, kLimit = 5;
   double previous = 0;
   for (double r = kStep; r <= kLimit; r += kStep) {
-    const double m = mapped(r);
+    const double m = r * RadialFactor(camera, r * r);
     if (!(m > previous)) return r - kStep;
     previous = m;
   }
