@@ -3,7 +3,9 @@
 // lost frames; the analysis must recover what made them, within its stated uncertainties.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -35,6 +37,7 @@ struct Recording {
   double fps = 120, duration = 1.0;
   std::set<int> lost;        // frames without the ball
   unsigned seed = 1;
+  double noise = kNoise;     // m, of x and z
 };
 
 Recording Released(double x0, double t0) {
@@ -49,7 +52,7 @@ Recording Released(double x0, double t0) {
 Track Record(const Scene& scene, const Recording& r) {
   const Motion motion(scene, r.x0, r.motion);
   std::mt19937_64 random(r.seed);
-  std::normal_distribution<double> noise(0.0, kNoise);
+  std::normal_distribution<double> noise(0.0, r.noise);
   Track track;
   track.source = "simulated.csv";
   const int frames = static_cast<int>(r.duration * r.fps);
@@ -433,6 +436,46 @@ TEST(TrackAnalysis, UncertaintyOfMuCoversACorrelatedTrackerBias) {
   }
 }
 
+// ---- A rolling shutter's measured readout -------------------------------------------------------
+
+// A readout measured 6 ms short (19 ms of a true 25 ms, ± 3 ms, over 1080 rows): every time is
+// early by v·6 ms/1080, 1.5 ms at the ball's row (v ≈ 270; t0 takes 1.1 ms of it, g the rest).
+// With the readout's uncertainty carried (Track::row_delay_u, from the sidecar) t0 lies 2 u off,
+// as the readout does; without it t0 misses by 8 u. Truth: the Motion that made the track.
+TEST(TrackAnalysis, AMeasuredReadoutsUncertaintyCoversTheTimesItShifts) {
+  const Scene scene = Ball();
+  Recording r = Released(8e-3, 2.4);
+  r.noise = 0.01e-3;
+  Track track = Record(scene, r);
+  constexpr double kRows = 1080, kTrue = 0.025, kMeasured = 0.019, kU = 0.003;
+  for (TrackFrame& f : track.frames)
+    if (f.found) f.t += f.v * (kMeasured - kTrue) / kRows;
+  TrackAnalysisOptions o;
+  o.u_x = 0.01e-3;
+  o.tracker_floor_px = 0.01;  // a tracker far better than the readout: the timing part dominates
+  o.tracker_blur = 0;
+  const TrackAnalysis without = AnalyseTrack(track, scene, o);
+  track.row_delay_u = kU / kRows;
+  const TrackAnalysis with = AnalyseTrack(track, scene, o);
+  ASSERT_TRUE(without.fit.available && with.fit.available);
+  const FittedParameter& t0 = with.fit.parameters[1];
+  const double pull = (t0.value - r.t0) / *t0.u;
+  std::printf("t0 %+.3f ms from the truth: u %.3f ms (systematic %.3f), pull %+.2f; without the readout's u: %+.1f\n",
+              1e3 * (t0.value - r.t0), 1e3 * *t0.u, 1e3 * *t0.se_systematic, pull,
+              (without.fit.parameters[1].value - r.t0) / *without.fit.parameters[1].u);
+  // The times' error is the readout's, −2 of its standard uncertainties, and so is t0's (measured
+  // −1.96: the tracker's small part adds to u).
+  EXPECT_NEAR(pull, (kMeasured - kTrue) / kU, 0.15);
+  EXPECT_GT(std::abs((without.fit.parameters[1].value - r.t0) / *without.fit.parameters[1].u), 5.0);
+  for (int j : {0, 2}) {
+    const FittedParameter& p = with.fit.parameters[j];
+    EXPECT_LT(std::abs(p.value - (j == 0 ? r.x0 : 9.80665)), 3 * *p.u) << p.name;
+  }
+  EXPECT_NE(std::find_if(with.fit.notes.begin(), with.fit.notes.end(),
+                         [](const std::string& n) { return n.find("measured readout") != std::string::npos; }),
+            with.fit.notes.end());
+}
+
 // ---- The CSV reader ----------------------------------------------------------------------------
 
 Track Parse(const std::string& text) {
@@ -481,6 +524,36 @@ TEST(TrackTable, BadRowsNameFileRowAndColumn) {
   EXPECT_NE(ErrorOf(h + "0,0,1,1,-2,1,1,1\n").find("row 2, column radius_px: must be > 0"), std::string::npos);
   EXPECT_NE(ErrorOf(h + "0,0,1,1,30,1,1\n").find("row 2"), std::string::npos);  // a field short
   EXPECT_NE(ErrorOf(h + "0,nan,1,1,30,1,1,1\n").find("row 2, column t"), std::string::npos);
+}
+
+// The sidecar beside the CSV (as `uphill track` writes it): a measured readout's uncertainty is
+// read as a row delay's; a sidecar that is not JSON, or whose fields are out of range, is named.
+TEST(TrackTable, ReadsTheReadoutsUncertaintyFromTheSidecar) {
+  const auto dir = std::filesystem::temp_directory_path() / ("uphill_track_sidecar_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string csv = (dir / "track.csv").string();
+  std::ofstream(csv) << "frame,t,u,v,radius_px,x,z,quality\n0,0.5,100,200,30,12.5,-3,0.95\n";
+  EXPECT_EQ(ReadTrackFile(csv).row_delay_u, 0.0);  // no sidecar
+  auto side = [&](const std::string& text) { std::ofstream(csv + ".json") << text; };
+  side(R"({"readout_s": 0.018, "readout_u_s": 0.0027, "image_height_px": 1080})");
+  EXPECT_DOUBLE_EQ(ReadTrackFile(csv).row_delay_u, 0.0027 / 1080);
+  side(R"({"readout_s": 0.025})");  // a readout given: no uncertainty stated
+  EXPECT_EQ(ReadTrackFile(csv).row_delay_u, 0.0);
+  auto error = [&] {
+    try {
+      ReadTrackFile(csv);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  side("{\"readout_u_s\": 0.0027,");
+  EXPECT_NE(error().find("track.csv.json: is not a JSON object"), std::string::npos) << error();
+  side(R"({"readout_u_s": -1, "image_height_px": 1080})");
+  EXPECT_NE(error().find("track.csv.json, readout_u_s: must be a number >= 0"), std::string::npos) << error();
+  side(R"({"readout_u_s": 0.0027})");
+  EXPECT_NE(error().find("track.csv.json, image_height_px: must be an integer > 0"), std::string::npos) << error();
+  std::filesystem::remove_all(dir);
 }
 
 // ---- The command line -------------------------------------------------------------------------

@@ -17,6 +17,7 @@
 
 #include "internal/background_model.hpp"
 #include "internal/outline_fit.hpp"
+#include "internal/row_delay_settle.hpp"
 #include "outline_geometry_support.hpp"
 #include "vision/camera.hpp"
 
@@ -140,6 +141,70 @@ TEST(RollingShutter, LongReadoutIsFoundInTwoProbes) {
 TEST(RollingShutter, GlobalShutterIsMeasuredAsOne) {
   const ShearedClip clip(0);
   EXPECT_NEAR(ProbedReadout(clip, 0), 0, 0.001);
+}
+
+// ---- Settling a clip's row delay (row_delay_settle.hpp) ----------------------------------------
+
+constexpr double kMost = 1.0 / kFps / kHeight;  // s per row: a readout of the whole frame time
+
+// Frames whose fits move from q toward the truth by a share 1 − s only, est(q) = c + s·q (each
+// frame's scatter about it ± spread): the settled delay is the fixed point c/(1 − s) exactly, its
+// uncertainty the mean's standard error over 1 − s, and the slope s. Truth: the closed form.
+TEST(RowDelaySettle, LinearEstimatesSettleOnTheirFixedPoint) {
+  const double truth = 0.6 * kMost, spread = 0.05 * kMost;
+  const double offsets[5] = {-2, -1, 0, 1, 2};  // × spread: mean 0, sample SD sqrt(2.5)
+  for (const double slope : {0.0, 0.47, 0.75}) {
+    int rounds = 0;
+    auto fit_at = [&](double q) {
+      ++rounds;
+      std::vector<double> estimates, sigmas;
+      for (double o : offsets) {
+        estimates.push_back(truth * (1 - slope) + slope * q + o * spread);
+        sigmas.push_back(0.01 * kMost);  // formal errors far below the scatter
+      }
+      return PreferredDelay(q, estimates, sigmas, 5);
+    };
+    const std::optional<SettledDelay> settled = SettleRowDelay(0, kMost, fit_at);
+    ASSERT_TRUE(settled.has_value());
+    EXPECT_EQ(rounds, 3);
+    EXPECT_NEAR(settled->slope, slope, 1e-12);
+    EXPECT_NEAR(settled->delay, truth, 1e-12 * kMost) << slope;
+    EXPECT_NEAR(settled->u, std::sqrt(2.5 / 5) * spread / (1 - slope), 1e-12 * kMost) << slope;
+  }
+}
+
+// The standard error is the formal one where the frames agree within it, the scatter's where they
+// do not; too few frames settle nothing.
+TEST(RowDelaySettle, StandardErrorIsTheLargerOfFormalAndScatter) {
+  const std::optional<DelayRound> tight = PreferredDelay(0, {1.0, 1.0, 1.0, 1.0}, {2.0, 2.0, 2.0, 2.0}, 2);
+  ASSERT_TRUE(tight.has_value());
+  EXPECT_DOUBLE_EQ(tight->mean, 1.0);
+  EXPECT_DOUBLE_EQ(tight->se, 1.0);  // 2/sqrt(4)
+  // Weights 4:1: mean (4·1 + 1·6)/5 = 2; scatter Σw(e − m)²/((n − 1)Σw) = (4·1 + 1·16)/(1·5) = 4.
+  const std::optional<DelayRound> wide = PreferredDelay(0, {1.0, 6.0}, {0.5, 1.0}, 2);
+  ASSERT_TRUE(wide.has_value());
+  EXPECT_DOUBLE_EQ(wide->mean, 2.0);
+  EXPECT_DOUBLE_EQ(wide->se, 2.0);
+  EXPECT_FALSE(PreferredDelay(0, {1.0, 2.0}, {1.0, 1.0}, 5).has_value());
+  EXPECT_FALSE(SettleRowDelay(0, kMost, [](double) { return std::optional<DelayRound>(); }).has_value());
+}
+
+// On the brute-force picture of a phone's 25 ms readout, settled from a global shutter through the
+// fits themselves: the truth within 5 % (the flat ball's fit absorbs little of the shear: s ≈ 0).
+TEST(RowDelaySettle, PhoneReadoutSettlesOnTheTruth) {
+  constexpr double kReadout = 0.025;
+  const ShearedClip clip(kReadout);
+  auto fit_at = [&](double q) -> std::optional<DelayRound> {
+    const FitOutcome f = clip.Fit(q);
+    if (!f.ok || !(f.row_delay_sigma > 0)) return std::nullopt;
+    return PreferredDelay(q, {f.row_delay, f.row_delay}, {f.row_delay_sigma, f.row_delay_sigma}, 2);
+  };
+  const std::optional<SettledDelay> settled = SettleRowDelay(0, kMost, fit_at);
+  ASSERT_TRUE(settled.has_value());
+  std::printf("  settled %.2f ms ± %.2f (slope %.2f)\n", 1e3 * settled->delay * kHeight, 1e3 * settled->u * kHeight,
+              settled->slope);
+  EXPECT_NEAR(settled->delay * kHeight, kReadout, 0.05 * kReadout);
+  EXPECT_LT(settled->u * kHeight, 0.2 * kReadout);
 }
 
 }  // namespace

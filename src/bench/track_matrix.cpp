@@ -200,8 +200,9 @@ std::unique_ptr<TrackMatrixRecord> RunTrackMatrix(const TrackMatrixOptions& o, s
       options.tracker.measure_readout = c.shutter.readout > 0;
       const TrackResult track = TrackVideo(run.files.video, c.scene, run.calibrated, options);
       if (track.measured_readout_frames > 0)
-        run.calibration_note += Fixed(", readout measured %.1f ms", 1e3 * track.readout) +
-                                " (true " + Fixed("%.1f ms)", 1e3 * c.shutter.readout);
+        run.calibration_note += Fixed(", readout measured %.1f", 1e3 * track.readout) +
+                                (track.readout_u ? Fixed(" ± %.1f", 1e3 * *track.readout_u) : "") + " ms (true " +
+                                Fixed("%.1f ms)", 1e3 * c.shutter.readout);
       for (size_t i = 0; i < track.rows.size() && i < positions.size(); ++i) {
         const BallObservation& b = track.rows[i].ball;
         positions[i] = {b.found, b.u, b.v, b.x, b.z, b.full_model};

@@ -12,6 +12,7 @@
 #include "internal/edge_fit.hpp"
 #include "internal/outline_fit.hpp"
 #include "internal/rejected_windows.hpp"
+#include "internal/row_delay_settle.hpp"
 
 namespace uphill {
 namespace {
@@ -75,6 +76,16 @@ struct BallTracker::Impl {
   double row_delay = 0;                             // s per row
   std::vector<double> exposures;                    // per-frame measurements |D|/|V|
   std::vector<double> row_delays;                   // per-frame measurements of the row delay, s
+  // The frames that measured the row delay: a window of each and its last fit's request, fitted
+  // again at the end of the clip (SettleReadout).
+  struct ReadoutFrame {
+    cv::Mat window;
+    cv::Point origin;
+    double gain;
+    FitRequest request;
+  };
+  std::vector<ReadoutFrame> readout_frames;
+  std::optional<double> row_delay_u;                // s per row, once settled
   std::vector<double> scene_residuals;              // recent steady levels
   int scene_suspect = 0;
   long scene_suspect_from = -1;
@@ -503,6 +514,44 @@ struct BallTracker::Impl {
     pending_bytes += bytes;
   }
 
+  // A frame that measured the row delay, for SettleReadout: the window its smear covers and the
+  // request of a narrow pass from its fit.
+  void KeepReadoutFrame(const cv::Mat& frame, double gain, const FitOutcome& fit, FitRequest q) {
+    q.centre = Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
+    q.reference_row = geometry.Project(q.centre.x(), q.centre.y()).y();
+    q.half_width_px = kNarrowHalfWidthPx;
+    q.fit_edge_shift = q.fit_light = true;
+    q.light_inverse_distance = fit.light_inverse_distance;
+    cv::Rect box = BodyRegion(q.centre, q.smear);
+    box = cv::Rect(box.x - 24, box.y - 24, box.width + 48, box.height + 48) & cv::Rect(0, 0, frame.cols, frame.rows);
+    if (!box.empty()) readout_frames.push_back({frame(box).clone(), box.tl(), gain, q});
+  }
+
+  // The clip's row delay, settled on the frames that measured it (row_delay_settle.hpp), and its
+  // standard uncertainty; the running median of their estimates is kept when it cannot be.
+  void SettleReadout() {
+    if (readout_frames.size() < kReadoutMinFrames) return;
+    const double most = 0.999 / options.fps / geometry.cal.camera.height;
+    auto fit_at = [&](double q) {
+      std::vector<double> estimates, sigmas;
+      for (const ReadoutFrame& k : readout_frames) {
+        FitRequest r = k.request;
+        r.row_delay = q;
+        r.row_delay_probe = kReadoutProbe / options.fps / geometry.cal.camera.height;
+        const FitOutcome fit = internal::FitOutline(geometry, {k.window, k.origin, k.gain}, *background, r);
+        if (!fit.ok || !(fit.row_delay_sigma > 0) || !(fit.row_delay > -0.5 * most && fit.row_delay < 1.5 * most))
+          continue;
+        estimates.push_back(fit.row_delay);
+        sigmas.push_back(fit.row_delay_sigma);
+      }
+      return internal::PreferredDelay(q, estimates, sigmas, kReadoutMinFrames);
+    };
+    if (const auto settled = internal::SettleRowDelay(row_delay, most, fit_at)) {
+      row_delay = settled->delay;
+      row_delay_u = settled->u;
+    }
+  }
+
   // Fits kept frames again whose background and motion are now known (all of them when `all`,
   // with whatever is known by then).
   void FitAgain(bool all) {
@@ -690,7 +739,12 @@ std::optional<BallTracker::Exposure> BallTracker::ExposureEstimate() const {
 
 std::optional<BallTracker::Readout> BallTracker::ReadoutEstimate() const {
   if (impl_->row_delays.size() < kReadoutMinFrames) return std::nullopt;
-  return Readout{impl_->row_delay * impl_->geometry.cal.camera.height, static_cast<int>(impl_->row_delays.size())};
+  const double rows = impl_->geometry.cal.camera.height;
+  Readout r;
+  r.seconds = impl_->row_delay * rows;
+  r.frames = static_cast<int>(impl_->row_delays.size());
+  if (impl_->row_delay_u) r.u = *impl_->row_delay_u * rows;
+  return r;
 }
 
 std::optional<long> BallTracker::SceneChangedAt() const { return impl_->scene_changed_at; }
@@ -703,6 +757,7 @@ std::vector<std::pair<long, BallObservation>> BallTracker::TakeRevisions() {
 
 void BallTracker::Finish() {
   Impl& m = *impl_;
+  m.SettleReadout();
   m.FitAgain(true);
   if (m.unconfirmed && m.frame_index > m.unconfirmed->frame) m.Withdraw();
 }
@@ -743,7 +798,10 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
     const bool needs_model_before = m.needs_model;
     BallObservation o = m.Observe(fit, q);
     m.light_inverse_distance = fit.light_inverse_distance;
-    if (fit.row_delay_sigma > 0) m.MeasuredRowDelay(fit.row_delay);
+    if (fit.row_delay_sigma > 0) {
+      m.MeasuredRowDelay(fit.row_delay);
+      m.KeepReadoutFrame(frame, gain, fit, q);
+    }
     m.noises.push_back(std::clamp(fit.noise, 1e-3, 0.2));
     if (m.noises.size() > 15) m.noises.pop_front();
     std::vector<double> sorted(m.noises.begin(), m.noises.end());

@@ -62,7 +62,9 @@
 // timestamp. When the readout is unknown (TrackerOptions::measure_readout) it is measured from the
 // outline's shear on the frames where the body moves fast enough for a whole frame's readout to
 // shear it by a pixel: each such frame's fit gives the row delay its rays prefer (outline_fit.hpp,
-// the centre held) and, from five frames on, their median is used (ReadoutEstimate()). The
+// the centre held) and, from five frames on, their median is used. Finish() settles it on those
+// frames, fitted again from windows kept of them, as the least-squares readout of the frames
+// with its standard uncertainty (row_delay_settle.hpp; ReadoutEstimate()). The
 // exposure time is a camera setting (TrackerOptions::exposure); when unknown it is measured from
 // the fitted smear against the track's speed (ExposureEstimate()).
 //
@@ -153,10 +155,13 @@ class BallTracker {
   std::optional<Exposure> ExposureEstimate() const;
 
   // The rolling shutter's readout measured so far (TrackerOptions::measure_readout): s from the
-  // first to the last row, and the frames it is the median of; unset before the first.
+  // first to the last row, and the frames it rests on; unset before five. During the clip it is
+  // the median of the frames' estimates; after Finish() the least-squares readout of those frames
+  // (see the header) and its standard uncertainty u (unset when it could not be settled).
   struct Readout {
     double seconds = 0;
     int frames = 0;
+    std::optional<double> u;
   };
   std::optional<Readout> ReadoutEstimate() const;
 

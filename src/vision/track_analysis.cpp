@@ -60,6 +60,7 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
       s.z.push_back(f.z);
       s.u.push_back(f.u);
       s.v.push_back(f.v);
+      s.time_u.push_back(f.v * track.row_delay_u);
       s.rows.push_back(f.row);
       a.measured.emplace_back(f.t, f.x);
     }

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "io/csv_table.hpp"
 #include "io/units.hpp"
@@ -92,6 +95,22 @@ std::size_t Track::found_count() const {
 
 Track ReadTrack(std::istream& in, const std::string& source) { return FromTable(ReadCsv(in, source)); }
 
-Track ReadTrackFile(const std::string& path) { return FromTable(ReadCsvFile(path)); }
+Track ReadTrackFile(const std::string& path) {
+  Track track = FromTable(ReadCsvFile(path));
+  const std::string sidecar = path + ".json";
+  if (path == "-" || !std::filesystem::is_regular_file(sidecar)) return track;
+  std::ifstream in(sidecar);
+  const nlohmann::json side = nlohmann::json::parse(in, nullptr, false);
+  if (side.is_discarded() || !side.is_object()) throw InputError(sidecar, "is not a JSON object (the track's sidecar)");
+  if (!side.contains("readout_u_s")) return track;
+  const nlohmann::json& u = side["readout_u_s"];
+  const nlohmann::json& rows = side.contains("image_height_px") ? side["image_height_px"] : nlohmann::json();
+  if (!u.is_number() || !(u.get<double>() >= 0 && std::isfinite(u.get<double>())))
+    throw InputError(sidecar + ", readout_u_s", "must be a number >= 0 (s, the measured readout's uncertainty)");
+  if (!rows.is_number_integer() || rows.get<long>() <= 0)
+    throw InputError(sidecar + ", image_height_px", "must be an integer > 0 with readout_u_s (the rows the readout spans)");
+  track.row_delay_u = u.get<double>() / static_cast<double>(rows.get<long>());
+  return track;
+}
 
 }  // namespace uphill

@@ -39,6 +39,11 @@ struct TrackFrame {
 struct Track {
   std::string source;  // file name or "<stdin>"
   std::vector<TrackFrame> frames;
+  // The standard uncertainty of a measured rolling shutter's row delay, s per row: a frame's time
+  // t = timestamp + v·readout/H is then uncertain by v·row_delay_u, in every frame alike (one
+  // readout). From the sidecar's readout_u_s / image_height_px (ReadTrackFile); 0: none (a
+  // global shutter, or a readout given).
+  double row_delay_u = 0;
 
   std::size_t found_count() const;
 };
@@ -47,7 +52,9 @@ struct Track {
 const std::vector<std::string>& TrackColumns();
 
 Track ReadTrack(std::istream& in, const std::string& source);
-// Opens `path` ("-" reads stdin); InputError naming the file when it cannot be read.
+// Opens `path` ("-" reads stdin); InputError naming the file when it cannot be read. Reads the
+// sidecar `path`.json too when there is one (data/README.md, "Track CSV"): InputError naming it
+// and the field when it is not JSON or readout_u_s / image_height_px are out of range.
 Track ReadTrackFile(const std::string& path);
 
 }  // namespace uphill

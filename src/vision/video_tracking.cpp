@@ -121,6 +121,7 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
   if (!capture.isOpened()) throw InputError(video_path, "is not a video that OpenCV/FFmpeg can read");
   TrackResult result;
   result.fps = capture.get(cv::CAP_PROP_FPS);
+  result.image_height = calibration.camera.height;
   const double count = capture.get(cv::CAP_PROP_FRAME_COUNT);
   result.declared_frames = count > 0 && std::isfinite(count) ? static_cast<long>(std::llround(count)) : 0;
   const int width = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_WIDTH));
@@ -206,13 +207,15 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
   if (const auto r = tracker.ReadoutEstimate()) {
     result.readout = r->seconds;
     result.measured_readout_frames = r->frames;
-    // The frames measured before the readout was: their centre is where the body was when the
-    // centre's row was exposed too (the shear about that row leaves it in place), so their time
-    // is that row's.
+    result.readout_u = r->u;
+    // Every frame's time with the clip's readout: a frame measured before it was known, or with
+    // the estimate the clip had reached, still has its centre where the body was when the
+    // centre's row was exposed (the shear about that row leaves it in place).
     for (TrackRow& row : result.rows)
-      if (row.ball.found && row.ball.time_offset == 0) {
-        row.ball.time_offset = row.ball.v * result.readout / calibration.camera.height;
-        row.t += row.ball.time_offset;
+      if (row.ball.found) {
+        const double offset = row.ball.v * result.readout / calibration.camera.height;
+        row.t += offset - row.ball.time_offset;
+        row.ball.time_offset = offset;
       }
   }
   result.transfer = tracker_options.transfer;
@@ -295,6 +298,10 @@ void WriteTrack(const std::string& csv_path, const TrackResult& result, const Tr
                                  {"readout_s", result.readout},
                                  {"partial", result.partial}};
   if (result.measured_readout_frames > 0) side["readout_measured_frames"] = result.measured_readout_frames;
+  if (result.readout_u) {
+    side["readout_u_s"] = *result.readout_u;
+    side["image_height_px"] = result.image_height;
+  }
   if (result.exposure) side["exposure_s"] = *result.exposure;
   else if (result.measured_exposure) {
     side["exposure_s"] = *result.measured_exposure;

@@ -52,6 +52,8 @@ struct TrackResult {
   int measured_exposure_frames = 0;
   double readout = 0;  // as used: given, or measured (measured_readout_frames > 0)
   int measured_readout_frames = 0;
+  std::optional<double> readout_u;  // s, the measured readout's standard uncertainty
+  int image_height = 0;             // px, the rows the readout spans
   VideoTransfer transfer = VideoTransfer::kSrgb;
   std::vector<long> exposure_changes;  // frames where the exposure jumped
 };

@@ -29,6 +29,12 @@ FitErrors EstimateFitErrors(const FitErrorInputs& in) {
     for (Eigen::Index j = 0; j < n; ++j) sigma(i, j) = s2 * std::pow(out.lag1, static_cast<double>(std::abs(i - j)));
   out.residual_covariance = b * sigma * b.transpose();
 
+  // The shared time error: one error, so a rank-one covariance (B e)(B e)ᵀ.
+  if (in.time_systematic.size() == n) {
+    const Eigen::Vector3d moved = b * in.derivatives.col(1).cwiseProduct(in.time_systematic);
+    out.timing_covariance = moved * moved.transpose();
+  }
+
   // Systematic part: the worst correlation length, parameter by parameter.
   const double span = in.x.maxCoeff() - in.x.minCoeff();
   std::vector<double> lengths = {0.0};
@@ -41,7 +47,7 @@ FitErrors EstimateFitErrors(const FitErrorInputs& in) {
         const double rho = i == j ? 1.0 : length == 0 ? 0.0 : std::isinf(length) ? 1.0 : std::exp(-d / length);
         sigma(i, j) = in.systematic(i) * in.systematic(j) * rho;
       }
-    out.systematic_covariances.push_back(b * sigma * b.transpose());
+    out.systematic_covariances.push_back(b * sigma * b.transpose() + out.timing_covariance);
     const Eigen::Vector3d variance = out.systematic_covariances.back().diagonal();
     for (int p = 0; p < 3; ++p)
       if (variance(p) > out.systematic_variance(p)) {

@@ -20,6 +20,10 @@ struct FitErrorInputs {
   Eigen::VectorXd residuals;       // measured − predicted, m, in frame order
   Eigen::VectorXd x;               // measured positions, m (the bias is correlated along the path)
   Eigen::VectorXd systematic;      // the tracker's systematic error of each position, 1σ, m
+  // Each frame's time error, 1σ, s, from one error shared by all frames (a measured rolling
+  // shutter's readout: v_i·u(row delay)); empty: none. It moves position i by ẋ_i = |∂x/∂t0|
+  // times it.
+  Eigen::VectorXd time_systematic;
 };
 
 struct FitErrors {
@@ -31,7 +35,9 @@ struct FitErrors {
   // Σ_ij = σ_i σ_j exp(−|x_i − x_j|/ℓ), ℓ from independent frames (0) to one bias (+inf).
   Eigen::Vector3d systematic_variance = Eigen::Vector3d::Zero();
   Eigen::Vector3d systematic_length = Eigen::Vector3d::Zero();  // the ℓ of that maximum, m
-  std::vector<Eigen::Matrix3d> systematic_covariances;         // one per ℓ tried
+  std::vector<Eigen::Matrix3d> systematic_covariances;         // one per ℓ tried, timing included
+  // The part of the shared time error (FitErrorInputs::time_systematic), in every ℓ's covariance.
+  Eigen::Matrix3d timing_covariance = Eigen::Matrix3d::Zero();
 
   // The largest variance of a linear combination gᵀδ over the ℓ tried, statistical part included.
   double WorstVariance(const Eigen::Vector3d& g) const;

@@ -134,7 +134,9 @@ std::optional<FitErrors> AddErrorParts(const Series& s, const std::vector<int>& 
   in.residuals.resize(n);
   in.x.resize(n);
   in.systematic.resize(n);
+  if (!s.time_u.empty()) in.time_systematic.resize(n);
   for (int i = 0; i < n; ++i) {
+    if (!s.time_u.empty()) in.time_systematic(i) = s.time_u[use[i]];
     in.residuals(i) = scaled[i] * o.u_x;
     in.weights(i) = std::abs(scaled[i]) <= o.huber_sigmas ? 1.0 : o.huber_sigmas / std::abs(scaled[i]);
     in.x(i) = s.x[use[i]];
@@ -152,6 +154,10 @@ std::optional<FitErrors> AddErrorParts(const Series& s, const std::vector<int>& 
   }
   if (fit->metres_per_pixel == 0.0)
     fit->notes.push_back("the track's pixel coordinates do not move: the tracker's systematic error is not estimated");
+  if (in.time_systematic.size() > 0 && in.time_systematic.maxCoeff() > 0)
+    fit->notes.push_back("the times carry the uncertainty of the rolling shutter's measured readout (up to " +
+                         Printf("%.2g", in.time_systematic.maxCoeff() * 1e3) +
+                         " ms in this window, shared by every frame): it is in the systematic part");
   const FitErrors errors = EstimateFitErrors(in);
   fit->residual_lag1 = errors.lag1;
   for (int j = 0; j < 3; ++j) {

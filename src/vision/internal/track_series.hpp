@@ -17,6 +17,7 @@ namespace uphill::internal {
 struct Series {
   std::vector<double> t, x, z;
   std::vector<double> u, v;  // raw pixels of the centre (the tracker's systematic error is in pixels)
+  std::vector<double> time_u;  // s: each time's uncertainty shared by all frames (Track::row_delay_u)
   std::vector<int> rows;
   int size() const { return static_cast<int>(t.size()); }
 };
