@@ -504,14 +504,20 @@ struct BallTracker::Impl {
     if (fit.rays_without_background == 0 && motion_known) return;
     const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
     const Vector2d smear(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]);
-    cv::Rect box = BodyRegion(c, smear * 2);
-    box = cv::Rect(box.x - 24, box.y - 24, box.width + 48, box.height + 48) & cv::Rect(0, 0, frame.cols, frame.rows);
+    const cv::Rect box = KeptWindow(c, smear * 2, frame);
     if (box.empty()) return;
     constexpr size_t kPendingBytes = 256u << 20;  // enough for minutes of a body at rest
     const size_t bytes = box.area() * 3u;
     if (pending_bytes + bytes > kPendingBytes) return;
     pending.push_back({f, t, gain, frame(box).clone(), box.tl(), o, c, edge_fallback});
     pending_bytes += bytes;
+  }
+
+  // The part of a frame kept for a later fit: the body's region, 24 px more each side (a fit
+  // started there may move by that much).
+  cv::Rect KeptWindow(const Vector2d& centre, const Vector2d& smear, const cv::Mat& frame) const {
+    const cv::Rect box = BodyRegion(centre, smear);
+    return cv::Rect(box.x - 24, box.y - 24, box.width + 48, box.height + 48) & cv::Rect(0, 0, frame.cols, frame.rows);
   }
 
   // A frame that measured the row delay, for SettleReadout: the window its smear covers and the
@@ -522,8 +528,7 @@ struct BallTracker::Impl {
     q.half_width_px = kNarrowHalfWidthPx;
     q.fit_edge_shift = q.fit_light = true;
     q.light_inverse_distance = fit.light_inverse_distance;
-    cv::Rect box = BodyRegion(q.centre, q.smear);
-    box = cv::Rect(box.x - 24, box.y - 24, box.width + 48, box.height + 48) & cv::Rect(0, 0, frame.cols, frame.rows);
+    const cv::Rect box = KeptWindow(q.centre, q.smear, frame);
     if (!box.empty()) readout_frames.push_back({frame(box).clone(), box.tl(), gain, q});
   }
 
