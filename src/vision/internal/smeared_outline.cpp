@@ -133,21 +133,13 @@ double SmearNodes::DistanceAtMiddle(const Vector3d& d) const {
 double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, cv::Vec3d* shade) const {
   const double p = body_.px_per_rad, sigma = body_.sigma_px;
   const size_t count = nodes_.size();
-  // u_n = −δ_n/σ at every node, and ∂δ_n/∂(x, z) (the same for D scaled by τ_n).
-  double u[33], ddx[33], ddz[33];
+  // u_n = −δ_n/σ at every node.
+  double u[33], sin_t[33], cos_t[33];
   for (size_t n = 0; n < count; ++n) {
     const Node& node = nodes_[n];
-    const Vector3d cross = d.cross(node.w);
-    const double sin_t = cross.norm(), cos_t = d.dot(node.w);
-    const double theta = Angle(sin_t, cos_t);
-    u[n] = -((theta - node.beta) * p - shift_) / sigma;
-    if (grad) {
-      // ∂θ/∂v = −(d − cosθ·ŵ)/(|v|·sinθ); ∂β/∂v = −tanβ·ŵ/|v|.
-      const double k = 1.0 / (node.norm * std::max(sin_t, 1e-12));
-      const Vector3d g = (-(d - cos_t * node.w) * k + node.tan_beta / node.norm * node.w) * p;
-      ddx[n] = g.x();
-      ddz[n] = g.z();
-    }
+    sin_t[n] = d.cross(node.w).norm();
+    cos_t[n] = d.dot(node.w);
+    u[n] = -((Angle(sin_t[n], cos_t[n]) - node.beta) * p - shift_) / sigma;
   }
   const size_t pieces = count - 1;
   double coverage = 0;
@@ -182,12 +174,17 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, cv::Vec3d* s
   if (grad) {
     grad->fill(0.0);
     for (size_t n = 0; n < count; ++n) {
-      // ∂c/∂δ_n = ∂c/∂u_n · (−1/σ).
+      if (du[n] == 0) continue;  // a node in the saturated tails on both sides: no pull
+      // ∂c/∂δ_n = ∂c/∂u_n · (−1/σ); ∂δ_n/∂(x, z) from ∂θ/∂v = −(d − cosθ·ŵ)/(|v|·sinθ) and
+      // ∂β/∂v = −tanβ·ŵ/|v| (the same for D, scaled by τ_n).
+      const Node& node = nodes_[n];
       const double w = -du[n] / (static_cast<double>(pieces) * sigma);
-      (*grad)[kCentreX] += w * ddx[n];
-      (*grad)[kCentreZ] += w * ddz[n];
-      (*grad)[kSmearX] += w * ddx[n] * nodes_[n].tau;
-      (*grad)[kSmearZ] += w * ddz[n] * nodes_[n].tau;
+      const double k = 1.0 / (node.norm * std::max(sin_t[n], 1e-12));
+      const Vector3d g = (-(d - cos_t[n] * node.w) * k + node.tan_beta / node.norm * node.w) * p;
+      (*grad)[kCentreX] += w * g.x();
+      (*grad)[kCentreZ] += w * g.z();
+      (*grad)[kSmearX] += w * g.x() * node.tau;
+      (*grad)[kSmearZ] += w * g.z() * node.tau;
       (*grad)[kEdgeShift] += w * -1.0;
     }
   }
