@@ -548,11 +548,23 @@ TEST(TrackTable, ReadsTheReadoutsUncertaintyFromTheSidecar) {
     return std::string("accepted");
   };
   side("{\"readout_u_s\": 0.0027,");
-  EXPECT_NE(error().find("track.csv.json: is not a JSON object"), std::string::npos) << error();
+  EXPECT_NE(error().find("track.csv.json: is not valid JSON"), std::string::npos) << error();
   side(R"({"readout_u_s": -1, "image_height_px": 1080})");
   EXPECT_NE(error().find("track.csv.json, readout_u_s: must be a number >= 0"), std::string::npos) << error();
   side(R"({"readout_u_s": 0.0027})");
   EXPECT_NE(error().find("track.csv.json, image_height_px: must be an integer > 0"), std::string::npos) << error();
+  side(R"({"readout_u_s": 1e400, "image_height_px": 1080})");  // beyond binary64: not read as JSON
+  EXPECT_NE(error().find("track.csv.json: is not valid JSON"), std::string::npos) << error();
+  for (const char* bad_u : {R"("x")", "-1e-3", "null", "[]"}) {
+    side(std::string(R"({"image_height_px": 1080, "readout_u_s": )") + bad_u + "}");
+    EXPECT_NE(error().find("readout_u_s: must be a number >= 0"), std::string::npos) << bad_u << ": " << error();
+  }
+  for (const char* bad_rows : {"1080.5", "1e30", "18446744073709551615", "-3", R"("1080")"}) {
+    side(std::string(R"({"readout_u_s": 0.0027, "image_height_px": )") + bad_rows + "}");
+    EXPECT_NE(error().find("image_height_px: must be an integer > 0"), std::string::npos) << bad_rows << ": " << error();
+  }
+  side("[1, 2]");
+  EXPECT_NE(error().find("is not a JSON object"), std::string::npos) << error();
   std::filesystem::remove_all(dir);
 }
 

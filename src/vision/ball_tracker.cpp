@@ -86,6 +86,7 @@ struct BallTracker::Impl {
   };
   std::vector<ReadoutFrame> readout_frames;
   std::optional<double> row_delay_u;                // s per row, once settled
+  int row_delay_frames = 0;                         // the frames it was settled on
   std::vector<double> scene_residuals;              // recent steady levels
   int scene_suspect = 0;
   long scene_suspect_from = -1;
@@ -149,14 +150,19 @@ struct BallTracker::Impl {
   }
 
   // A frame's measured row delay; the median of all so far is used from kReadoutMinFrames on.
-  void MeasuredRowDelay(double delay) {
-    const double most = 1 / options.fps / geometry.cal.camera.height;
-    if (!(delay > -0.5 * most && delay < 1.5 * most)) return;  // a fit that did not see the shear
+  // False for a fit that did not see the shear (a delay far outside one frame time's).
+  bool MeasuredRowDelay(double delay) {
+    if (!SeesShear(delay)) return false;
     row_delays.push_back(delay);
-    if (row_delays.size() < kReadoutMinFrames) return;
+    if (row_delays.size() < kReadoutMinFrames) return true;
     std::vector<double> d = row_delays;
     std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-    row_delay = std::clamp(d[d.size() / 2], 0.0, 0.999 * most);
+    row_delay = std::clamp(d[d.size() / 2], 0.0, 0.999 / options.fps / geometry.cal.camera.height);
+    return true;
+  }
+  bool SeesShear(double delay) const {
+    const double most = 1 / options.fps / geometry.cal.camera.height;
+    return delay > -0.5 * most && delay < 1.5 * most;
   }
 
   double RadiusPx(double x, double z) const {
@@ -521,14 +527,16 @@ struct BallTracker::Impl {
   }
 
   // A frame that measured the row delay, for SettleReadout: the window its smear covers and the
-  // request of a narrow pass from its fit.
+  // request of a narrow pass from its fit. The smear's prior stays the motion's prediction: one
+  // centred on the smear fitted at this frame's delay would hold part of the shear that delay got
+  // wrong, and pull the settled readout back toward it (on the phone clip by about 1 ms).
   void KeepReadoutFrame(const cv::Mat& frame, double gain, const FitOutcome& fit, FitRequest q) {
     q.centre = Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
     q.reference_row = geometry.Project(q.centre.x(), q.centre.y()).y();
     q.half_width_px = kNarrowHalfWidthPx;
     q.fit_edge_shift = q.fit_light = true;
     q.light_inverse_distance = fit.light_inverse_distance;
-    const cv::Rect box = KeptWindow(q.centre, q.smear, frame);
+    const cv::Rect box = KeptWindow(q.centre, 2 * Vector2d(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]), frame);
     if (!box.empty()) readout_frames.push_back({frame(box).clone(), box.tl(), gain, q});
   }
 
@@ -536,24 +544,25 @@ struct BallTracker::Impl {
   // standard uncertainty; the running median of their estimates is kept when it cannot be.
   void SettleReadout() {
     if (readout_frames.size() < kReadoutMinFrames) return;
-    const double most = 0.999 / options.fps / geometry.cal.camera.height;
-    auto fit_at = [&](double q) {
-      std::vector<double> estimates, sigmas;
+    auto fit_frames = [&](double q) {
+      std::vector<internal::FrameFit> fits;
       for (const ReadoutFrame& k : readout_frames) {
         FitRequest r = k.request;
         r.row_delay = q;
         r.row_delay_probe = kReadoutProbe / options.fps / geometry.cal.camera.height;
         const FitOutcome fit = internal::FitOutline(geometry, {k.window, k.origin, k.gain}, *background, r);
-        if (!fit.ok || !(fit.row_delay_sigma > 0) || !(fit.row_delay > -0.5 * most && fit.row_delay < 1.5 * most))
-          continue;
-        estimates.push_back(fit.row_delay);
-        sigmas.push_back(fit.row_delay_sigma);
+        if (fit.ok && fit.row_delay_sigma > 0 && SeesShear(fit.row_delay))
+          fits.push_back(internal::FrameDelay{fit.row_delay, fit.row_delay_sigma});
+        else
+          fits.push_back(std::nullopt);
       }
-      return internal::PreferredDelay(q, estimates, sigmas, kReadoutMinFrames);
+      return fits;
     };
-    if (const auto settled = internal::SettleRowDelay(row_delay, most, fit_at)) {
+    const double most = 0.999 / options.fps / geometry.cal.camera.height;
+    if (const auto settled = internal::SettleRowDelay(row_delay, most, kReadoutMinFrames, fit_frames)) {
       row_delay = settled->delay;
       row_delay_u = settled->u;
+      row_delay_frames = settled->frames;
     }
   }
 
@@ -748,7 +757,10 @@ std::optional<BallTracker::Readout> BallTracker::ReadoutEstimate() const {
   Readout r;
   r.seconds = impl_->row_delay * rows;
   r.frames = static_cast<int>(impl_->row_delays.size());
-  if (impl_->row_delay_u) r.u = *impl_->row_delay_u * rows;
+  if (impl_->row_delay_u) {
+    r.u = *impl_->row_delay_u * rows;
+    r.frames = impl_->row_delay_frames;
+  }
   return r;
 }
 
@@ -803,10 +815,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
     const bool needs_model_before = m.needs_model;
     BallObservation o = m.Observe(fit, q);
     m.light_inverse_distance = fit.light_inverse_distance;
-    if (fit.row_delay_sigma > 0) {
-      m.MeasuredRowDelay(fit.row_delay);
-      m.KeepReadoutFrame(frame, gain, fit, q);
-    }
+    if (fit.row_delay_sigma > 0 && m.MeasuredRowDelay(fit.row_delay)) m.KeepReadoutFrame(frame, gain, fit, q);
     m.noises.push_back(std::clamp(fit.noise, 1e-3, 0.2));
     if (m.noises.size() > 15) m.noises.pop_front();
     std::vector<double> sorted(m.noises.begin(), m.noises.end());

@@ -79,7 +79,7 @@
 //    (systematic_length says which ℓ it was).
 //    A measured rolling shutter's readout (Track::row_delay_u, from the track's sidecar) adds to
 //    it: every frame's time is uncertain by v_i·row_delay_u, one error shared by all frames, so
-//    position i by ẋ_i·v_i·row_delay_u (ẋ_i = |∂x/∂t0|), a rank-one covariance added at every ℓ.
+//    position i by ẋ_i·v_i·row_delay_u (ẋ_i = −∂x/∂t0), a rank-one covariance added at every ℓ.
 //  - u = sqrt(se_statistical² + se_systematic²) (the residuals also hold part of the bias: a
 //    small double count, on the safe side). The release event quotes max(u, se·sqrt(max(1, χ²/ν))).
 // Assumptions: the bias is smooth along the path at the scales tried and of the size the two

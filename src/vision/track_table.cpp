@@ -98,10 +98,12 @@ Track ReadTrack(std::istream& in, const std::string& source) { return FromTable(
 Track ReadTrackFile(const std::string& path) {
   Track track = FromTable(ReadCsvFile(path));
   const std::string sidecar = path + ".json";
-  if (path == "-" || !std::filesystem::is_regular_file(sidecar)) return track;
+  std::error_code error;
+  if (path == "-" || !std::filesystem::is_regular_file(sidecar, error)) return track;
   std::ifstream in(sidecar);
   const nlohmann::json side = nlohmann::json::parse(in, nullptr, false);
-  if (side.is_discarded() || !side.is_object()) throw InputError(sidecar, "is not a JSON object (the track's sidecar)");
+  if (side.is_discarded()) throw InputError(sidecar, "is not valid JSON (the track's sidecar, written by uphill track)");
+  if (!side.is_object()) throw InputError(sidecar, "is not a JSON object (the track's sidecar, written by uphill track)");
   if (!side.contains("readout_u_s")) return track;
   const nlohmann::json& u = side["readout_u_s"];
   const nlohmann::json& rows = side.contains("image_height_px") ? side["image_height_px"] : nlohmann::json();

@@ -21,7 +21,7 @@ struct FitErrorInputs {
   Eigen::VectorXd x;               // measured positions, m (the bias is correlated along the path)
   Eigen::VectorXd systematic;      // the tracker's systematic error of each position, 1σ, m
   // Each frame's time error, 1σ, s, from one error shared by all frames (a measured rolling
-  // shutter's readout: v_i·u(row delay)); empty: none. It moves position i by ẋ_i = |∂x/∂t0|
+  // shutter's readout: v_i·u(row delay)); empty: none. It moves position i by ẋ_i = −∂x/∂t0
   // times it.
   Eigen::VectorXd time_systematic;
 };
