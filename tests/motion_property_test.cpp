@@ -284,7 +284,9 @@ TEST(MotionRods, NormalAnglePathIsConsistent) {
     EXPECT_NEAR(c.ddx, (hi.dx - lo.dx) / (2 * h), 1e-9);
     EXPECT_NEAR(c.ddz, (hi.dz - lo.dz) / (2 * h), 1e-9);
     EXPECT_NEAR(c.dr_star, (hi.r_star - lo.r_star) / (2 * h), 1e-9);
-    if (f > 0) EXPECT_NEAR(p.NormalAngleOf(c.x), beta, 1e-12);
+    if (f > 0) {
+      EXPECT_NEAR(p.NormalAngleOf(c.x), beta, 1e-12);
+    }
   }
 }
 
