@@ -146,7 +146,7 @@ struct BallTracker::Impl {
   bool ProbesReadout(const Vector2d& centre, const Vector2d& velocity) const {
     if (!options.measure_readout || row_delays.size() >= kReadoutFrames || velocity.isZero()) return false;
     const double px_per_s = velocity.norm() / MetresPerPx(centre.x(), centre.y());
-    return px_per_s * 2 * RadiusPx(centre.x(), centre.y()) / options.fps / geometry.cal.camera.height > 1;
+    return px_per_s * 2 * RadiusPx(centre.x(), centre.y()) * FrameRowDelay() > 1;
   }
 
   // A frame's measured row delay; the median of all so far is used from kReadoutMinFrames on.
@@ -157,13 +157,12 @@ struct BallTracker::Impl {
     if (row_delays.size() < kReadoutMinFrames) return true;
     std::vector<double> d = row_delays;
     std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-    row_delay = std::clamp(d[d.size() / 2], 0.0, 0.999 / options.fps / geometry.cal.camera.height);
+    row_delay = std::clamp(d[d.size() / 2], 0.0, 0.999 * FrameRowDelay());
     return true;
   }
-  bool SeesShear(double delay) const {
-    const double most = 1 / options.fps / geometry.cal.camera.height;
-    return delay > -0.5 * most && delay < 1.5 * most;
-  }
+  bool SeesShear(double delay) const { return delay > -0.5 * FrameRowDelay() && delay < 1.5 * FrameRowDelay(); }
+  // The row delay of a readout lasting the whole frame time, s per row: the most a camera has.
+  double FrameRowDelay() const { return 1 / options.fps / geometry.cal.camera.height; }
 
   double RadiusPx(double x, double z) const {
     const Vector3d c(x, 0, z);
@@ -231,7 +230,7 @@ struct BallTracker::Impl {
     q.light_inverse_distance = light_inverse_distance;
     q.half_width_px = half_width;
     q.row_delay = row_delay;
-    if (ProbesReadout(centre, velocity)) q.row_delay_probe = kReadoutProbe / options.fps / geometry.cal.camera.height;
+    if (ProbesReadout(centre, velocity)) q.row_delay_probe = kReadoutProbe * FrameRowDelay();
     q.reference_row = geometry.Project(centre.x(), centre.y()).y();
     const double m_per_px = MetresPerPx(centre.x(), centre.y());
     if (moving_known) {
@@ -549,7 +548,7 @@ struct BallTracker::Impl {
       for (const ReadoutFrame& k : readout_frames) {
         FitRequest r = k.request;
         r.row_delay = q;
-        r.row_delay_probe = kReadoutProbe / options.fps / geometry.cal.camera.height;
+        r.row_delay_probe = kReadoutProbe * FrameRowDelay();
         const FitOutcome fit = internal::FitOutline(geometry, {k.window, k.origin, k.gain}, *background, r);
         if (fit.ok && fit.row_delay_sigma > 0 && SeesShear(fit.row_delay))
           fits.push_back(internal::FrameDelay{fit.row_delay, fit.row_delay_sigma});
@@ -558,8 +557,7 @@ struct BallTracker::Impl {
       }
       return fits;
     };
-    const double most = 0.999 / options.fps / geometry.cal.camera.height;
-    if (const auto settled = internal::SettleRowDelay(row_delay, most, kReadoutMinFrames, fit_frames)) {
+    if (const auto settled = internal::SettleRowDelay(row_delay, 0.999 * FrameRowDelay(), kReadoutMinFrames, fit_frames)) {
       row_delay = settled->delay;
       row_delay_u = settled->u;
       row_delay_frames = settled->frames;
