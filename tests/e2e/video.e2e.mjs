@@ -52,8 +52,9 @@ const browser = await launchBrowser();
 let failed = false;
 try {
   // A refused request (422: fewer than 4 clicks so far) is logged by the browser as a failed
-  // resource; only the page's own errors count.
-  const { page, problems } = await openPage(browser, url, 20000, (text) => /status of 4\d\d/.test(text));
+  // resource; only the page's own errors count. Each step may wait 60 s: the server calibrates
+  // and tracks on the same two cores as the rest of `ctest -j2`, and once took over 20 s.
+  const { page, problems } = await openPage(browser, url, 60000, (text) => /status of 4\d\d/.test(text));
   const shot = async (name) => { if (shots) await page.screenshot({ path: path.join(shots, name), fullPage: true }); };
   const click = async (selector) => { count(KLM.click); await page.click(selector); };
   const fill = async (selector, text) => { count(KLM.click + KLM.key * text.length); await page.fill(selector, text); };

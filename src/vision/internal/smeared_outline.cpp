@@ -47,10 +47,8 @@ class NormalTable {
   double cdf_[kNodes], pdf_[kNodes];
 };
 
-const NormalTable& Normal() {
-  static const NormalTable table;
-  return table;
-}
+// Built at start-up rather than on first use, so that reading it costs no guard per node.
+const NormalTable kNormal;
 
 // Φ, φ and Ψ at one node (most samples of a ray lie in the saturated tails, away from the edge).
 struct NodeCdf {
@@ -58,7 +56,7 @@ struct NodeCdf {
   explicit NodeCdf(double x) : u(x) {
     if (x > kSaturated) cdf = 1, pdf = 0;
     else if (x < -kSaturated) cdf = 0, pdf = 0;
-    else Normal().At(x, &cdf, &pdf);
+    else kNormal.At(x, &cdf, &pdf);
     integrated = x * cdf + pdf;  // Ψ(u) = ∫_{−∞}^{u} Φ = u·Φ(u) + φ(u)
   }
 };
@@ -117,6 +115,14 @@ SmearNodes::SmearNodes(const SmearedBody& body, const double* p, const Eigen::Ve
     const double sin_b = std::min(body.a / node.norm, 1.0 - 1e-12);
     node.beta = std::asin(sin_b);
     node.tan_beta = sin_b / std::sqrt(1 - sin_b * sin_b);
+    node.reach = 0;
+    if (n > 0) {
+      // |δ_n − δ_{n−1}| ≤ p·(θ(w_{n−1}, w_n) + |β_n − β_{n−1}|) by the triangle inequality of
+      // angles; 1e-9 of it spares rounding.
+      const Node& last = nodes_[n - 1];
+      const double step = std::atan2(last.w.cross(node.w).norm(), last.w.dot(node.w)) + std::abs(node.beta - last.beta);
+      node.reach = last.reach + step * body.px_per_rad * (1 + 1e-9);
+    }
   }
 }
 
@@ -133,13 +139,31 @@ double SmearNodes::DistanceAtMiddle(const Vector3d& d) const {
 double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, cv::Vec3d* shade) const {
   const double p = body_.px_per_rad, sigma = body_.sigma_px;
   const size_t count = nodes_.size();
-  // u_n = −δ_n/σ at every node.
+  // u_n = −δ_n/σ at the nodes that can pull. The others are skipped, marked by a u beyond the
+  // saturation: δ moves by at most reach_n − reach_k from node k to node n (Node::reach), so a
+  // node closer than that to an exact node k far in a tail lies in the same tail, with Φ = 0 or 1
+  // and φ = 0, as do the pieces between such nodes (MeanCdf's constant case: exact, no pull).
   double u[33], sin_t[33], cos_t[33];
-  for (size_t n = 0; n < count; ++n) {
+  const double band = kSaturated * sigma + 1e-6;  // px; beyond it Φ is saturated (with rounding to spare)
+  const auto evaluate = [&](size_t n) {
     const Node& node = nodes_[n];
     sin_t[n] = d.cross(node.w).norm();
     cos_t[n] = d.dot(node.w);
     u[n] = -((Angle(sin_t[n], cos_t[n]) - node.beta) * p - shift_) / sigma;
+  };
+  evaluate(0);
+  for (size_t k = 0;;) {
+    // Nodes n > k with reach_n − reach_k below |δ_k| − band are in δ_k's tail.
+    const double room = std::abs(u[k]) * sigma - band;
+    size_t j = k + 1;
+    for (; j < count && nodes_[j].reach - nodes_[k].reach < room; ++j) {
+      u[j] = u[k] > 0 ? kSaturated + 1 : -kSaturated - 1;
+    }
+    if (j == count) break;
+    evaluate(j);
+    // The piece (j − 1, j) needs both ends where node j is not in the same tail as the skipped.
+    if (j - 1 > k && !(std::abs(u[j]) > kSaturated && (u[j] > 0) == (u[k] > 0))) evaluate(j - 1);
+    k = j;
   }
   const size_t pieces = count - 1;
   double coverage = 0;

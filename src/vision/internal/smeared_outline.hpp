@@ -75,6 +75,7 @@ class SmearNodes {
   struct Node {
     Eigen::Vector3d w;  // unit direction of C(τ) − O
     double norm, beta, tan_beta, tau;
+    double reach;  // px: a bound of |δ_n − δ_0| for every direction, summed over the pieces
   };
   const SmearedBody& body_;
   double shift_;
