@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -16,7 +17,11 @@ using Eigen::Vector2d;
 using Eigen::Vector3d;
 
 constexpr double kEdgeShiftPriorPx = 0.3;
-constexpr double kShadowPrior = 0.05;    // σ of the background's factor along a ray
+// σ of the background's factor along a ray (its level and its tilt): the body's soft shadow and
+// uneven light. A factor free to tilt along the ray takes up part of an edge's position: at 5 %
+// the fits' least-squares minima on the ray-traced clips lay up to 0.06 px further from the truth
+// (docs/track.md, "The fit's Jacobian").
+constexpr double kShadowPrior = 0.01;
 constexpr double kRayLossFactor = 1.5;  // Cauchy scale: this many times a good ray's χ²
 // A smear longer than this many radii is fitted with the body's shading (body_shading.hpp).
 constexpr double kShadedSmear = 0.25;
@@ -72,6 +77,10 @@ struct RayColours {
   std::vector<cv::Vec3d> back;  // (σ0 + σ1·t)·B, or B0 + B1·t, per sample
   cv::Vec3d body;
   bool ok = false;
+  // The inverse of the solve's normal matrix (priors included): known background, over
+  // (σ0, σ1, F); unknown, over (B0, B1, F) of each channel. ProjectOutColours needs them.
+  Eigen::Matrix<double, 5, 5> known_inverse;
+  std::array<Eigen::Matrix3d, 3> unknown_inverse;
 };
 
 RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, const std::vector<cv::Vec3d>& shade,
@@ -107,7 +116,7 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
     }
     a(1, 0) = a(0, 1);
     for (int k = 2; k < 5; ++k) a(k, 0) = a(0, k), a(k, 1) = a(1, k);
-    // σ = 1 ± 5 %: a soft shadow or uneven light, not a dark pattern taken for a shadowed table.
+    // σ = 1 ± 1 %: a soft shadow or uneven light, not a dark pattern taken for a shadowed table.
     const double w = (noise / kShadowPrior) * (noise / kShadowPrior);
     a(0, 0) += w, y(0) += w, a(1, 1) += w;
     const Eigen::Matrix<double, 5, 1> x = a.ldlt().solve(y);
@@ -117,6 +126,7 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
     }
     for (size_t i = 0; i < n; ++i) out.back[i] = (x(0) + x(1) * ray.along[i]) * cv::Vec3d(ray.back[i]);
     out.body = cv::Vec3d(x(2), x(3), x(4));
+    out.known_inverse = a.inverse();
     out.ok = true;
     return out;
   }
@@ -144,10 +154,63 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
     for (int ch = design; ch < (designs == 1 ? 3 : design + 1); ++ch) {
       for (size_t i = 0; i < n; ++i) out.back[i][ch] = x(0, ch) + x(1, ch) * ray.along[i];
       out.body[ch] = x(2, ch);
+      out.unknown_inverse[ch] = ldlt.solve(Eigen::Matrix3d::Identity());
     }
   }
   out.ok = true;
   return out;
+}
+
+// Kaufman's Jacobian of the variable projection: the columns ∂r/∂p at the colours held (row-major,
+// 3 rows per sample) with their part in the span of the colours' design removed, J ← J − A·N⁻¹·Aᵀ·J
+// (A the colour solve's design at the coverages c, N its normal matrix with the priors). Without
+// the projection a step of the centre is met by no change of the colours, where the colours do
+// change with it; Gauss–Newton then converges only linearly (the step halving each iteration).
+void ProjectOutColours(const RaySamples& ray, const std::vector<double>& c, const std::vector<cv::Vec3d>& shade,
+                       const RayColours& colours, double* jacobian) {
+  const size_t n = c.size();
+  const auto body = [&](size_t i, int ch) { return shade.empty() ? c[i] : c[i] * shade[i][ch]; };
+  const auto row = [&](size_t i, int ch) { return jacobian + (3 * i + ch) * kSmearParameters; };
+  using Columns = Eigen::Matrix<double, 1, kSmearParameters>;
+  if (!ray.back.empty()) {
+    // A's row (i, ch): (u·B, u·t·B, k at column 2 + ch), u = 1 − c_i, k the body's column.
+    Eigen::Matrix<double, 5, kSmearParameters> g = Eigen::Matrix<double, 5, kSmearParameters>::Zero();
+    for (size_t i = 0; i < n; ++i) {
+      const double u = 1 - c[i], t = ray.along[i];
+      for (int ch = 0; ch < 3; ++ch) {
+        const Eigen::Map<const Columns> j(row(i, ch));
+        const double b = ray.back[i][ch];
+        g.row(0) += u * b * j;
+        g.row(1) += u * t * b * j;
+        g.row(2 + ch) += body(i, ch) * j;
+      }
+    }
+    const Eigen::Matrix<double, 5, kSmearParameters> h = colours.known_inverse * g;
+    for (size_t i = 0; i < n; ++i) {
+      const double u = 1 - c[i], t = ray.along[i];
+      for (int ch = 0; ch < 3; ++ch) {
+        const double b = ray.back[i][ch];
+        Eigen::Map<Columns>(row(i, ch)) -= u * b * h.row(0) + u * t * b * h.row(1) + body(i, ch) * h.row(2 + ch);
+      }
+    }
+    return;
+  }
+  // Each channel's own (B0, B1, F): A's row (i, ch) is (u, u·t, k) in that channel's columns.
+  for (int ch = 0; ch < 3; ++ch) {
+    Eigen::Matrix<double, 3, kSmearParameters> g = Eigen::Matrix<double, 3, kSmearParameters>::Zero();
+    for (size_t i = 0; i < n; ++i) {
+      const double u = 1 - c[i];
+      const Eigen::Map<const Columns> j(row(i, ch));
+      g.row(0) += u * j;
+      g.row(1) += u * ray.along[i] * j;
+      g.row(2) += body(i, ch) * j;
+    }
+    const Eigen::Matrix<double, 3, kSmearParameters> h = colours.unknown_inverse[ch] * g;
+    for (size_t i = 0; i < n; ++i) {
+      const double u = 1 - c[i];
+      Eigen::Map<Columns>(row(i, ch)) -= u * h.row(0) + u * ray.along[i] * h.row(1) + body(i, ch) * h.row(2);
+    }
+  }
 }
 
 class RayCost : public ceres::CostFunction {
@@ -266,6 +329,7 @@ class RayCost : public ceres::CostFunction {
         }
       }
     }
+    if (!grad.empty() && colours.ok) ProjectOutColours(ray_, c, shade, colours, jacobian);
     if (solved) *solved = std::move(colours);
   }
 
@@ -514,10 +578,11 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   if (!q.fit_edge_shift) problem.SetManifold(params, new ceres::SubsetManifold(kSmearParameters, {kEdgeShift}));
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;
-  // Capped at 6 from a prediction inside the windows: on the painted spheroid's POV-Ray clip the
-  // centre is no better after more (RMS 0.30 px with 6, 0.33 px with 25), and each costs a
-  // Jacobian of every sample.
-  solver.max_num_iterations = 6;
+  // Capped at 3: with Kaufman's Jacobian the step shrinks about four-fold per iteration, and the
+  // ray-traced clips measure the same with 3 as with 6 (docs/track.md, "The fit's Jacobian"); 2
+  // are too few for a fit started from a coarse search (the phone clip then locks on a wrong
+  // place). Each iteration costs a Jacobian of every sample.
+  solver.max_num_iterations = 3;
   solver.num_threads = 1;
   solver.logging_type = ceres::SILENT;
   // Parameters are metres near 0.5 and pixels: 1e-7 of the centre is below 1e-4 px; the cost's

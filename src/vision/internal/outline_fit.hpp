@@ -11,12 +11,9 @@
 //   I_i = (1 − c_i)·g·B_i + c_i·F_k
 // c_i the coverage of the sample's viewing ray, g·B_i the background at the sample (the
 // background model times this frame's gain) and F_k the body's colour at this ray's limb, a
-// nuisance solved in closed form for every evaluation (variable projection). The Jacobian holds
-// the solved colours fixed: it is not Kaufman's, which also removes from each column its part in
-// the span of the colours' design. So each solve converges linearly and stops at its iteration
-// cap short of the least-squares minimum, and that is what the accuracy was measured with; the
-// projected Jacobian converges in about 3 iterations to centres up to 0.06 px worse (docs/track.md,
-// "The fit's Jacobian"). On a smear longer than a quarter radius, once the body's shading is learnt
+// nuisance solved in closed form for every evaluation (variable projection, with Kaufman's
+// Jacobian: the derivative at the colours held, less its part in the span of the colours' design;
+// it drops only a term proportional to the residuals). On a smear longer than a quarter radius, once the body's shading is learnt
 // (body_shading.hpp), the body's term is c_i·S_i·F_k instead: S_i its mean relative colour over
 // the part of it that passed over the sample, evaluated at the fit's start and held through the
 // solve. The shading is read as lit by a lamp at a finite distance (BodyShading::LitFrom: a lamp
@@ -37,7 +34,7 @@
 // path's bend over the exposure (the motion's acceleration) is the caller's prediction, held.
 //
 // Accuracy: see ball_tracker.hpp. Cost: rays × samples × (pieces + 1) outline evaluations per
-// Jacobian; at most 6 Ceres iterations per pass; one pass where the model measured the previous
+// Jacobian; at most 3 Ceres iterations per pass; one pass where the model measured the previous
 // frame (ball_tracker.cpp, MeasureNear), else two or more.
 #pragma once
 
