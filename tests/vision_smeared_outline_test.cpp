@@ -60,6 +60,17 @@ std::vector<Vector3d> DirectionsAcross(const SmearedBody& body, const double* p,
   return out;
 }
 
+// The central difference of coverage(parameters) in parameter q.
+template <typename Coverage>
+double CentralDifference(const Coverage& coverage, const double* p, int q, double step) {
+  double plus[kSmearParameters], minus[kSmearParameters];
+  std::copy(p, p + kSmearParameters, plus);
+  std::copy(p, p + kSmearParameters, minus);
+  plus[q] += step;
+  minus[q] -= step;
+  return (coverage(plus) - coverage(minus)) / (2 * step);
+}
+
 TEST(SmearedOutline, AtRestIsTheSoftEdgeOfTheOutline) {
   const SmearedBody body = Body();
   const double p[kSmearParameters] = {0.32, 0.05, 0.0, 0.0, 0.1};
@@ -101,12 +112,7 @@ TEST(SmearedOutline, GradientMatchesDifferencesOfTheIntegral) {
     SmearGradient grad;
     nodes.Coverage(dirs[i], &grad);
     for (int q = 0; q < kSmearParameters; ++q) {
-      double plus[kSmearParameters], minus[kSmearParameters];
-      std::copy(p, p + kSmearParameters, plus);
-      std::copy(p, p + kSmearParameters, minus);
-      plus[q] += steps[q];
-      minus[q] -= steps[q];
-      const double numeric = (ReferenceCoverage(body, plus, dirs[i]) - ReferenceCoverage(body, minus, dirs[i])) / (2 * steps[q]);
+      const double numeric = CentralDifference([&](const double* at) { return ReferenceCoverage(body, at, dirs[i]); }, p, q, steps[q]);
       // In units of coverage per pixel of motion (per px of edge shift for b).
       const double scale = q == kEdgeShift ? 1.0 : 1.0 / 1500 * (Vector3d(p[kCentreX], 0, p[kCentreZ]) - body.eye).norm();
       worst = std::max(worst, std::abs(grad[q] - numeric) * scale);
@@ -198,13 +204,8 @@ TEST(SmearedOutline, LongSmearIsItsLinearPiecesExactly) {
     partial += c > 1e-3 && c < 1 - 1e-3;
     if (i % 11 != 0) continue;
     for (int q = 0; q < kSmearParameters; ++q) {
-      double plus[kSmearParameters], minus[kSmearParameters];
-      std::copy(p, p + kSmearParameters, plus);
-      std::copy(p, p + kSmearParameters, minus);
-      plus[q] += steps[q];
-      minus[q] -= steps[q];
       const double numeric =
-          (PiecewiseCoverage(body, plus, dirs[i], m) - PiecewiseCoverage(body, minus, dirs[i], m)) / (2 * steps[q]);
+          CentralDifference([&](const double* at) { return PiecewiseCoverage(body, at, dirs[i], m); }, p, q, steps[q]);
       worst_grad = std::max(worst_grad, std::abs(grad[q] - numeric) * steps[q]);
       largest_grad = std::max(largest_grad, std::abs(numeric) * steps[q]);
     }
