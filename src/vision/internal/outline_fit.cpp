@@ -27,10 +27,8 @@ constexpr double kRayLossFactor = 1.5;  // Cauchy scale: this many times a good 
 constexpr double kShadedSmear = 0.25;
 // The lamp's inverse distance in a frame (BodyShading::LitFrom): σ of its prior about the previous
 // frame's, 1/m (a lamp a metre or two away; the first frames, where the body has barely moved,
-// leave it at its prior), the Gauss–Newton steps (the centre held), the step of its numerical
-// derivative.
+// leave it at its prior), and the step of its numerical derivative.
 constexpr double kLightPrior = 0.5;
-constexpr int kLightSteps = 1;
 constexpr double kLightStep = 0.02;
 constexpr double kSharedRows = 0.5;  // a rolling shutter's samples this many rows apart share nodes
 // Samples a smear's ramp along a ray is fitted at: on the fast ray-traced clips 16 measure as the
@@ -348,35 +346,35 @@ double UpperMedian(std::vector<double> values) {
 // A ray whose mean square (units of the noise²) is below this is an inlier.
 double InlierLimit(const std::vector<double>& squares) { return kRayLossFactor * std::max(1.0, UpperMedian(squares)); }
 
-std::vector<double> MeanSquares(const std::vector<RayCost*>& rays, const double* p) {
-  std::vector<double> squares(rays.size());
-  double contrast;
-  for (size_t k = 0; k < rays.size(); ++k) rays[k]->Assess(p, &contrast, &squares[k]);
-  return squares;
-}
-
 // The lamp's inverse distance (BodyShading::LitFrom) that best explains the rays at p, the centre
-// held: Gauss–Newton from the prior mean, its derivative by a forward difference (a fresh shade of
-// every sample). *lit (the shading the rays read) is left lit by the result.
-double FitLightDistance(const BodyShading& learnt, BodyShading* lit, const std::vector<const RayCost*>& rays,
+// held: one Gauss–Newton step from the prior mean over the rays that are inliers there, its
+// derivative by a forward difference (a fresh shade of every sample). *lit (the shading the rays
+// read) is left lit by the result.
+double FitLightDistance(const BodyShading& learnt, BodyShading* lit, const std::vector<RayCost*>& rays,
                         const double* p, double prior) {
   const Vector3d centre(p[kCentreX], 0, p[kCentreZ]);
-  const auto residuals = [&](double kappa, std::vector<double>* r) {
-    *lit = learnt.LitFrom(centre, kappa);
-    r->clear();
-    for (const RayCost* ray : rays) ray->FreshResiduals(p, r);
-    return Eigen::Map<const Eigen::VectorXd>(r->data(), static_cast<Eigen::Index>(r->size()));
-  };
-  double kappa = prior;
-  std::vector<double> r0, r1;
-  const double inv_prior = 1 / (kLightPrior * kLightPrior);
-  for (int step = 0; step < kLightSteps; ++step) {
-    const Eigen::Map<const Eigen::VectorXd> e0 = residuals(kappa, &r0);
-    const Eigen::VectorXd slope = (residuals(kappa + kLightStep, &r1) - e0) / kLightStep;
-    const double next = kappa - (slope.dot(e0) + inv_prior * (kappa - prior)) / (slope.squaredNorm() + inv_prior);
-    if (!std::isfinite(next)) break;
-    kappa = next;
+  *lit = learnt.LitFrom(centre, prior);
+  std::vector<std::vector<double>> at_prior(rays.size());
+  std::vector<double> squares(rays.size());
+  for (size_t k = 0; k < rays.size(); ++k) {
+    rays[k]->FreshResiduals(p, &at_prior[k]);
+    double sum = 0;
+    for (double v : at_prior[k]) sum += v * v;
+    squares[k] = sum / static_cast<double>(std::max<size_t>(1, at_prior[k].size()));
   }
+  const double limit = InlierLimit(squares);
+  std::vector<double> r0, r1;
+  *lit = learnt.LitFrom(centre, prior + kLightStep);
+  for (size_t k = 0; k < rays.size(); ++k)
+    if (squares[k] < limit) {
+      r0.insert(r0.end(), at_prior[k].begin(), at_prior[k].end());
+      rays[k]->FreshResiduals(p, &r1);
+    }
+  const auto e0 = Eigen::Map<const Eigen::VectorXd>(r0.data(), static_cast<Eigen::Index>(r0.size()));
+  const Eigen::VectorXd slope = (Eigen::Map<const Eigen::VectorXd>(r1.data(), static_cast<Eigen::Index>(r1.size())) - e0) / kLightStep;
+  const double inv_prior = 1 / (kLightPrior * kLightPrior);
+  double kappa = prior - slope.dot(e0) / (slope.squaredNorm() + inv_prior);
+  if (!std::isfinite(kappa)) kappa = prior;
   *lit = learnt.LitFrom(centre, kappa);
   return kappa;
 }
@@ -460,6 +458,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   const bool shaded = g.shading && g.shading->ready() && smear_px.norm() > kShadedSmear * radius_px;
   BodyShading lit = shaded ? g.shading->LitFrom(Vector3d(x, 0, z), q.light_inverse_distance) : BodyShading(1.0);
   if (shaded) body.shading = &lit;
+  const bool fit_light = shaded && q.fit_light;  // the lamp's distance fitted, then the centre
 
   // Rays: windows and their three undistorted anchors (start, middle, end).
   struct Ray {
@@ -564,7 +563,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
     const double fit_step = std::min(3.0, std::abs(smear_px.dot(ray.dir)) / kRampSamples);
     if (fit_step > step) ThinOut(&samples, static_cast<int>(std::ceil(length / fit_step)) + 1);
     const double loss_scale = std::sqrt(kRayLossFactor * 3.0 * samples.dirs.size());
-    auto* cost = new RayCost(body, std::move(samples), inv_noise, shaded, params);
+    auto* cost = new RayCost(body, std::move(samples), inv_noise, shaded && !fit_light, params);
     costs.push_back(cost);
     problem.AddResidualBlock(cost, new ceres::CauchyLoss(loss_scale), params);
   }
@@ -590,19 +589,15 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   solver.function_tolerance = 1e-7;
   solver.parameter_tolerance = 1e-7;
   ceres::Solver::Summary summary;
-  ceres::Solve(solver, &problem, &summary);
-  // The shading learnt where the body rested, lit from where this frame sees the lamp, then the
-  // centre solved again with it.
-  if (shaded && q.fit_light && std::isfinite(params[kCentreX]) && std::isfinite(params[kCentreZ])) {
-    const std::vector<double> squares = MeanSquares(costs, params);
-    const double limit = InlierLimit(squares);
-    std::vector<const RayCost*> inliers;
-    for (size_t k = 0; k < costs.size(); ++k)
-      if (squares[k] < limit) inliers.push_back(costs[k]);
-    out.light_inverse_distance = FitLightDistance(*g.shading, &lit, inliers, params, q.light_inverse_distance);
+  // The shading learnt where the body rested, lit from where this frame sees the lamp at the
+  // fit's start (a first pass's result, or the prediction where the model measured the frame
+  // before): solving first and then once more from there measures the same on the ray-traced
+  // clips, at a second solve's cost.
+  if (fit_light) {
+    out.light_inverse_distance = FitLightDistance(*g.shading, &lit, costs, params, q.light_inverse_distance);
     for (RayCost* cost : costs) cost->Shade(params);
-    ceres::Solve(solver, &problem, &summary);
   }
+  ceres::Solve(solver, &problem, &summary);
   for (double v : params)
     if (!std::isfinite(v)) return out;
   if (!InFront(g, params[kCentreX], params[kCentreZ])) return out;

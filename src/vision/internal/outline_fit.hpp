@@ -18,10 +18,10 @@
 // the part of it that passed over the sample, evaluated at the fit's start and held through the
 // solve. The shading is read as lit by a lamp at a finite distance (BodyShading::LitFrom: a lamp
 // a metre away is seen from the body in another direction once it has crossed the apparatus; on
-// the ray-traced fast clips the centre otherwise lags by up to 1 px on the longest smears): after
-// the solve, the lamp's inverse distance κ is fitted to the inlier rays with the centre held (one
-// Gauss–Newton step from the request's κ, prior σ 0.5 /m), and the centre solved once more with
-// S_i from there. So the channel in which the fit sees the edge is, ray by ray, the colour
+// the ray-traced fast clips the centre otherwise lags by up to 1 px on the longest smears): before
+// the solve, the lamp's inverse distance κ is fitted at the fit's start to the inlier rays with
+// the centre held (one Gauss–Newton step from the request's κ, prior σ 0.5 /m), and the centre
+// then solved with S_i from there. So the channel in which the fit sees the edge is, ray by ray, the colour
 // difference between the body's limb and what lies behind it: a body as grey as the table but of
 // another hue, or a table with grain, costs nothing. Where the background is not yet known at
 // every sample of a ray (the body rested there since the first frame) the ray's background is a
