@@ -225,12 +225,25 @@ class RayCost : public ceres::CostFunction {
 
   // S_i at the parameters p.
   void Shade(const double* p) {
+    last_.valid = false;
     ray_.shade.resize(ray_.dirs.size());
     ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { nodes.Coverage(ray_.dirs[i], nullptr, &ray_.shade[i]); });
   }
 
+  // Ceres evaluates a candidate's cost and, when it takes the step, the Jacobian at the same
+  // point: so the Jacobian is computed with every cost and kept for that second call (the same
+  // numbers, the coverage computed once).
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    Compute(parameters[0], ray_.shade, residuals, jacobians ? jacobians[0] : nullptr, nullptr);
+    const double* p = parameters[0];
+    if (!last_.valid || !std::equal(p, p + kSmearParameters, last_.p.begin())) {
+      last_.residuals.resize(num_residuals());
+      last_.jacobian.resize(static_cast<size_t>(num_residuals()) * kSmearParameters);
+      Compute(p, ray_.shade, last_.residuals.data(), last_.jacobian.data(), nullptr);
+      std::copy(p, p + kSmearParameters, last_.p.begin());
+      last_.valid = true;
+    }
+    std::copy(last_.residuals.begin(), last_.residuals.end(), residuals);
+    if (jacobians && jacobians[0]) std::copy(last_.jacobian.begin(), last_.jacobian.end(), jacobians[0]);
     return true;
   }
 
@@ -271,7 +284,10 @@ class RayCost : public ceres::CostFunction {
   }
 
   // The rows' delay (s per row) from here on, instead of the request's.
-  void SetRowDelay(double row_delay) { ray_.row_delay = row_delay; }
+  void SetRowDelay(double row_delay) {
+    ray_.row_delay = row_delay;
+    last_.valid = false;
+  }
 
  private:
   // visit(i, nodes) for every sample i with the smear's nodes it sees: the ray's, or with a
@@ -334,6 +350,13 @@ class RayCost : public ceres::CostFunction {
   const SmearedBody& body_;
   RaySamples ray_;
   double inv_noise_;
+  // The last point Evaluate computed, its residuals and Jacobian (row-major).
+  struct LastEvaluation {
+    bool valid = false;
+    std::array<double, kSmearParameters> p{};
+    std::vector<double> residuals, jacobian;
+  };
+  mutable LastEvaluation last_;
 };
 
 // The upper of the two middle values for an even count (internal::Median of track_series.hpp
