@@ -19,7 +19,7 @@ using Eigen::Vector3d;
 constexpr double kEdgeShiftPriorPx = 0.3;
 // σ of the background's factor along a ray (its level and its tilt): the body's soft shadow and
 // uneven light. A factor free to tilt along the ray takes up part of an edge's position: at 5 %
-// the fits' least-squares minima on the ray-traced clips lay up to 0.06 px further from the truth
+// the fits' least-squares minima on the ray-traced clips lay about 0.07 px further from the truth
 // (docs/track.md, "The fit's Jacobian").
 constexpr double kShadowPrior = 0.01;
 constexpr double kRayLossFactor = 1.5;  // Cauchy scale: this many times a good ray's χ²
@@ -163,7 +163,8 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
 // 3 rows per sample) with their part in the span of the colours' design removed, J ← J − A·N⁻¹·Aᵀ·J
 // (A the colour solve's design at the coverages c, N its normal matrix with the priors). Without
 // the projection a step of the centre is met by no change of the colours, where the colours do
-// change with it; Gauss–Newton then converges only linearly (the step halving each iteration).
+// change with it; Gauss–Newton then converges only linearly (on fast-360-30 the step halved each
+// iteration).
 void ProjectOutColours(const RaySamples& ray, const std::vector<double>& c, const std::vector<cv::Vec3d>& shade,
                        const RayColours& colours, double* jacobian) {
   const size_t n = c.size();
@@ -601,9 +602,10 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;
   // Capped at 3: with Kaufman's Jacobian the step shrinks about four-fold per iteration, and the
-  // ray-traced clips measure the same with 3 as with 6 (docs/track.md, "The fit's Jacobian"); 2
-  // are too few for a fit started from a coarse search (the phone clip then locks on a wrong
-  // place). Each iteration costs a Jacobian of every sample.
+  // ray-traced clips measure the same with 3 as with 6 (docs/track.md, "The fit's Jacobian", with
+  // the background held to ± 0.5 %; the phone clip at ± 1 %); 2 are too few for a fit started from
+  // a coarse search (the phone clip then locks on a wrong place). Each iteration costs a Jacobian
+  // of every sample.
   solver.max_num_iterations = 3;
   solver.num_threads = 1;
   solver.logging_type = ceres::SILENT;

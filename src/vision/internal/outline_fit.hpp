@@ -33,8 +33,8 @@
 // over the exposure, a uniform edge shift b. Priors: b ~ N(0, 0.3 px), D ~ N(D_pred, σ_D). The
 // path's bend over the exposure (the motion's acceleration) is the caller's prediction, held.
 //
-// Accuracy: see ball_tracker.hpp. Cost: rays × samples × (pieces + 1) outline evaluations per
-// Jacobian; at most 3 Ceres iterations per pass; one pass where the model measured the previous
+// Accuracy: see ball_tracker.hpp. Cost: at most rays × samples × (pieces + 1) outline evaluations
+// per Jacobian; at most 3 Ceres iterations per pass; one pass where the model measured the previous
 // frame (ball_tracker.cpp, MeasureNear), else two or more.
 #pragma once
 
