@@ -13,21 +13,22 @@
 // background model times this frame's gain) and F_k the body's colour at this ray's limb, a
 // nuisance solved in closed form for every evaluation (variable projection, with Kaufman's
 // Jacobian: the derivative at the colours held, less its part in the span of the colours' design;
-// it drops only a term proportional to the residuals). On a smear longer than a quarter radius, once the body's shading is learnt
-// (body_shading.hpp), the body's term is c_i·S_i·F_k instead: S_i its mean relative colour over
-// the part of it that passed over the sample, evaluated at the fit's start and held through the
-// solve. The shading is read as lit by a lamp at a finite distance (BodyShading::LitFrom: a lamp
-// a metre away is seen from the body in another direction once it has crossed the apparatus; on
-// the ray-traced fast clips the centre otherwise lags by up to 1 px on the longest smears): before
-// the solve, the lamp's inverse distance κ is fitted at the fit's start to the inlier rays with
-// the centre held (one Gauss–Newton step from the request's κ, prior σ 0.5 /m), and the centre
-// then solved with S_i from there. So the channel in which the fit sees the edge is, ray by ray, the colour
-// difference between the body's limb and what lies behind it: a body as grey as the table but of
-// another hue, or a table with grain, costs nothing. Where the background is not yet known at
-// every sample of a ray (the body rested there since the first frame) the ray's background is a
-// constant B_k solved the same way. A painted band, a highlight, a seam, the shadow: such a ray's
-// samples do not follow one limb colour, its misfit is large, and a Cauchy loss per ray (scale:
-// 4 times the expected χ² of a good ray) gives it no say.
+// it drops only a term proportional to the residuals). On a smear longer than a quarter radius,
+// once the body's shading is learnt (body_shading.hpp), the body's term is c_i·S_i·F_k instead:
+// S_i its mean relative colour over the part of it that passed over the sample, evaluated at the
+// fit's start and held through the solve. The shading is read as lit by a lamp at a finite
+// distance (BodyShading::LitFrom: a lamp a metre away is seen from the body in another direction
+// once it has crossed the apparatus; on the ray-traced fast clips the centre otherwise lags by up
+// to 1 px on the longest smears): before the solve, the lamp's inverse distance κ is fitted at
+// the fit's start to the inlier rays with the centre held (one Gauss–Newton step from the
+// request's κ, prior σ 0.5 /m), and the centre then solved with S_i from there. So the channel in
+// which the fit sees the edge is, ray by ray, the colour difference between the body's limb and
+// what lies behind it: a body as grey as the table but of another hue, or a table with grain,
+// costs nothing. Where the background is not yet known at every sample of a ray (the body rested
+// there since the first frame) the ray's background is a constant B_k solved the same way. A
+// painted band, a highlight, a seam, the shadow: such a ray's samples do not follow one limb
+// colour, its misfit is large, and a Cauchy loss per ray (scale: 4 times the expected χ² of a good
+// ray) gives it no say.
 //
 // Parameters (smeared_outline.hpp's order): the centre (x, z) at the reference time, the smear D
 // over the exposure, a uniform edge shift b. Priors: b ~ N(0, 0.3 px), D ~ N(D_pred, σ_D). The

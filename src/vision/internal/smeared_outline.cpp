@@ -120,7 +120,8 @@ SmearNodes::SmearNodes(const SmearedBody& body, const double* p, const Eigen::Ve
       // |δ_n − δ_{n−1}| ≤ p·(θ(w_{n−1}, w_n) + |β_n − β_{n−1}|) by the triangle inequality of
       // angles; 1e-9 of it spares rounding.
       const Node& last = nodes_[n - 1];
-      const double step = std::atan2(last.w.cross(node.w).norm(), last.w.dot(node.w)) + std::abs(node.beta - last.beta);
+      const double step =
+          std::atan2(last.w.cross(node.w).norm(), last.w.dot(node.w)) + std::abs(node.beta - last.beta);
       node.reach = last.reach + step * body.px_per_rad * (1 + 1e-9);
     }
   }
@@ -144,7 +145,8 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, cv::Vec3d* s
   // node closer than that to an exact node k far in a tail lies in the same tail, with Φ = 0 or 1
   // and φ = 0, as do the pieces between such nodes (MeanCdf's constant case: exact, no pull).
   double u[33], sin_t[33], cos_t[33];
-  const double band = kSaturated * sigma + 1e-6;  // px; beyond it Φ is saturated (with rounding to spare)
+  // px: beyond it Φ is saturated (with 1e-6 px to spare for rounding).
+  const double band = kSaturated * sigma + 1e-6;
   const auto evaluate = [&](size_t n) {
     const Node& node = nodes_[n];
     sin_t[n] = d.cross(node.w).norm();
