@@ -153,6 +153,44 @@ TEST(BodyShading, LitFromTheLampOverheadIsTheBallUnderThatLamp) {
   EXPECT_GT(unlit, 3 * lit);  // the case is one the lamp's distance matters for
 }
 
+// The smear model averages the shading's basis over the surface points a pixel saw and colours
+// the mean under each light it tries (outline_fit.hpp): that must be the mean of the colours.
+// Truth: a shading given in closed form, S(n) = 1 + 0.5·n_z + 0.2·n_x·n_z (B), 1 − 0.3·n_x (G),
+// 1 + 0.1·(n_x² − n_y²) (R), turned by R: S(Rᵀ·n), with n each point's normal from the geometry.
+TEST(BodyShading, MeanOfBasesIsTheMeanColourUnderATurnedLight) {
+  BodyShading::Coefficients k = BodyShading::Coefficients::Zero();
+  k(0, 0) = k(0, 1) = k(0, 2) = 1;
+  k(3, 0) = 0.5, k(6, 0) = 0.2, k(1, 1) = -0.3, k(7, 2) = 0.1;
+  const auto closed_form = [](const Vector3d& n) {
+    return Vector3d(1 + 0.5 * n.z() + 0.2 * n.x() * n.z(), 1 - 0.3 * n.x(), 1 + 0.1 * (n.x() * n.x() - n.y() * n.y()));
+  };
+  const Vector3d omega(0.2, -0.5, 0.9);
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(omega.norm(), omega.normalized()).toRotationMatrix();
+  const BodyShading turned = BodyShading(1.0, k).Turned(omega);
+  const Vector3d v(0.1, 0.6, 0.05);  // the ball's centre from the eye
+  const Vector3d w = v.normalized(), e1 = w.cross(Vector3d::UnitZ()).normalized(), e2 = w.cross(e1);
+  const double sin_b = kRadius / v.norm();
+  BodyShading::Basis sum = BodyShading::Basis::Zero();
+  Vector3d expected = Vector3d::Zero();
+  int count = 0;
+  for (double r : {0.0, 0.2, 0.45})  // within the part of the disc read as it is (kReliable)
+    for (int j = 0; j < 7; ++j) {
+      const double phi = 2 * M_PI * j / 7;
+      const Vector3d d = (w + r * sin_b * (std::cos(phi) * e1 + std::sin(phi) * e2)).normalized();
+      const double b = d.dot(v), disc = b * b - v.squaredNorm() + kRadius * kRadius;
+      const Vector3d n = ((b - std::sqrt(disc)) * d - v) / kRadius;
+      sum += turned.LearntBasisAt(d, v, kRadius);
+      expected += closed_form(turn.transpose() * n);
+      ++count;
+    }
+  const cv::Vec3d mean = turned.FromBasis(sum / count);
+  expected /= count;
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(mean[ch], expected[ch], 1e-12) << "channel " << ch;
+  EXPECT_GT((expected - Vector3d::Ones()).cwiseAbs().maxCoeff(), 0.1);  // the turn and the shading matter
+  const cv::Vec3d none = turned.FromBasis(BodyShading::Basis::Zero());  // no surface point: 1
+  EXPECT_EQ(none, cv::Vec3d(1, 1, 1));
+}
+
 TEST(BodyShading, StrongHighlightIsNotTakenForShading) {
   const OutlineGeometry g = Geometry();
   const BodyShading shading = LearnFromViews(g, [](const Vector3d& n, const Vector3d& view) {

@@ -257,8 +257,9 @@ TEST(SmearedOutline, ShadeIsTheCoverageWeightedMeanOfTheShadingOverTheExposure) 
   const SmearNodes nodes(body, p, Vector2d::Zero(), SmearPieces(blur_px, radius_px));
   double worst = 0, spread = 0;
   for (const Vector3d& d : DirectionsAcross(body, p, 0.5 * blur_px, 2.0)) {
-    cv::Vec3d shade;
-    if (nodes.Coverage(d, nullptr, &shade) < 0.02) continue;  // barely reached: its shade weighs nothing
+    BodyShading::Basis basis;
+    if (nodes.Coverage(d, nullptr, &basis) < 0.02) continue;  // barely reached: its shade weighs nothing
+    const cv::Vec3d shade = shading.FromBasis(basis);
     const Eigen::Vector3d want = reference(d);
     for (int ch = 0; ch < 3; ++ch) {
       worst = std::max(worst, std::abs(shade[ch] - want[ch]));

@@ -42,7 +42,7 @@ constexpr double kFastMaxRmsPx = 0.3;       // RMS of the edge points about the 
 constexpr double kFastMinAgreement = 0.85;  // share of the searched rays that are inliers
 constexpr double kFastMaxDisagreementPx = 0.5;  // edge fit against the model, at acquisition
 constexpr int kFastDistrust = 3;            // untrusted fast fits in a row: the clip needs the model
-constexpr int kLearnEvery = 8;              // on the fast path, frames between background updates
+constexpr int kLearnEvery = 8;              // frames between background updates of the whole band
 // A model fit whose smear measures the exposure: its inlier rays fit within 1.5 noise levels and
 // are at least this share of the rays (a half: on ray-traced footage a ball's shadow, the rails'
 // reflections and the highlight leave 55-75 % of the rays inliers, and the exposure is the
@@ -855,8 +855,15 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
     }
     m.KeepForRefit(f, t, frame, gain, fit, o, motion_known, edge_fallback);
     // Not while a scene change is being confirmed: the changed picture is not the background.
-    if (m.scene_suspect == 0)
-      m.background->Learn(frame, m.BodyRegion(Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]), smear));
+    // Every frame near the body (what it uncovered since the last frame, and where the next
+    // frames' rays read), the whole band every kLearnEvery frames, as on the fast path: a still
+    // scene's background needs no more looks than that, normalised by each frame's gain.
+    if (m.scene_suspect == 0) {
+      const cv::Rect body = m.BodyRegion(Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]), smear);
+      const int reach = static_cast<int>(std::ceil(2 * m.RadiusPx(o.x, o.z) + step_px)) + 2;
+      const cv::Rect near(body.x - reach, body.y - reach, body.width + 2 * reach, body.height + 2 * reach);
+      m.background->Learn(frame, body, f % kLearnEvery == 0 ? cv::Rect() : near);
+    }
     m.FitAgain(false);
     return o;
   };

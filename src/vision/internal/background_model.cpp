@@ -75,7 +75,7 @@ bool BackgroundModel::Measure(const cv::Mat& bgr, const cv::Rect& exclude) {
   return true;
 }
 
-void BackgroundModel::Learn(const cv::Mat& bgr, const cv::Rect& exclude) {
+void BackgroundModel::Learn(const cv::Mat& bgr, const cv::Rect& exclude, const cv::Rect& within) {
   const float inv_gain = static_cast<float>(1.0 / gain_);
   const float clamp = static_cast<float>(std::max(4 * noise_, 0.01));
   // η = 1/min(n + 1, kAveraged) by the count n so far.
@@ -112,7 +112,12 @@ void BackgroundModel::Learn(const cv::Mat& bgr, const cv::Rect& exclude) {
     abs_count += row_count;
   };
   const int ex0 = exclude.x, ex1 = exclude.x + exclude.width;
-  for (const Run& run : runs_) {
+  for (Run run : runs_) {
+    if (!within.empty()) {
+      if (run.y < within.y || run.y >= within.y + within.height) continue;
+      run.begin = std::max(run.begin, within.x), run.end = std::min(run.end, within.x + within.width);
+      if (run.begin >= run.end) continue;
+    }
     if (exclude.empty() || run.y < exclude.y || run.y >= exclude.y + exclude.height || run.end <= ex0 || run.begin >= ex1) {
       learn(run.y, run.begin, run.end);
       continue;

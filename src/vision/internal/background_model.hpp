@@ -41,8 +41,9 @@ class BackgroundModel {
   double Gain() const { return gain_; }
   double SceneResidual() const { return residual_; }
 
-  // Learns the band's pixels of `bgr` outside `exclude` (gain from the last Measure).
-  void Learn(const cv::Mat& bgr, const cv::Rect& exclude);
+  // Learns the band's pixels of `bgr` outside `exclude` (gain from the last Measure), only those
+  // inside `within` unless it is empty.
+  void Learn(const cv::Mat& bgr, const cv::Rect& exclude, const cv::Rect& within = cv::Rect());
 
   // Whether every pixel of `rect` (clipped to the frame) has been seen; the background there
   // (linear light, gain 1), bilinear.

@@ -22,7 +22,14 @@ constexpr double kCutBright = 2, kCutDark = 3.5;  // robust deviations
 
 }  // namespace
 
-BodyShading::Basis BodyShading::BasisAt(const Eigen::Vector3d& d, const Eigen::Vector3d& v, double a) const {
+BodyShading::Basis BodyShading::OfNormal(const Eigen::Vector3d& n) {
+  Basis basis;
+  basis << 1, n.x(), n.y(), n.z(), n.x() * n.y(), n.y() * n.z(), n.x() * n.z(), n.x() * n.x() - n.y() * n.y(),
+      3 * n.z() * n.z() - 1;
+  return basis;
+}
+
+BodyShading::Basis BodyShading::LearntBasisAt(const Eigen::Vector3d& d, const Eigen::Vector3d& v, double a) const {
   const double b = d.dot(v), disc = b * b - v.squaredNorm() + a * a;
   // The surface point the ray meets first; a ray that misses reads the limb point nearest to it.
   Eigen::Vector3d n = disc >= 0 ? Eigen::Vector3d((b - std::sqrt(disc)) * d - v) : Eigen::Vector3d(b * d - v);
@@ -35,17 +42,33 @@ BodyShading::Basis BodyShading::BasisAt(const Eigen::Vector3d& d, const Eigen::V
     n = kReliable * across - kReliableCos * d;
   }
   n.y() *= s_;  // back from the scaled space: normals scale by the inverse transpose
-  n = turn_.transpose() * n.normalized();
-  Basis basis;
-  basis << 1, n.x(), n.y(), n.z(), n.x() * n.y(), n.y() * n.z(), n.x() * n.z(), n.x() * n.x() - n.y() * n.y(),
-      3 * n.z() * n.z() - 1;
-  return basis;
+  return OfNormal(n.normalized());
 }
 
 BodyShading BodyShading::Turned(const Eigen::Vector3d& omega) const {
   BodyShading turned(*this);
   const double angle = omega.norm();
-  if (angle > 0) turned.turn_ = Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix();
+  if (!(angle > 0)) return turned;
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix();
+  // The colour at normal n is the learnt colour at turnᵀ·n: the turned colours at 16 normals
+  // spread over the sphere, whose bases span the 9, give the coefficients on the unturned basis
+  // by least squares (exact: the turned colour is itself a quadratic in n).
+  static const auto normals = [] {
+    std::array<Eigen::Vector3d, 16> n;
+    for (int k = 0; k < 16; ++k) {
+      const double z = 1 - (2 * k + 1) / 16.0, r = std::sqrt(1 - z * z), phi = k * 2.399963229728653;
+      n[k] = Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z);
+    }
+    return n;
+  }();
+  static const Eigen::Matrix<double, 9, 16> solve = [] {
+    Eigen::Matrix<double, 16, 9> p;
+    for (int k = 0; k < 16; ++k) p.row(k) = OfNormal(normals[k]).transpose();
+    return Eigen::Matrix<double, 9, 16>((p.transpose() * p).ldlt().solve(p.transpose()));
+  }();
+  Eigen::Matrix<double, 16, 3> colours;
+  for (int k = 0; k < 16; ++k) colours.row(k) = OfNormal(turn.transpose() * normals[k]).transpose() * coefficients_;
+  turned.colours_ = (solve * colours).transpose();
   return turned;
 }
 
@@ -60,10 +83,14 @@ BodyShading BodyShading::LitFrom(const Eigen::Vector3d& centre, double inverse_d
   return Turned(turn.angle() * turn.axis());
 }
 
-cv::Vec3d BodyShading::At(const Eigen::Vector3d& d, const Eigen::Vector3d& v, double a) const {
-  const Eigen::Vector3d c = coefficients_.transpose() * BasisAt(d, v, a);
-  // A quadratic may dip below zero where the views were darkest; a colour is not negative.
+cv::Vec3d BodyShading::FromBasis(const Basis& basis) const {
+  if (basis(0) == 0) return cv::Vec3d(1, 1, 1);  // the constant term of any surface point is 1
+  const Eigen::Vector3d c = colours_ * basis;
   return cv::Vec3d(std::max(c.x(), kFloor), std::max(c.y(), kFloor), std::max(c.z(), kFloor));
+}
+
+cv::Vec3d BodyShading::At(const Eigen::Vector3d& d, const Eigen::Vector3d& v, double a) const {
+  return FromBasis(LearntBasisAt(d, v, a));
 }
 
 void BodyShading::Learn(const cv::Mat& bgr, const std::array<float, 256>& table, const OutlineGeometry& g, double x,
@@ -90,7 +117,7 @@ void BodyShading::Learn(const cv::Mat& bgr, const std::array<float, 256>& table,
     Eigen::Vector3d d = g.to_apparatus * Eigen::Vector3d(normalised[k].x(), normalised[k].y(), 1.0);
     d.y() *= g.s;
     const cv::Vec3d colour(SampleLinear(bgr, table, pixels[k].x(), pixels[k].y()));
-    view.emplace_back(BasisAt(d.normalized(), v, g.a), colour);
+    view.emplace_back(LearntBasisAt(d.normalized(), v, g.a), colour);
     mean += colour;
   }
   mean /= static_cast<double>(view.size());
@@ -141,6 +168,7 @@ void BodyShading::Learn(const cv::Mat& bgr, const std::array<float, 256>& table,
   for (size_t k = 0; k < samples_.size(); ++k)
     if (inlier[k]) sum += error[k] * error[k], ++count;
   misfit_ = std::sqrt(sum / std::max<size_t>(count, 1));
+  colours_ = coefficients_.transpose();
   ready_ = coefficients_.allFinite() && misfit_ <= kMaxMisfit && count >= kMinInliers * samples_.size();
   samples_.clear();
   samples_.shrink_to_fit();

@@ -67,7 +67,7 @@ class BodyShading {
   // A shading given by its coefficients, learnt with the body centred at `learnt_at` (apparatus
   // frame, m), ready at once (a test's known shading).
   BodyShading(double s, const Coefficients& coefficients, const Eigen::Vector3d& learnt_at = Eigen::Vector3d::Zero())
-      : s_(s), ready_(true), coefficients_(coefficients), learnt_at_(learnt_at) {}
+      : s_(s), ready_(true), coefficients_(coefficients), learnt_at_(learnt_at), colours_(coefficients.transpose()) {}
 
   // One sharp view of the body resting with its centre at (x, 0, z) in `bgr` (8-bit BGR, `table`
   // its linear light). Views after kViews are ignored; the fit is made at the kViews-th.
@@ -79,8 +79,22 @@ class BodyShading {
 
   // The relative colour (B, G, R; about 1) seen along the unit direction d from the eye of the
   // body of radius a centred at v from the eye (scaled space); a direction that misses the body
-  // reads its outline's nearest point.
+  // reads its outline's nearest point. FromBasis(LearntBasisAt(d, v, a)).
   cv::Vec3d At(const Eigen::Vector3d& d, const Eigen::Vector3d& v, double a) const;
+
+  // The quadratic basis (see the header) at the normal that At reads, in the frame the shading
+  // was learnt in (before any turn of the light). The space of quadratics on the sphere is closed
+  // under rotation, so under any light the colour is linear in this basis: a mean of bases over
+  // many surface points (a smear's, smeared_outline.hpp) gives their mean colour under every
+  // light through FromBasis, without visiting the points again.
+  using Basis = Eigen::Matrix<double, 9, 1>;
+  Basis LearntBasisAt(const Eigen::Vector3d& d, const Eigen::Vector3d& v, double a) const;
+
+  // The colour of a basis (or of a mean of bases) under this shading's light, each channel at
+  // least 0.02 (a quadratic may dip below zero where the views were darkest); a zero basis (no
+  // surface point) reads 1. Accurate to rounding: the turn is applied to the coefficients as the
+  // 9 × 9 matrix that maps the basis at a normal to the basis at the turned normal.
+  cv::Vec3d FromBasis(const Basis& basis) const;
 
   // This shading with the light turned by the rotation vector omega (apparatus frame, rad): the
   // colour at normal n is the learnt colour at R(omega)ᵀ·n. Lit by a lamp a metre away, a body
@@ -99,8 +113,8 @@ class BodyShading {
   double misfit() const { return misfit_; }
 
  private:
-  using Basis = Eigen::Matrix<double, 9, 1>;
-  Basis BasisAt(const Eigen::Vector3d& d, const Eigen::Vector3d& v, double a) const;
+  static Basis OfNormal(const Eigen::Vector3d& n);
+
 
   double s_;
   int views_ = 0;
@@ -110,7 +124,8 @@ class BodyShading {
   std::vector<std::pair<Basis, cv::Vec3d>> samples_;  // (basis at the normal, relative colour)
   Coefficients coefficients_ = Coefficients::Zero();
   Eigen::Vector3d learnt_at_ = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d turn_ = Eigen::Matrix3d::Identity();  // Turned
+  // The coefficients under the turned light (Turned), transposed: colour = colours_·basis.
+  Eigen::Matrix<double, 3, 9> colours_ = Eigen::Matrix<double, 3, 9>::Zero();
 };
 
 }  // namespace uphill::internal

@@ -45,6 +45,10 @@ struct RaySamples {
   // The body's relative colour over the part of it that passed over each sample (S_i below), at
   // the fit's starting point; empty: one colour per ray.
   std::vector<cv::Vec3d> shade;
+  // On a shaded ray, each sample's coverage and mean shading basis at the fit's start (smeared_outline.hpp):
+  // S_i under any light follows from them without another pass over the smear's nodes.
+  std::vector<double> start_coverage;
+  std::vector<BodyShading::Basis> start_basis;
   Vector2d bend = Vector2d::Zero();    // A of smeared_outline.hpp, m
   int pieces = 1;
   std::vector<Vector3d> dirs;          // unit, scaled space
@@ -221,14 +225,21 @@ class RayCost : public ceres::CostFunction {
       : body_(body), ray_(std::move(ray)), inv_noise_(inv_noise) {
     set_num_residuals(static_cast<int>(3 * ray_.dirs.size()));
     mutable_parameter_block_sizes()->push_back(kSmearParameters);
-    if (shaded) Shade(start);
+    if (shaded) {
+      const size_t n = ray_.dirs.size();
+      ray_.start_coverage.resize(n);
+      ray_.start_basis.resize(n);
+      ForEachSample(start, [&](size_t i, const SmearNodes& nodes) {
+        ray_.start_coverage[i] = nodes.Coverage(ray_.dirs[i], nullptr, &ray_.start_basis[i]);
+      });
+      Shade();
+    }
   }
 
-  // S_i at the parameters p.
-  void Shade(const double* p) {
-    last_.valid = false;
-    ray_.shade.resize(ray_.dirs.size());
-    ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { nodes.Coverage(ray_.dirs[i], nullptr, &ray_.shade[i]); });
+  // S_i at the fit's start under the body's light as it is now (the lamp fitted since).
+  void Shade() {
+    last_.valid = accepted_.valid = false;
+    ray_.shade = ShadeAtStart();
   }
 
   // Ceres evaluates a candidate's cost and, when it takes the step, the Jacobian at the same
@@ -236,43 +247,52 @@ class RayCost : public ceres::CostFunction {
   // numbers, the coverage computed once).
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const double* p = parameters[0];
-    if (!last_.valid || !std::equal(p, p + kSmearParameters, last_.p.begin())) {
+    if (!last_.At(p)) {
       last_.residuals.resize(num_residuals());
       last_.jacobian.resize(static_cast<size_t>(num_residuals()) * kSmearParameters);
-      Compute(p, ray_.shade, last_.residuals.data(), last_.jacobian.data(), nullptr);
+      RayColours colours;
+      Compute(p, ray_.shade, last_.residuals.data(), last_.jacobian.data(), &colours);
+      last_.contrast = Contrast(colours);
       std::copy(p, p + kSmearParameters, last_.p.begin());
       last_.valid = true;
     }
     std::copy(last_.residuals.begin(), last_.residuals.end(), residuals);
-    if (jacobians && jacobians[0]) std::copy(last_.jacobian.begin(), last_.jacobian.end(), jacobians[0]);
+    if (jacobians && jacobians[0]) {
+      std::copy(last_.jacobian.begin(), last_.jacobian.end(), jacobians[0]);
+      // Ceres asks for the Jacobian only at a point it has moved to (or started from): where the
+      // solve ends unless a later candidate is taken, and what Assess then reads.
+      accepted_.p = last_.p, accepted_.residuals = last_.residuals, accepted_.contrast = last_.contrast;
+      accepted_.valid = true;
+    }
     return true;
   }
 
-  // |F − B| (linear units) and the ray's mean squared residual (units of the noise²) at p.
+  // |F − B| (linear units) and the ray's mean squared residual (units of the noise²) at p: from
+  // the solve's last evaluations where it evaluated p, else computed.
   void Assess(const double* p, double* contrast, double* mean_square) const {
-    const size_t n = ray_.dirs.size();
-    std::vector<double> r(3 * n);
+    const auto mean = [](const std::vector<double>& r) {
+      double sum = 0;
+      for (double v : r) sum += v * v;
+      return sum / static_cast<double>(r.size());
+    };
+    for (const LastEvaluation* known : {&last_, &accepted_})
+      if (known->At(p)) {
+        *contrast = known->contrast, *mean_square = mean(known->residuals);
+        return;
+      }
+    std::vector<double> r(3 * ray_.dirs.size());
     RayColours colours;
     Compute(p, ray_.shade, r.data(), nullptr, &colours);
-    double sum = 0;
-    for (double v : r) sum += v * v;
-    *mean_square = sum / static_cast<double>(r.size());
-    cv::Vec3d mean_back(0, 0, 0);
-    for (const cv::Vec3d& b : colours.back) mean_back += b;
-    *contrast = colours.ok ? cv::norm(colours.body - mean_back / static_cast<double>(n)) : 0.0;
+    *contrast = Contrast(colours), *mean_square = mean(r);
   }
 
   size_t samples() const { return ray_.dirs.size(); }
 
-  // The residuals at p (appended to r), the shade evaluated afresh from the body's shading.
-  void FreshResiduals(const double* p, std::vector<double>* r) const {
-    const size_t n = ray_.dirs.size();
-    std::vector<double> c(n);
-    std::vector<cv::Vec3d> shade(n);
-    ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { c[i] = nodes.Coverage(ray_.dirs[i], nullptr, &shade[i]); });
+  // The residuals at the fit's start (appended to r) under the body's light as it is now.
+  void ResidualsAtStart(std::vector<double>* r) const {
     const size_t at = r->size();
-    r->resize(at + 3 * n);
-    Residuals(c, {}, shade, r->data() + at, nullptr, nullptr);
+    r->resize(at + 3 * ray_.dirs.size());
+    Residuals(ray_.start_coverage, {}, ShadeAtStart(), r->data() + at, nullptr, nullptr);
   }
 
   // The sum of squared residuals (units of the noise²) at p.
@@ -287,7 +307,7 @@ class RayCost : public ceres::CostFunction {
   // The rows' delay (s per row) from here on, instead of the request's.
   void SetRowDelay(double row_delay) {
     ray_.row_delay = row_delay;
-    last_.valid = false;
+    last_.valid = accepted_.valid = false;
   }
 
  private:
@@ -310,6 +330,12 @@ class RayCost : public ceres::CostFunction {
       }
       visit(i, *nodes);
     }
+  }
+
+  std::vector<cv::Vec3d> ShadeAtStart() const {
+    std::vector<cv::Vec3d> shade(ray_.start_basis.size());
+    for (size_t i = 0; i < shade.size(); ++i) shade[i] = body_.shading->FromBasis(ray_.start_basis[i]);
+    return shade;
   }
 
   // The residuals at p with the shade S_i (empty: none), their Jacobian (row-major, when not
@@ -351,13 +377,23 @@ class RayCost : public ceres::CostFunction {
   const SmearedBody& body_;
   RaySamples ray_;
   double inv_noise_;
-  // The last point Evaluate computed, its residuals and Jacobian (row-major).
+  // |F − B| of the colours solved at a point (linear units; 0 where the solve failed).
+  static double Contrast(const RayColours& colours) {
+    if (!colours.ok) return 0.0;
+    cv::Vec3d mean_back(0, 0, 0);
+    for (const cv::Vec3d& b : colours.back) mean_back += b;
+    return cv::norm(colours.body - mean_back / static_cast<double>(colours.back.size()));
+  }
+
+  // A point Evaluate computed, its residuals, Jacobian (row-major; last_ only) and contrast.
   struct LastEvaluation {
     bool valid = false;
     std::array<double, kSmearParameters> p{};
     std::vector<double> residuals, jacobian;
+    double contrast = 0;
+    bool At(const double* q) const { return valid && std::equal(q, q + kSmearParameters, p.begin()); }
   };
-  mutable LastEvaluation last_;
+  mutable LastEvaluation last_, accepted_;
 };
 
 // The upper of the two middle values for an even count (internal::Median of track_series.hpp
@@ -370,10 +406,10 @@ double UpperMedian(std::vector<double> values) {
 // A ray whose mean square (units of the noise²) is below this is an inlier.
 double InlierLimit(const std::vector<double>& squares) { return kRayLossFactor * std::max(1.0, UpperMedian(squares)); }
 
-// The lamp's inverse distance (BodyShading::LitFrom) that best explains the rays at p, the centre
-// held: one Gauss–Newton step from the prior mean over the rays that are inliers there, its
-// derivative by a forward difference (a fresh shade of every sample). *lit (the shading the rays
-// read) is left lit by the result.
+// The lamp's inverse distance (BodyShading::LitFrom) that best explains the rays at the fit's
+// start p, the centre held: one Gauss–Newton step from the prior mean over the rays that are
+// inliers there, its derivative by a forward difference (each sample's shade from its basis at
+// the start). *lit (the shading the rays read) is left lit by the result.
 double FitLightDistance(const BodyShading& learnt, BodyShading* lit, const std::vector<RayCost*>& rays,
                         const double* p, double prior) {
   const Vector3d centre(p[kCentreX], 0, p[kCentreZ]);
@@ -381,7 +417,7 @@ double FitLightDistance(const BodyShading& learnt, BodyShading* lit, const std::
   std::vector<std::vector<double>> at_prior(rays.size());
   std::vector<double> squares(rays.size());
   for (size_t k = 0; k < rays.size(); ++k) {
-    rays[k]->FreshResiduals(p, &at_prior[k]);
+    rays[k]->ResidualsAtStart(&at_prior[k]);
     double sum = 0;
     for (double v : at_prior[k]) sum += v * v;
     squares[k] = sum / static_cast<double>(std::max<size_t>(1, at_prior[k].size()));
@@ -392,7 +428,7 @@ double FitLightDistance(const BodyShading& learnt, BodyShading* lit, const std::
   for (size_t k = 0; k < rays.size(); ++k)
     if (squares[k] < limit) {
       r0.insert(r0.end(), at_prior[k].begin(), at_prior[k].end());
-      rays[k]->FreshResiduals(p, &r1);
+      rays[k]->ResidualsAtStart(&r1);
     }
   const auto e0 = Eigen::Map<const Eigen::VectorXd>(r0.data(), static_cast<Eigen::Index>(r0.size()));
   const Eigen::VectorXd slope = (Eigen::Map<const Eigen::VectorXd>(r1.data(), static_cast<Eigen::Index>(r1.size())) - e0) / kLightStep;
@@ -587,7 +623,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
     const double fit_step = std::min(3.0, std::abs(smear_px.dot(ray.dir)) / kRampSamples);
     if (fit_step > step) ThinOut(&samples, static_cast<int>(std::ceil(length / fit_step)) + 1);
     const double loss_scale = std::sqrt(kRayLossFactor * 3.0 * samples.dirs.size());
-    auto* cost = new RayCost(body, std::move(samples), inv_noise, shaded && !fit_light, params);
+    auto* cost = new RayCost(body, std::move(samples), inv_noise, shaded, params);
     costs.push_back(cost);
     problem.AddResidualBlock(cost, new ceres::CauchyLoss(loss_scale), params);
   }
@@ -620,7 +656,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   // clips, at a second solve's cost.
   if (fit_light) {
     out.light_inverse_distance = FitLightDistance(*g.shading, &lit, costs, params, q.light_inverse_distance);
-    for (RayCost* cost : costs) cost->Shade(params);
+    for (RayCost* cost : costs) cost->Shade();
   }
   ceres::Solve(solver, &problem, &summary);
   for (double v : params)

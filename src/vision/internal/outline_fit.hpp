@@ -16,7 +16,8 @@
 // it drops only a term proportional to the residuals). On a smear longer than a quarter radius,
 // once the body's shading is learnt (body_shading.hpp), the body's term is c_i·S_i·F_k instead:
 // S_i its mean relative colour over the part of it that passed over the sample, evaluated at the
-// fit's start and held through the solve. The shading is read as lit by a lamp at a finite
+// fit's start and held through the solve (each sample's mean shading basis is taken once there,
+// and S_i under any lamp follows from it: BodyShading::FromBasis). The shading is read as lit by a lamp at a finite
 // distance (BodyShading::LitFrom: a lamp a metre away is seen from the body in another direction
 // once it has crossed the apparatus; on the ray-traced fast clips the centre otherwise lags by up
 // to 1 px on the longest smears): before the solve, the lamp's inverse distance κ is fitted at

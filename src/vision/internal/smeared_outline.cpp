@@ -137,7 +137,7 @@ double SmearNodes::DistanceAtMiddle(const Vector3d& d) const {
   return 0.5 * (delta(nodes_[lo]) + delta(nodes_[hi]));
 }
 
-double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, cv::Vec3d* shade) const {
+double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, BodyShading::Basis* shade) const {
   const double p = body_.px_per_rad, sigma = body_.sigma_px;
   const size_t count = nodes_.size();
   // u_n = −δ_n/σ at the nodes that can pull. The others are skipped, marked by a u beyond the
@@ -184,17 +184,16 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, cv::Vec3d* s
   }
   coverage /= static_cast<double>(pieces);
   if (shade) {
-    *shade = cv::Vec3d(1, 1, 1);
+    shade->setZero();
     if (body_.shading) {
-      cv::Vec3d sum(0, 0, 0);
       double weight = 0;
       for (size_t n = 0; n < count; ++n) {
         if (cdf[n] < 1e-6) continue;
         const double w = cdf[n] * (n == 0 || n == pieces ? 0.5 : 1.0);
-        sum += w * body_.shading->At(d, nodes_[n].w * nodes_[n].norm, body_.a);
+        *shade += w * body_.shading->LearntBasisAt(d, nodes_[n].w * nodes_[n].norm, body_.a);
         weight += w;
       }
-      if (weight > 0) *shade = sum / weight;
+      if (weight > 0) *shade /= weight;
     }
   }
   if (grad) {

@@ -62,11 +62,12 @@ class SmearNodes {
              const Eigen::Vector2d& bend = Eigen::Vector2d::Zero());
 
   // Coverage of the unit direction d (scaled space), and its gradient when grad != nullptr.
-  // shade (when not null, and the body has a shading): the body's mean relative colour over the
-  // part of it that passed over d (body_shading.hpp), the average over the nodes weighted by their
-  // coverage Φ (trapezoidal in τ); 1 where the body does not reach d. Its derivatives are not
-  // given: it changes slowly with the parameters next to the coverage.
-  double Coverage(const Eigen::Vector3d& d, SmearGradient* grad, cv::Vec3d* shade = nullptr) const;
+  // shade (when not null, and the body has a shading): the mean of the shading's basis over the
+  // part of the body that passed over d (BodyShading::LearntBasisAt), the average over the nodes
+  // weighted by their coverage Φ (trapezoidal in τ); zero where the body does not reach d.
+  // BodyShading::FromBasis turns it into the body's mean relative colour there under any light.
+  // Its derivatives are not given: it changes slowly with the parameters next to the coverage.
+  double Coverage(const Eigen::Vector3d& d, SmearGradient* grad, BodyShading::Basis* shade = nullptr) const;
 
   // The signed distance δ (px) of d from the outline at the window's middle (τ = 0).
   double DistanceAtMiddle(const Eigen::Vector3d& d) const;
