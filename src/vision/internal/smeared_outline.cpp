@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace uphill::internal {
 namespace {
@@ -11,8 +12,10 @@ using Eigen::Vector3d;
 
 constexpr double kInvSqrt2 = 0.70710678118654752440;
 constexpr double kInvSqrt2Pi = 0.39894228040143267794;
-// Beyond this many standard deviations Φ is 0 or 1 and φ is below 1e-15 in binary64.
-constexpr double kSaturated = 8.3;
+// Beyond this many standard deviations Φ is taken as 0 or 1 and φ as 0: Φ(−6) = 9.9e-10 and
+// φ(6) = 6.1e-9, so a coverage errs by at most 1e-9 (the fit reads it to about 1e-8, the noise
+// to about 1e-2), and a node that far from the edge costs no arithmetic.
+constexpr double kSaturated = 6.0;
 
 // Φ and φ on a grid of step 1/128 over ±kSaturated, computed once with erfc and exp, and read
 // back by cubic Hermite interpolation (the derivatives are known: Φ' = φ, φ' = −u·φ). The
@@ -104,6 +107,7 @@ SmearNodes::SmearNodes(const SmearedBody& body, const double* p, const Eigen::Ve
     : body_(body), shift_(p[kEdgeShift]) {
   const int m = std::max(1, pieces);
   nodes_.resize(m + 1);
+  reach_.assign(m + 1, 0.0);
   for (int n = 0; n <= m; ++n) {
     Node& node = nodes_[n];
     node.tau = -0.5 + static_cast<double>(n) / m;
@@ -115,14 +119,13 @@ SmearNodes::SmearNodes(const SmearedBody& body, const double* p, const Eigen::Ve
     const double sin_b = std::min(body.a / node.norm, 1.0 - 1e-12);
     node.beta = std::asin(sin_b);
     node.tan_beta = sin_b / std::sqrt(1 - sin_b * sin_b);
-    node.reach = 0;
     if (n > 0) {
       // |δ_n − δ_{n−1}| ≤ p·(θ(w_{n−1}, w_n) + |β_n − β_{n−1}|) by the triangle inequality of
       // angles; 1e-9 of it spares rounding.
       const Node& last = nodes_[n - 1];
       const double step =
           std::atan2(last.w.cross(node.w).norm(), last.w.dot(node.w)) + std::abs(node.beta - last.beta);
-      node.reach = last.reach + step * body.px_per_rad * (1 + 1e-9);
+      reach_[n] = reach_[n - 1] + step * body.px_per_rad * (1 + 1e-9);
     }
   }
 }
@@ -141,7 +144,7 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, BodyShading:
   const double p = body_.px_per_rad, sigma = body_.sigma_px;
   const size_t count = nodes_.size();
   // u_n = −δ_n/σ at the nodes that can pull. The others are skipped, marked by a u beyond the
-  // saturation: δ moves by at most reach_n − reach_k from node k to node n (Node::reach), so a
+  // saturation: δ moves by at most reach_n − reach_k from node k to node n (reach_), so a
   // node closer than that to an exact node k far in a tail lies in the same tail, with Φ = 0 or 1
   // and φ = 0, as do the pieces between such nodes (MeanCdf's constant case: exact, no pull).
   double u[33], sin_t[33], cos_t[33];
@@ -157,27 +160,40 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, BodyShading:
   for (size_t k = 0;;) {
     // Nodes n > k with reach_n − reach_k below |δ_k| − band are in δ_k's tail.
     const double room = std::abs(u[k]) * sigma - band;
+    const double from = reach_[k], tail = u[k] > 0 ? kSaturated + 1 : -kSaturated - 1;
     size_t j = k + 1;
-    for (; j < count && nodes_[j].reach - nodes_[k].reach < room; ++j) {
-      u[j] = u[k] > 0 ? kSaturated + 1 : -kSaturated - 1;
-    }
+    for (; j < count && reach_[j] - from < room; ++j) u[j] = tail;
     if (j == count) break;
     evaluate(j);
     // The piece (j − 1, j) needs both ends where node j is not in the same tail as the skipped.
     if (j - 1 > k && !(std::abs(u[j]) > kSaturated && (u[j] > 0) == (u[k] > 0))) evaluate(j - 1);
     k = j;
   }
+  // The pieces: one with both ends in the same saturated tail is Φ = 0 or 1 throughout, with no
+  // pull (MeanCdf's constant case, taken here without forming its nodes' Φ); the others ("live")
+  // are integrated, and their nodes listed for the gradient.
   const size_t pieces = count - 1;
   double coverage = 0;
-  double du[33] = {0};
-  double cdf[33];
-  NodeCdf left(u[0]);
-  cdf[0] = left.cdf;
+  double du[33];
+  size_t live[33], lives = 0;
+  std::optional<NodeCdf> left;  // node j's, when the piece before it was live
   for (size_t j = 0; j < pieces; ++j) {
-    const NodeCdf right(u[j + 1]);
-    cdf[j + 1] = right.cdf;
+    const double a = u[j], b = u[j + 1];
+    if ((a > kSaturated && b > kSaturated) || (a < -kSaturated && b < -kSaturated)) {
+      coverage += a > 0 ? 1.0 : 0.0;
+      left.reset();
+      continue;
+    }
+    if (!left) {
+      left.emplace(a);
+      du[j] = 0;
+      live[lives++] = j;
+    }
+    const NodeCdf right(b);
+    du[j + 1] = 0;
+    live[lives++] = j + 1;
     double d0, d1;
-    coverage += MeanCdf(left, right, &d0, &d1);
+    coverage += MeanCdf(*left, right, &d0, &d1);
     du[j] += d0;
     du[j + 1] += d1;
     left = right;
@@ -188,8 +204,9 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, BodyShading:
     if (body_.shading) {
       double weight = 0;
       for (size_t n = 0; n < count; ++n) {
-        if (cdf[n] < 1e-6) continue;
-        const double w = cdf[n] * (n == 0 || n == pieces ? 0.5 : 1.0);
+        const double cdf = u[n] > kSaturated ? 1.0 : u[n] < -kSaturated ? 0.0 : NodeCdf(u[n]).cdf;
+        if (cdf < 1e-6) continue;
+        const double w = cdf * (n == 0 || n == pieces ? 0.5 : 1.0);
         *shade += w * body_.shading->LearntBasisAt(d, nodes_[n].w * nodes_[n].norm, body_.a);
         weight += w;
       }
@@ -198,8 +215,9 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, BodyShading:
   }
   if (grad) {
     grad->fill(0.0);
-    for (size_t n = 0; n < count; ++n) {
-      if (du[n] == 0) continue;  // a node in the saturated tails on both sides: no pull
+    for (size_t i = 0; i < lives; ++i) {
+      const size_t n = live[i];
+      if (du[n] == 0) continue;  // no pull
       // ∂c/∂δ_n = ∂c/∂u_n · (−1/σ); ∂δ_n/∂(x, z) from ∂θ/∂v = −(d − cosθ·ŵ)/(|v|·sinθ) and
       // ∂β/∂v = −tanβ·ŵ/|v| (the same for D, scaled by τ_n).
       const Node& node = nodes_[n];

@@ -76,11 +76,13 @@ class SmearNodes {
   struct Node {
     Eigen::Vector3d w;  // unit direction of C(τ) − O
     double norm, beta, tan_beta, tau;
-    double reach;  // px: a bound of |δ_n − δ_0| for every direction, summed over the pieces
   };
   const SmearedBody& body_;
   double shift_;
   std::vector<Node> nodes_;
+  // px, per node: a bound of |δ_n − δ_0| for every direction, summed over the pieces (apart from
+  // the nodes: Coverage searches it).
+  std::vector<double> reach_;
 };
 
 }  // namespace uphill::internal
