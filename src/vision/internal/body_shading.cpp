@@ -31,9 +31,9 @@ BodyShading::Basis BodyShading::OfNormal(const Eigen::Vector3d& n) {
 
 BodyShading::Basis BodyShading::LearntBasisAt(const Eigen::Vector3d& d, const Eigen::Vector3d& v, double a) const {
   const double b = d.dot(v), disc = b * b - v.squaredNorm() + a * a;
-  // The surface point the ray meets first; a ray that misses reads the limb point nearest to it.
-  Eigen::Vector3d n = disc >= 0 ? Eigen::Vector3d((b - std::sqrt(disc)) * d - v) : Eigen::Vector3d(b * d - v);
-  n.normalize();
+  // The surface point the ray meets first (its distance from the centre is a); a ray that misses
+  // reads the limb point nearest to it.
+  Eigen::Vector3d n = disc >= 0 ? Eigen::Vector3d(((b - std::sqrt(disc)) * d - v) / a) : (b * d - v).normalized();
   // Beyond the part of the disc the views show (sin of the angle to the eye above kReliable) the
   // quadratic is an extrapolation: the normal at kReliable in the same direction is read instead.
   const double towards_eye = -n.dot(d);
@@ -41,6 +41,7 @@ BodyShading::Basis BodyShading::LearntBasisAt(const Eigen::Vector3d& d, const Ei
     const Eigen::Vector3d across = (n + towards_eye * d).normalized();
     n = kReliable * across - kReliableCos * d;
   }
+  if (s_ == 1) return OfNormal(n);
   n.y() *= s_;  // back from the scaled space: normals scale by the inverse transpose
   return OfNormal(n.normalized());
 }

@@ -123,14 +123,15 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
     // σ = 1 ± 1 %: a soft shadow or uneven light, not a dark pattern taken for a shadowed table.
     const double w = (noise / kShadowPrior) * (noise / kShadowPrior);
     a(0, 0) += w, y(0) += w, a(1, 1) += w;
-    const Eigen::Matrix<double, 5, 1> x = a.ldlt().solve(y);
+    const Eigen::LDLT<Eigen::Matrix<double, 5, 5>> ldlt(a);
+    const Eigen::Matrix<double, 5, 1> x = ldlt.solve(y);
     if (!x.allFinite() || a.diagonal().tail<3>().minCoeff() < 1e-9) {
       for (size_t i = 0; i < n; ++i) out.back[i] = ray.back[i];
       return out;
     }
     for (size_t i = 0; i < n; ++i) out.back[i] = (x(0) + x(1) * ray.along[i]) * cv::Vec3d(ray.back[i]);
     out.body = cv::Vec3d(x(2), x(3), x(4));
-    out.known_inverse = a.inverse();
+    out.known_inverse = ldlt.solve(Eigen::Matrix<double, 5, 5>::Identity());
     out.ok = true;
     return out;
   }
