@@ -50,14 +50,16 @@ struct SmearedBody {
   const BodyShading* shading = nullptr;           // the body's appearance (ready), or none
 };
 
-// Pieces M for a blur of `blur_px` on a body of `radius_px` (see the header).
+// Pieces M for a blur of `blur_px` on a body of `radius_px` (see the header), at most kMostPieces.
+constexpr int kMostPieces = 32;
 int SmearPieces(double blur_px, double radius_px);
 
 // The nodes of one exposure window: the body at τ_n = −½ + n/M, n = 0..M.
 class SmearNodes {
  public:
   // params: (x, z, D_x, D_z, b) as SmearParameter; offset: added to the centre's (x, z) (the
-  // rolling shutter's shift of this ray's rows); bend: A of the header, m.
+  // rolling shutter's shift of this ray's rows); bend: A of the header, m; pieces: 1 to
+  // kMostPieces (clamped).
   SmearNodes(const SmearedBody& body, const double* params, const Eigen::Vector2d& offset, int pieces,
              const Eigen::Vector2d& bend = Eigen::Vector2d::Zero());
 
@@ -79,10 +81,12 @@ class SmearNodes {
   };
   const SmearedBody& body_;
   double shift_;
-  std::vector<Node> nodes_;
+  // In place rather than on the heap: a rolling shutter builds nodes for nearly every sample.
+  int count_ = 0;
+  std::array<Node, kMostPieces + 1> nodes_;
   // px, per node: a bound of |δ_n − δ_0| for every direction, summed over the pieces (apart from
-  // the nodes: Coverage searches it).
-  std::vector<double> reach_;
+  // the nodes: Coverage scans it).
+  std::array<double, kMostPieces + 1> reach_;
 };
 
 }  // namespace uphill::internal
