@@ -23,6 +23,10 @@ using internal::FitOutcome;
 using internal::FitRequest;
 
 constexpr double kNarrowHalfWidthPx = 1.5;  // second pass, around the first fit
+// Ceres iterations of a narrow pass (outline_fit.hpp, FitRequest::iterations): the ray-traced
+// clips measure as with 3 (spheroid-band 0.251 px against 0.248, fast-360-30 0.238 against 0.237)
+// at 10 % less of the tracker's time.
+constexpr int kNarrowIterations = 2;
 constexpr int kHistoryGap = 5;              // frames without the body after which we predict no more
 constexpr size_t kHistory = 6;              // samples the prediction is fitted to
 constexpr double kSceneChangeFactor = 4;    // scene residual jump (times its usual level, plus 0.01)
@@ -279,6 +283,7 @@ struct BallTracker::Impl {
     q.smear = Vector2d(first.p[internal::kSmearX], first.p[internal::kSmearZ]);
     q.fit_light = true;
     q.half_width_px = kNarrowHalfWidthPx;
+    q.iterations = kNarrowIterations;
     FitOutcome second = internal::FitOutline(geometry, view, *background, q);
     return second.ok ? second : first;
   }
@@ -290,6 +295,7 @@ struct BallTracker::Impl {
     const FitRequest wide = q;
     q.half_width_px = kNarrowHalfWidthPx + 1;
     q.fit_edge_shift = true;
+    q.iterations = kNarrowIterations;
     const FitOutcome one = internal::FitOutline(geometry, view, *background, q);
     if (one.ok && (geometry.Project(one.p[internal::kCentreX], one.p[internal::kCentreZ]) -
                    geometry.Project(q.centre.x(), q.centre.y())).norm() < 0.5)
@@ -534,6 +540,7 @@ struct BallTracker::Impl {
     q.reference_row = geometry.Project(q.centre.x(), q.centre.y()).y();
     q.half_width_px = kNarrowHalfWidthPx;
     q.fit_edge_shift = q.fit_light = true;
+    q.iterations = kNarrowIterations;
     q.light_inverse_distance = fit.light_inverse_distance;
     const cv::Rect box = KeptWindow(q.centre, 2 * Vector2d(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]), frame);
     if (!box.empty()) readout_frames.push_back({frame(box).clone(), box.tl(), gain, q});

@@ -668,12 +668,8 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   if (!q.fit_edge_shift) problem.SetManifold(params, new ceres::SubsetManifold(kSmearParameters, {kEdgeShift}));
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;
-  // Capped at 3: with Kaufman's Jacobian the step shrinks about four-fold per iteration, and the
-  // ray-traced clips measure the same with 3 as with 6 (docs/track.md, "The fit's Jacobian", with
-  // the background held to ± 0.5 %; the phone clip at ± 1 %); 2 are too few for a fit started from
-  // a coarse search (the phone clip then locks on a wrong place). Each iteration costs a Jacobian
-  // of every sample.
-  solver.max_num_iterations = 3;
+  // The request's cap (FitRequest::iterations). Each iteration costs a Jacobian of every sample.
+  solver.max_num_iterations = std::max(1, q.iterations);
   solver.num_threads = 1;
   solver.logging_type = ceres::SILENT;
   // Parameters are metres near 0.5 and pixels: 1e-7 of the centre is below 1e-4 px; the cost's

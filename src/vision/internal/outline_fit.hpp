@@ -36,8 +36,9 @@
 // path's bend over the exposure (the motion's acceleration) is the caller's prediction, held.
 //
 // Accuracy: see ball_tracker.hpp. Cost: at most rays × samples × (pieces + 1) outline evaluations
-// per Jacobian; at most 3 Ceres iterations per pass; one pass where the model measured the previous
-// frame (ball_tracker.cpp, MeasureNear), else two or more.
+// per Jacobian; at most FitRequest::iterations Ceres iterations per pass; one pass where the
+// model measured the previous frame (ball_tracker.cpp, MeasureNear), else two or more. Ceres
+// solves each ray as 6 rows (reduced_rows.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -80,6 +81,12 @@ struct FitRequest {
   bool fit_edge_shift = true;           // false: b held at 0 (a first pass far from the edges)
   double light_inverse_distance = 0;    // 1/m: the lamp's, prior mean (BodyShading::LitFrom)
   bool fit_light = true;                // false: held at its prior mean (a first pass)
+  // Ceres iterations at most. With Kaufman's Jacobian the step shrinks about four-fold per
+  // iteration: from a coarse search 3 (the ray-traced clips measure the same with 3 as with 6;
+  // with 2 the phone clip locks on a wrong place); a narrow pass around a fit or a checked
+  // prediction, started within half a pixel or so, is done in 2 (docs/track.md, "The fit's
+  // Jacobian").
+  int iterations = 3;
 };
 
 // The picture a fit reads: a whole frame (origin 0, 0) or a window of one kept for a later refit,
