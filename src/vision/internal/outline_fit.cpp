@@ -88,9 +88,12 @@ struct RayColours {
   cv::Vec3d body;
   bool ok = false;
   // The inverse of the solve's normal matrix (priors included): known background, over
-  // (σ0, σ1, F); unknown, over (B0, B1, F) of each channel. ProjectOutColours needs them.
+  // (σ0, σ1, F); unknown, over (B0, B1, F) of each channel. ProjectedGram needs them.
   Eigen::Matrix<double, 5, 5> known_inverse;
   std::array<Eigen::Matrix3d, 3> unknown_inverse;
+  // The design's own Gram matrix AᵀA (the normal matrix without the priors), likewise.
+  Eigen::Matrix<double, 5, 5> known_design;
+  std::array<Eigen::Matrix3d, 3> unknown_design;
 };
 
 RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, const std::vector<cv::Vec3d>& shade,
@@ -126,6 +129,7 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
     }
     a(1, 0) = a(0, 1);
     for (int k = 2; k < 5; ++k) a(k, 0) = a(0, k), a(k, 1) = a(1, k);
+    out.known_design = a;
     // σ = 1 ± 1 %: a soft shadow or uneven light, not a dark pattern taken for a shadowed table.
     const double w = (noise / kShadowPrior) * (noise / kShadowPrior);
     a(0, 0) += w, y(0) += w, a(1, 1) += w;
@@ -154,6 +158,7 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
       a += row * row.transpose();
       for (int ch = 0; ch < 3; ++ch) y.col(ch) += row * static_cast<double>(ray.image[i][ch]);
     }
+    const Eigen::Matrix3d without_priors = a;
     a(1, 1) += 1e-6 * (a(0, 0) + 1e-12);
     const Eigen::LDLT<Eigen::Matrix3d> ldlt(a);
     const Eigen::Matrix3d x = ldlt.solve(y);
@@ -166,63 +171,93 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
       for (size_t i = 0; i < n; ++i) out.back[i][ch] = x(0, ch) + x(1, ch) * ray.along[i];
       out.body[ch] = x(2, ch);
       out.unknown_inverse[ch] = ldlt.solve(Eigen::Matrix3d::Identity());
+      out.unknown_design[ch] = without_priors;
     }
   }
   out.ok = true;
   return out;
 }
 
-// Kaufman's Jacobian of the variable projection: the columns ∂r/∂p at the colours held (row-major,
-// 3 rows per sample) with their part in the span of the colours' design removed, J ← J − A·N⁻¹·Aᵀ·J
-// (A the colour solve's design at the coverages c, N its normal matrix with the priors). Without
-// the projection a step of the centre is met by no change of the colours, where the colours do
-// change with it; Gauss–Newton then converges only linearly (on fast-360-30 the step halved each
-// iteration).
-void ProjectOutColours(const RaySamples& ray, const std::vector<double>& c, const std::vector<cv::Vec3d>& shade,
-                       const RayColours& colours, double* jacobian) {
+// The Gram matrix of [J r] for a ray (reduced_rows.hpp): r its residuals, 3 per sample, and J
+// Kaufman's Jacobian of the variable projection: the columns ∂r/∂p at the colours held, J₀ (row
+// (i, ch): k·∇c_i, k = −(F − B)/noise), less their part in the span of the colours' design A,
+// J = J₀ − A·N⁻¹·Aᵀ·J₀ (N the colour solve's normal matrix, priors included). Without that
+// projection a step of the centre is met by no change of the colours, where the colours do change
+// with it, and Gauss–Newton converges only linearly (on fast-360-30 the step halved each
+// iteration). J is not formed: with g = AᵀJ₀ and H = N⁻¹·g,
+//   JᵀJ = J₀ᵀJ₀ − gᵀH − Hᵀg + Hᵀ·(AᵀA)·H   and   Jᵀr = J₀ᵀr − Hᵀ·(Aᵀr),
+// sums over the samples in one pass. `residuals`: the ray's r (Residuals).
+ReducedRows ProjectedGram(const RaySamples& ray, const std::vector<double>& c, const std::vector<SmearGradient>& grad,
+                          const std::vector<cv::Vec3d>& shade, const RayColours& colours, const double* residuals,
+                          double inv_noise) {
+  using Vector5 = Eigen::Matrix<double, kSmearParameters, 1>;
+  using Matrix5 = Eigen::Matrix<double, kSmearParameters, kSmearParameters>;
   const size_t n = c.size();
+  const bool known = !ray.back.empty();
   const auto body = [&](size_t i, int ch) { return shade.empty() ? c[i] : c[i] * shade[i][ch]; };
-  const auto row = [&](size_t i, int ch) { return jacobian + (3 * i + ch) * kSmearParameters; };
-  using Columns = Eigen::Matrix<double, 1, kSmearParameters>;
-  if (!ray.back.empty()) {
-    // A's row (i, ch): (u·B, u·t·B, k at column 2 + ch), u = 1 − c_i, k the body's column.
-    Eigen::Matrix<double, 5, kSmearParameters> g = Eigen::Matrix<double, 5, kSmearParameters>::Zero();
-    for (size_t i = 0; i < n; ++i) {
-      const double u = 1 - c[i], t = ray.along[i];
-      for (int ch = 0; ch < 3; ++ch) {
-        const Eigen::Map<const Columns> j(row(i, ch));
+  Matrix5 jj = Matrix5::Zero(), aj = Matrix5::Zero();  // J₀ᵀJ₀; AᵀJ₀ (known background)
+  Vector5 jr = Vector5::Zero(), ar = Vector5::Zero();  // J₀ᵀr; Aᵀr (known background)
+  std::array<Eigen::Matrix<double, 3, kSmearParameters>, 3> aj_ch{};  // per channel (unknown background)
+  std::array<Eigen::Vector3d, 3> ar_ch{};
+  for (auto& m : aj_ch) m.setZero();
+  for (auto& v : ar_ch) v.setZero();
+  double rr = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Map<const Vector5> g(grad[i].data());
+    const cv::Vec3d& B = colours.back[i];
+    const cv::Vec3d F = !colours.ok ? B : shade.empty() ? colours.body : colours.body.mul(shade[i]);
+    const double u = 1 - c[i], t = ray.along[i];
+    double kk = 0, kr = 0, bk = 0, br = 0;
+    double body_k[3];
+    for (int ch = 0; ch < 3; ++ch) {
+      const double r = residuals[3 * i + ch], k = -(F[ch] - B[ch]) * inv_noise;
+      kk += k * k, kr += k * r, rr += r * r;
+      if (!colours.ok) continue;
+      const double a_body = body(i, ch);
+      if (known) {
         const double b = ray.back[i][ch];
-        g.row(0) += u * b * j;
-        g.row(1) += u * t * b * j;
-        g.row(2 + ch) += body(i, ch) * j;
+        bk += b * k, br += b * r;
+        body_k[ch] = a_body * k;
+        ar(2 + ch) += a_body * r;
+      } else {
+        const double w[3] = {u * k, u * t * k, a_body * k};
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < kSmearParameters; ++b) aj_ch[ch](a, b) += w[a] * g(b);
+        ar_ch[ch] += Eigen::Vector3d(u, u * t, a_body) * r;
       }
     }
-    const Eigen::Matrix<double, 5, kSmearParameters> h = colours.known_inverse * g;
-    for (size_t i = 0; i < n; ++i) {
-      const double u = 1 - c[i], t = ray.along[i];
-      for (int ch = 0; ch < 3; ++ch) {
-        const double b = ray.back[i][ch];
-        Eigen::Map<Columns>(row(i, ch)) -= u * b * h.row(0) + u * t * b * h.row(1) + body(i, ch) * h.row(2 + ch);
-      }
+    // By hand: Eigen's rank updates do not unroll at this size, and this loop is the pass.
+    for (int a = 0; a < kSmearParameters; ++a) {
+      const double kg = kk * g(a);
+      for (int b = a; b < kSmearParameters; ++b) jj(a, b) += kg * g(b);
+      jr(a) += kr * g(a);
     }
-    return;
-  }
-  // Each channel's own (B0, B1, F): A's row (i, ch) is (u, u·t, k) in that channel's columns.
-  for (int ch = 0; ch < 3; ++ch) {
-    Eigen::Matrix<double, 3, kSmearParameters> g = Eigen::Matrix<double, 3, kSmearParameters>::Zero();
-    for (size_t i = 0; i < n; ++i) {
-      const double u = 1 - c[i];
-      const Eigen::Map<const Columns> j(row(i, ch));
-      g.row(0) += u * j;
-      g.row(1) += u * ray.along[i] * j;
-      g.row(2) += body(i, ch) * j;
-    }
-    const Eigen::Matrix<double, 3, kSmearParameters> h = colours.unknown_inverse[ch] * g;
-    for (size_t i = 0; i < n; ++i) {
-      const double u = 1 - c[i];
-      Eigen::Map<Columns>(row(i, ch)) -= u * h.row(0) + u * ray.along[i] * h.row(1) + body(i, ch) * h.row(2);
+    if (colours.ok && known) {
+      const double w[5] = {u * bk, u * t * bk, body_k[0], body_k[1], body_k[2]};
+      for (int a = 0; a < 5; ++a)
+        for (int b = 0; b < kSmearParameters; ++b) aj(a, b) += w[a] * g(b);
+      ar(0) += u * br, ar(1) += u * t * br;
     }
   }
+  for (int a = 0; a < kSmearParameters; ++a)
+    for (int b = 0; b < a; ++b) jj(a, b) = jj(b, a);
+  if (colours.ok && known) {
+    const Matrix5 h = colours.known_inverse * aj;
+    jj += -aj.transpose() * h - h.transpose() * aj + h.transpose() * colours.known_design * h;
+    jr -= h.transpose() * ar;
+  } else if (colours.ok) {
+    for (int ch = 0; ch < 3; ++ch) {
+      const Eigen::Matrix<double, 3, kSmearParameters> h = colours.unknown_inverse[ch] * aj_ch[ch];
+      jj += -aj_ch[ch].transpose() * h - h.transpose() * aj_ch[ch] + h.transpose() * colours.unknown_design[ch] * h;
+      jr -= h.transpose() * ar_ch[ch];
+    }
+  }
+  ReducedRows gram;
+  gram.topLeftCorner<kSmearParameters, kSmearParameters>() = jj;
+  gram.topRightCorner<kSmearParameters, 1>() = jr;
+  gram.bottomLeftCorner<1, kSmearParameters>() = jr.transpose();
+  gram(kSmearParameters, kSmearParameters) = rr;
+  return gram;
 }
 
 class RayCost : public ceres::CostFunction {
@@ -282,7 +317,7 @@ class RayCost : public ceres::CostFunction {
       }
     std::vector<double> r(3 * ray_.dirs.size());
     RayColours colours;
-    Compute(p, ray_.shade, r.data(), nullptr, &colours);
+    Compute(p, ray_.shade, r.data(), &colours);
     double sum = 0;
     for (double v : r) sum += v * v;
     *contrast = Contrast(colours), *mean_square = sum / count;
@@ -294,13 +329,13 @@ class RayCost : public ceres::CostFunction {
   void ResidualsAtStart(std::vector<double>* r) const {
     const size_t at = r->size();
     r->resize(at + 3 * ray_.dirs.size());
-    Residuals(ray_.start_coverage, {}, ShadeAtStart(), r->data() + at, nullptr, nullptr);
+    Residuals(ray_.start_coverage, ShadeAtStart(), r->data() + at, nullptr);
   }
 
   // The sum of squared residuals (units of the noise²) at p.
   double ChiSquare(const double* p) const {
     std::vector<double> r(3 * ray_.dirs.size());
-    Compute(p, ray_.shade, r.data(), nullptr, nullptr);
+    Compute(p, ray_.shade, r.data(), nullptr);
     double sum = 0;
     for (double v : r) sum += v * v;
     return sum;
@@ -340,39 +375,25 @@ class RayCost : public ceres::CostFunction {
     return shade;
   }
 
-  // The residuals at p with the shade S_i (empty: none), their Jacobian (row-major, when not
-  // null) and the colours solved there (when not null).
-  void Compute(const double* p, const std::vector<cv::Vec3d>& shade, double* residuals, double* jacobian,
-               RayColours* solved) const {
-    const size_t n = ray_.dirs.size();
-    std::vector<double> c(n);
-    std::vector<SmearGradient> grad(jacobian ? n : 0);
-    ForEachSample(p, [&](size_t i, const SmearNodes& nodes) {
-      c[i] = nodes.Coverage(ray_.dirs[i], grad.empty() ? nullptr : &grad[i]);
-    });
-    Residuals(c, grad, shade, residuals, jacobian, solved);
+  // The residuals at p with the shade S_i (empty: none), and the colours solved there (when not
+  // null).
+  void Compute(const double* p, const std::vector<cv::Vec3d>& shade, double* residuals, RayColours* solved) const {
+    std::vector<double> c(ray_.dirs.size());
+    ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { c[i] = nodes.Coverage(ray_.dirs[i], nullptr); });
+    Residuals(c, shade, residuals, solved);
   }
 
-  // The residuals given the samples' coverages c, and their Jacobian from the coverages'
-  // gradients (when asked for).
-  void Residuals(const std::vector<double>& c, const std::vector<SmearGradient>& grad,
-                 const std::vector<cv::Vec3d>& shade, double* residuals, double* jacobian, RayColours* solved) const {
+  // The residuals given the samples' coverages c, and the colours solved there (when not null).
+  void Residuals(const std::vector<double>& c, const std::vector<cv::Vec3d>& shade, double* residuals,
+                 RayColours* solved) const {
     const size_t n = ray_.dirs.size();
     RayColours colours = SolveColours(ray_, c, shade, 1.0 / inv_noise_);
     for (size_t i = 0; i < n; ++i) {
       const cv::Vec3d I = ray_.image[i];
       const cv::Vec3d& B = colours.back[i];
       const cv::Vec3d F = !colours.ok ? B : shade.empty() ? colours.body : colours.body.mul(shade[i]);
-      for (int ch = 0; ch < 3; ++ch) {
-        residuals[3 * i + ch] = (I[ch] - B[ch] - c[i] * (F[ch] - B[ch])) * inv_noise_;
-        if (!grad.empty()) {
-          double* row = jacobian + (3 * i + ch) * kSmearParameters;
-          const double k = -(F[ch] - B[ch]) * inv_noise_;
-          for (int q = 0; q < kSmearParameters; ++q) row[q] = k * grad[i][q];
-        }
-      }
+      for (int ch = 0; ch < 3; ++ch) residuals[3 * i + ch] = (I[ch] - B[ch] - c[i] * (F[ch] - B[ch])) * inv_noise_;
     }
-    if (!grad.empty() && colours.ok) ProjectOutColours(ray_, c, shade, colours, jacobian);
     if (solved) *solved = std::move(colours);
   }
 
@@ -402,29 +423,28 @@ class RayCost : public ceres::CostFunction {
 
   // The ray at p reduced to *out (see Evaluate).
   void Reduce(const double* p, Reduced* out) const {
-    const size_t m = 3 * ray_.dirs.size();
-    std::vector<double>& r = scratch_.residuals;
-    std::vector<double>& jacobian = scratch_.jacobian;
-    r.resize(m), jacobian.resize(m * kSmearParameters);
+    const size_t n = ray_.dirs.size();
+    std::vector<double> c(n);
+    std::vector<SmearGradient> grad(n);
+    ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { c[i] = nodes.Coverage(ray_.dirs[i], &grad[i]); });
+    std::vector<double>& r = scratch_residuals_;
+    r.resize(3 * n);
     RayColours colours;
-    Compute(p, ray_.shade, r.data(), jacobian.data(), &colours);
-    const ReducedRows factor = ReduceRows(jacobian.data(), r.data(), m);
+    Residuals(c, ray_.shade, r.data(), &colours);
+    const ReducedRows gram = ProjectedGram(ray_, c, grad, ray_.shade, colours, r.data(), inv_noise_);
+    const ReducedRows factor = FactorGram(gram);
     for (int i = 0; i < kReduced; ++i) {
       out->residuals[i] = factor(i, kSmearParameters);
       for (int j = 0; j < kSmearParameters; ++j) out->jacobian[i * kSmearParameters + j] = factor(i, j);
     }
-    double sum = 0;
-    for (double v : r) sum += v * v;
-    out->sum_of_squares = sum;
+    out->sum_of_squares = gram(kSmearParameters, kSmearParameters);
     out->contrast = Contrast(colours);
     std::copy(p, p + kSmearParameters, out->p.begin());
     out->valid = true;
   }
 
   mutable Reduced last_, accepted_;
-  mutable struct {
-    std::vector<double> residuals, jacobian;  // the full ray's, kept for their memory only
-  } scratch_;
+  mutable std::vector<double> scratch_residuals_;  // the full ray's, kept for their memory only
 };
 
 // The upper of the two middle values for an even count (internal::Median of track_series.hpp
