@@ -32,7 +32,7 @@ constexpr double kShadedSmear = 0.25;
 // leave it at its prior), and the step of its numerical derivative.
 constexpr double kLightPrior = 0.5;
 constexpr double kLightStep = 0.02;
-constexpr double kSharedRows = 0.5;  // a rolling shutter's samples this many rows apart share nodes
+constexpr double kSharedRows = 0.5;  // a rolling shutter's ray spanning fewer rows shares one window
 // Samples a smear's ramp along a ray is fitted at: on the fast ray-traced clips 16 measure as the
 // window's 41 did (fast-360-30 0.256 px, against 0.255) in two thirds of the time; 8 to 12 move
 // the painted spheroid's clip from 0.26 to 0.28-0.29 px.
@@ -349,8 +349,9 @@ class RayCost : public ceres::CostFunction {
 
  private:
   // visit(i, nodes) for every sample i with the smear's nodes it sees: the ray's, or with a
-  // rolling shutter its own row's (shared by the samples within kSharedRows of a row: the body
-  // moves by V·δ per row, 0.05 px at 2000 px/s and a phone's 25 ms over 1080 rows).
+  // rolling shutter its own row's (the body moves by V·δ per row, 0.05 px at 2000 px/s and a
+  // phone's 25 ms over 1080 rows), interpolated between the nodes of the ray's first and last
+  // rows (SmearNodes' second constructor).
   template <typename Visit>
   void ForEachSample(const double* p, Visit visit) const {
     if (ray_.rows.empty()) {
@@ -358,15 +359,17 @@ class RayCost : public ceres::CostFunction {
       for (size_t i = 0; i < ray_.dirs.size(); ++i) visit(i, nodes);
       return;
     }
-    std::optional<SmearNodes> nodes;
-    double row = 0;
-    for (size_t i = 0; i < ray_.dirs.size(); ++i) {
-      if (!nodes || std::abs(ray_.rows[i] - row) > kSharedRows) {
-        row = ray_.rows[i];
-        nodes.emplace(body_, p, ray_.velocity * (row * ray_.row_delay), ray_.pieces, ray_.bend);
-      }
-      visit(i, *nodes);
+    const auto [lo, hi] = std::minmax_element(ray_.rows.begin(), ray_.rows.end());
+    const auto window = [&](double row) {
+      return SmearNodes(body_, p, ray_.velocity * (row * ray_.row_delay), ray_.pieces, ray_.bend);
+    };
+    if (*hi - *lo <= kSharedRows) {
+      const SmearNodes nodes = window(0.5 * (*lo + *hi));
+      for (size_t i = 0; i < ray_.dirs.size(); ++i) visit(i, nodes);
+      return;
     }
+    const SmearNodes first = window(*lo), last = window(*hi);
+    for (size_t i = 0; i < ray_.dirs.size(); ++i) visit(i, SmearNodes(first, last, (ray_.rows[i] - *lo) / (*hi - *lo)));
   }
 
   std::vector<cv::Vec3d> ShadeAtStart() const {

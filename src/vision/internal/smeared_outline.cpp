@@ -139,6 +139,20 @@ SmearNodes::SmearNodes(const SmearedBody& body, const double* p, const Eigen::Ve
   }
 }
 
+SmearNodes::SmearNodes(const SmearNodes& a, const SmearNodes& b, double t)
+    : body_(a.body_), shift_(a.shift_), count_(a.count_) {
+  for (int n = 0; n < count_; ++n) {
+    const Node &na = a.nodes_[n], &nb = b.nodes_[n];
+    Node& node = nodes_[n];
+    node.w = na.w + t * (nb.w - na.w);
+    node.norm = na.norm + t * (nb.norm - na.norm);
+    node.beta = na.beta + t * (nb.beta - na.beta);
+    node.tan_beta = na.tan_beta + t * (nb.tan_beta - na.tan_beta);
+    node.tau = na.tau;
+    reach_[n] = std::max(a.reach_[n], b.reach_[n]) * (1 + 1e-6);
+  }
+}
+
 double SmearNodes::DistanceAtMiddle(const Vector3d& d) const {
   // Linear between the nodes either side of τ = 0 (exact for an odd count of pieces' midpoint
   // up to the bend of δ, which is below rounding for the use made of it: windows and masks).

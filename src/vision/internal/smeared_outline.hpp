@@ -63,6 +63,13 @@ class SmearNodes {
   SmearNodes(const SmearedBody& body, const double* params, const Eigen::Vector2d& offset, int pieces,
              const Eigen::Vector2d& bend = Eigen::Vector2d::Zero());
 
+  // The nodes of a window between two others of the same body, parameters and pieces that differ
+  // only in their offset (a rolling shutter's rows), at the offset a + t·(b − a), t in [0, 1]: each
+  // node's quantities interpolated linearly. They are smooth in the offset, so the error is of
+  // second order: for offsets 1 mm apart at 0.6 m, below 4e-7 rad (1e-3 px at 2000 px per rad);
+  // the reach (a bound) is taken as the larger of the two ends' with a 1e-6 relative margin.
+  SmearNodes(const SmearNodes& a, const SmearNodes& b, double t);
+
   // Coverage of the unit direction d (scaled space), and its gradient when grad != nullptr.
   // shade (when not null, and the body has a shading): the mean of the shading's basis over the
   // part of the body that passed over d (BodyShading::LearntBasisAt), the average over the nodes
