@@ -14,9 +14,9 @@
 //
 // Accuracy: exact for est(q) linear in q with s in [0, 0.8] and the fixed point inside [0, most]
 // (tests/vision_rolling_shutter_test.cpp); on the ray-traced phone clip (readout 25 ms, 15
-// frames) it gives 19.0 ± 2.9 ms with the renderer's camera and 19.4 ± 4.1 ms with the user's
-// calibration, where the median of the frames' estimates, the first five probed from a global
-// shutter, gave 13.7 and 14.4 ms with no uncertainty (docs/track.md).
+// frames) it gives 28.2 ± 2.2 ms with tracker version 12, with the renderer's camera as with the
+// user's calibration, where the median of the frames' estimates, the first five probed from a
+// global shutter, gave 13.7 and 14.4 ms with no uncertainty (docs/track.md).
 #pragma once
 
 #include <cstddef>
