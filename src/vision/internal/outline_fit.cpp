@@ -7,7 +7,6 @@
 #include <array>
 #include <cmath>
 #include <memory>
-#include <optional>
 #include <string>
 
 #include "reduced_rows.hpp"
@@ -372,6 +371,7 @@ class RayCost : public ceres::CostFunction {
     for (size_t i = 0; i < ray_.dirs.size(); ++i) visit(i, SmearNodes(first, last, (ray_.rows[i] - *lo) / (*hi - *lo)));
   }
 
+  // S_i of every sample from its basis at the fit's start, under the body's light as it is now.
   std::vector<cv::Vec3d> ShadeAtStart() const {
     std::vector<cv::Vec3d> shade(ray_.start_basis.size());
     for (size_t i = 0; i < shade.size(); ++i) shade[i] = body_.shading->FromBasis(ray_.start_basis[i]);

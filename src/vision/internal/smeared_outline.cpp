@@ -3,7 +3,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <optional>
 
 namespace uphill::internal {
 namespace {
@@ -130,10 +129,12 @@ SmearNodes::SmearNodes(const SmearedBody& body, const double* p, const Eigen::Ve
     if (n > 0) {
       // |δ_n − δ_{n−1}| ≤ p·(θ(w_{n−1}, w_n) + |β_n − β_{n−1}|) by the triangle inequality of
       // angles. The angle from its chord c: θ = 2·asin(c/2) = c + c³/24 + … ≤ c·(1 + c²/8) for
-      // c ≤ 2; 1e-9 of it spares rounding.
+      // c ≤ 1 (successive nodes are far closer: c is the smear's angle over the pieces); 1e-9 of
+      // it spares rounding.
       const Node& last = nodes_[n - 1];
       const double chord = (node.w - last.w).norm();
-      const double step = chord * (1 + chord * chord / 8) + std::abs(node.beta - last.beta);
+      const double angle = chord <= 1 ? chord * (1 + chord * chord / 8) : 2 * std::asin(std::min(1.0, chord / 2));
+      const double step = angle + std::abs(node.beta - last.beta);
       reach_[n] = reach_[n - 1] + step * body.px_per_rad * (1 + 1e-9);
     }
   }
@@ -200,16 +201,17 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, BodyShading:
   double coverage = 0;
   double du[kMost];
   size_t live[kMost], lives = 0;
-  std::optional<NodeCdf> left;  // node j's, when the piece before it was live
+  NodeCdf left(0.0);
+  bool left_known = false;  // left is node j's: the piece before it was live
   for (size_t j = 0; j < pieces; ++j) {
     const double a = u[j], b = u[j + 1];
     if ((a > kSaturated && b > kSaturated) || (a < -kSaturated && b < -kSaturated)) {
       coverage += a > 0 ? 1.0 : 0.0;
-      left.reset();
+      left_known = false;
       continue;
     }
-    if (!left) {
-      left.emplace(a);
+    if (!left_known) {
+      left = NodeCdf(a);
       du[j] = 0;
       live[lives++] = j;
     }
@@ -217,10 +219,11 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, BodyShading:
     du[j + 1] = 0;
     live[lives++] = j + 1;
     double d0, d1;
-    coverage += MeanCdf(*left, right, &d0, &d1);
+    coverage += MeanCdf(left, right, &d0, &d1);
     du[j] += d0;
     du[j + 1] += d1;
     left = right;
+    left_known = true;
   }
   coverage /= static_cast<double>(pieces);
   if (shade) {
