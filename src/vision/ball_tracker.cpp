@@ -120,6 +120,7 @@ struct BallTracker::Impl {
   bool needs_model = false;
   int distrusted = 0;
   long confident_model_frame = -1;  // the last frame the model measured, its background known
+  long learnt_near_at = -1;         // the last frame whose background the model's path learnt
   // A body found anew where the model could not check it against the background (rays whose
   // background was never seen: the first frames of a clip) counts once the next frames find it
   // again near it; found in that frame alone it was the table's texture (wood grain between the
@@ -862,14 +863,18 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
     }
     m.KeepForRefit(f, t, frame, gain, fit, o, motion_known, edge_fallback);
     // Not while a scene change is being confirmed: the changed picture is not the background.
-    // Every frame near the body (what it uncovered since the last frame, and where the next
-    // frames' rays read), the whole band every kLearnEvery frames, as on the fast path: a still
-    // scene's background needs no more looks than that, normalised by each frame's gain.
+    // Near the body (what it uncovered since the last frame, and where the next frames' rays
+    // read) where the model learnt the frame before; the whole band every kLearnEvery frames, as
+    // on the fast path, and after any frame it did not learn (the body found anew, or measured
+    // by the fast path): a still scene's background needs no more looks than that, normalised by
+    // each frame's gain.
     if (m.scene_suspect == 0) {
       const cv::Rect body = m.BodyRegion(Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]), smear);
       const int reach = static_cast<int>(std::ceil(2 * m.RadiusPx(o.x, o.z) + step_px)) + 2;
       const cv::Rect near(body.x - reach, body.y - reach, body.width + 2 * reach, body.height + 2 * reach);
-      m.background->Learn(frame, body, f % kLearnEvery == 0 ? cv::Rect() : near);
+      const bool whole = f % kLearnEvery == 0 || m.learnt_near_at != f - 1;
+      m.background->Learn(frame, body, whole ? cv::Rect() : near);
+      m.learnt_near_at = f;
     }
     m.FitAgain(false);
     return o;

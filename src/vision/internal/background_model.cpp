@@ -126,8 +126,9 @@ void BackgroundModel::Learn(const cv::Mat& bgr, const cv::Rect& exclude, const c
     if (run.end > ex1) learn(run.y, ex1, run.end);
   }
   UpdateProbes();
-  // Mean |I/g − B| ≈ 0.8 σ for Gaussian noise.
-  if (abs_count > 100) noise_ = 0.8 * noise_ + 0.2 * (abs_sum / abs_count / 0.8);
+  // Mean |I/g − B| ≈ 0.8 σ for Gaussian noise; from the whole band only (near the body a rail's
+  // reflection or the shadow's edge would take part in it).
+  if (within.empty() && abs_count > 100) noise_ = 0.8 * noise_ + 0.2 * (abs_sum / abs_count / 0.8);
 }
 
 }  // namespace uphill::internal

@@ -42,7 +42,7 @@ class BackgroundModel {
   double SceneResidual() const { return residual_; }
 
   // Learns the band's pixels of `bgr` outside `exclude` (gain from the last Measure), only those
-  // inside `within` unless it is empty.
+  // inside `within` unless it is empty (the noise level, which sets the clamp, is then kept).
   void Learn(const cv::Mat& bgr, const cv::Rect& exclude, const cv::Rect& within = cv::Rect());
 
   // Whether every pixel of `rect` (clipped to the frame) has been seen; the background there

@@ -93,7 +93,9 @@ class BodyShading {
   // The colour of a basis (or of a mean of bases) under this shading's light, each channel at
   // least 0.02 (a quadratic may dip below zero where the views were darkest); a zero basis (no
   // surface point) reads 1. Accurate to rounding: the turn is applied to the coefficients as the
-  // 9 × 9 matrix that maps the basis at a normal to the basis at the turned normal.
+  // 9 × 9 matrix that maps the basis at a normal to the basis at the turned normal. For a mean of
+  // bases the floor applies to the mean colour: it equals the mean of the points' colours where
+  // none of them falls below the floor.
   cv::Vec3d FromBasis(const Basis& basis) const;
 
   // This shading with the light turned by the rotation vector omega (apparatus frame, rad): the

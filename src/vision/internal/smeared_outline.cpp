@@ -150,8 +150,12 @@ SmearNodes::SmearNodes(const SmearNodes& a, const SmearNodes& b, double t)
     node.beta = na.beta + t * (nb.beta - na.beta);
     node.tan_beta = na.tan_beta + t * (nb.tan_beta - na.tan_beta);
     node.tau = na.tau;
-    reach_[n] = std::max(a.reach_[n], b.reach_[n]) * (1 + 1e-6);
+    if (n > 0) {
+      const double step = std::max(a.reach_[n] - a.reach_[n - 1], b.reach_[n] - b.reach_[n - 1]);
+      reach_[n] = reach_[n - 1] + step * (1 + 1e-3);
+    }
   }
+  reach_[0] = 0;
 }
 
 double SmearNodes::DistanceAtMiddle(const Vector3d& d) const {
