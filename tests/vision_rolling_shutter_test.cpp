@@ -1,7 +1,7 @@
 // The rolling shutter in the full model's fit (src/vision/internal/outline_fit.hpp), and the fit's
 // convergence on the same picture: a ball moving fast under a rolling shutter, each row exposed
 // for E starting (row − reference row)·δ after the reference row, and the row delay δ that the
-// fit's rays prefer (FitRequest::row_delay_probe).
+// fit's rays prefer (FitRequest::estimate_row_delay).
 //
 // Truth: the picture is rendered here by brute force, independently of the smear model: every
 // pixel's viewing ray (UndistortPixels) is tested against the sphere at 64 instants spread evenly
@@ -98,7 +98,7 @@ struct ShearedClip {
     q.smear_sigma = 0.1 * q.smear.norm();
     q.row_delay = row_delay;
     q.reference_row = reference_row;
-    q.row_delay_probe = 0.25 / kFps / kHeight;
+    q.estimate_row_delay = true;
     q.half_width_px = 2;
     q.noise = 0.004;  // the 8-bit quantisation, linear units
     return FitOutline(geometry, FrameView{frame, {0, 0}, 1.0}, background, q);
@@ -109,39 +109,39 @@ struct ShearedClip {
   }
 };
 
-// The readout (s) that the fit's rays prefer, probed from `readout`.
+// The readout (s) that the fit's rays prefer, fitted at `readout`.
 double ProbedReadout(const ShearedClip& clip, double readout) {
   const FitOutcome f = clip.Fit(readout / kHeight);
   EXPECT_TRUE(f.ok);
   EXPECT_GT(f.row_delay_sigma, 0);
-  std::printf("  probed from %.2f ms: %.2f ms (± %.2f); centre %.3f px from the truth\n", 1e3 * readout,
+  std::printf("  fitted at %.2f ms: %.2f ms (± %.2f); centre %.3f px from the truth\n", 1e3 * readout,
               1e3 * f.row_delay * kHeight, 1e3 * f.row_delay_sigma * kHeight, clip.CentreErrorPx(f));
   return f.row_delay * kHeight;
 }
 
-// A phone's 25 ms: probed from the truth, the truth (measured 25.2 ms); probed from a global
-// shutter (0), an estimate near it (measured 26.7 ms), and probed again from there (as the tracker
-// does frame after frame), the truth again (measured 25.2 ms).
+// A phone's 25 ms: estimated at the truth, the truth (measured 25.2 ms); at a global shutter (0),
+// one Gauss–Newton step away, an estimate near it (measured 24.4 ms), and at that estimate (as the
+// tracker does frame after frame), the truth again (measured 25.2 ms).
 TEST(RollingShutter, ReadoutOfAPhoneIsFoundFromAGlobalShutter) {
   constexpr double kReadout = 0.025;
   const ShearedClip clip(kReadout);
-  EXPECT_NEAR(ProbedReadout(clip, kReadout), kReadout, 0.05 * kReadout);
+  EXPECT_NEAR(ProbedReadout(clip, kReadout), kReadout, 0.02 * kReadout);
   const double first = ProbedReadout(clip, 0);
-  EXPECT_NEAR(first, kReadout, 0.2 * kReadout);
-  EXPECT_NEAR(ProbedReadout(clip, first), kReadout, 0.05 * kReadout);
+  EXPECT_NEAR(first, kReadout, 0.05 * kReadout);
+  EXPECT_NEAR(ProbedReadout(clip, first), kReadout, 0.02 * kReadout);
 }
 
-// Twice as long: from a global shutter the first probe overshoots (the χ² is no parabola that far
-// from its minimum: measured 66 ms), the second lands within 2 % (measured 51.0 ms).
+// Twice as long: from a global shutter the step falls short by the square of its length
+// (measured 44.5 ms), the second lands within 2 % (measured 49.9 ms).
 TEST(RollingShutter, LongReadoutIsFoundInTwoProbes) {
   constexpr double kReadout = 0.050;
   const ShearedClip clip(kReadout);
   const double first = ProbedReadout(clip, 0);
-  EXPECT_GT(first, 0.5 * kReadout);
-  EXPECT_NEAR(ProbedReadout(clip, first), kReadout, 0.05 * kReadout);
+  EXPECT_GT(first, 0.8 * kReadout);
+  EXPECT_NEAR(ProbedReadout(clip, first), kReadout, 0.02 * kReadout);
 }
 
-// A global shutter is measured as one (measured 0.4 ms of a 33 ms frame).
+// A global shutter is measured as one (measured 0.5 ms of a 33 ms frame, ± 0.3).
 TEST(RollingShutter, GlobalShutterIsMeasuredAsOne) {
   const ShearedClip clip(0);
   EXPECT_NEAR(ProbedReadout(clip, 0), 0, 0.001);
@@ -183,35 +183,50 @@ TEST(OutlineFit, ConvergesFromAPixelAndAHalfOffWithTheBackgroundSolvedPerRay) { 
 
 constexpr double kMost = 1.0 / kFps / kHeight;  // s per row: a readout of the whole frame time
 
-// Frames whose fits move from q toward the truth by a share 1 − s only, est(q) = c + s·q (each
-// frame's scatter about it ± spread): the settled delay is the fixed point c/(1 − s) exactly, its
-// uncertainty the mean's standard error over 1 − s, and the slope s; from a start at the truth as
-// from a global shutter. A frame that fails in one round is left out of every round's mean (here
-// the sixth frame, far off, fails in the second: were it kept in the first round's mean the
-// slope would be wrong). Truth: the closed form.
-TEST(RowDelaySettle, LinearEstimatesSettleOnTheirFixedPoint) {
+// Frames whose estimates are a Gauss–Newton step's, off by k·(q − truth)² from the truth when
+// fitted at q (each frame's scatter about it ± spread): two fitted at a global shutter's 0, far
+// from the truth, three near it. The first mean is pulled low by the far two (by 2/5 of their
+// 0.1·kMost); they are fitted again there, and the second mean is off by 2/5 of k·(first mean −
+// truth)² only. Truth: the closed form. A far frame whose refit fails is left out.
+TEST(RowDelaySettle, FarFramesAreFittedAgainAtTheMean) {
   const double truth = 0.6 * kMost, spread = 0.05 * kMost;
-  const double offsets[6] = {-2, -1, 0, 1, 2, 40};  // × spread: the first five mean 0, sample SD sqrt(2.5)
-  for (const double slope : {0.0, 0.47, 0.75}) {
-    for (const double start : {0.0, truth}) {
-      int rounds = 0;
-      auto fit_frames = [&](double q) {
-        ++rounds;
-        std::vector<FrameFit> fits;
-        for (double o : offsets) {
-          if (o == 40 && rounds == 2) fits.push_back(std::nullopt);
-          else fits.push_back(FrameDelay{truth * (1 - slope) + slope * q + o * spread, 0.01 * kMost});
-        }
-        return fits;
-      };
-      const std::optional<SettledDelay> settled = SettleRowDelay(start, kMost, 5, fit_frames);
-      ASSERT_TRUE(settled.has_value());
-      EXPECT_EQ(rounds, 3);
+  const double k = 0.1 * kMost / ((0.6 * kMost) * (0.6 * kMost));
+  const double offsets[5] = {-2, -1, 0, 1, 2};  // × spread: mean 0, sample SD sqrt(2.5)
+  const std::vector<double> fitted_at = {0, 0, truth, truth, truth};
+  const auto estimate = [&](size_t i, double q) {
+    return FrameDelay{truth + offsets[i] * spread + k * (q - truth) * (q - truth), 0.01 * kMost};
+  };
+  for (const bool refit_fails : {false, true}) {
+    std::vector<FrameFit> fits;
+    for (size_t i = 0; i < 5; ++i) fits.push_back(estimate(i, fitted_at[i]));
+    std::vector<size_t> refitted;
+    const auto refit = [&](size_t i, double q) -> FrameFit {
+      refitted.push_back(i);
+      if (refit_fails && i == 1) return std::nullopt;
+      return estimate(i, q);
+    };
+    const std::optional<SettledDelay> settled = SettleRowDelay(fits, fitted_at, 0.2 * kMost, kMost, 4, refit);
+    ASSERT_TRUE(settled.has_value());
+    EXPECT_EQ(refitted, (std::vector<size_t>{0, 1}));
+    const double first = truth + 2 * 0.1 * kMost / 5;
+    if (!refit_fails) {
       EXPECT_EQ(settled->frames, 5);
-      EXPECT_NEAR(settled->slope, slope, 1e-12) << start;
-      EXPECT_NEAR(settled->delay, truth, 1e-12 * kMost) << slope << " " << start;
-      // The formal errors (0.01/sqrt(5)) are far below the scatter's.
-      EXPECT_NEAR(settled->u, std::sqrt(2.5 / 5) * spread / (1 - slope), 1e-12 * kMost) << slope << " " << start;
+      EXPECT_EQ(settled->refitted, 2);
+      const double bias = k * (first - truth) * (first - truth);  // each refitted frame's
+      EXPECT_NEAR(settled->delay, truth + 2 * bias / 5, 1e-12 * kMost);
+      // The formal errors (0.01/sqrt(5)) are far below the scatter's: the sample SD of the
+      // estimates over sqrt(5), the offsets' sqrt(2.5)·spread with the two refits' bias.
+      double mean = 0, square = 0;
+      for (size_t i = 0; i < 5; ++i) mean += (offsets[i] * spread + (i < 2 ? bias : 0)) / 5;
+      for (size_t i = 0; i < 5; ++i) square += std::pow(offsets[i] * spread + (i < 2 ? bias : 0) - mean, 2);
+      EXPECT_NEAR(settled->u, std::sqrt(square / 4 / 5), 1e-12 * kMost);
+      EXPECT_NEAR(settled->u, std::sqrt(2.5 / 5) * spread, 0.01 * spread);
+    } else {
+      EXPECT_EQ(settled->frames, 4);
+      EXPECT_EQ(settled->refitted, 1);
+      // Frames 0, 2, 3, 4: offsets −2, 0, 1, 2 (mean 0.25), frame 0 with its refit's bias.
+      const double bias = k * (first - truth) * (first - truth);
+      EXPECT_NEAR(settled->delay, truth + 0.25 * spread + bias / 4, 1e-12 * kMost);
     }
   }
 }
@@ -219,37 +234,39 @@ TEST(RowDelaySettle, LinearEstimatesSettleOnTheirFixedPoint) {
 // The standard error is the formal one where the frames agree within it, the scatter's where they
 // do not; too few frames settle nothing.
 TEST(RowDelaySettle, StandardErrorIsTheLargerOfFormalAndScatter) {
-  const std::vector<bool> all(4, true);
   const std::vector<FrameFit> tight(4, FrameDelay{1.0, 2.0});
-  const std::optional<DelayRound> t = PreferredDelay(0, tight, all, 2);
+  const std::optional<DelayMean> t = PreferredDelay(tight, 2);
   ASSERT_TRUE(t.has_value());
   EXPECT_DOUBLE_EQ(t->mean, 1.0);
   EXPECT_DOUBLE_EQ(t->se, 1.0);  // 2/sqrt(4)
   // Weights 4:1: mean (4·1 + 1·6)/5 = 2; scatter Σw(e − m)²/((n − 1)Σw) = (4·1 + 1·16)/(1·5) = 4.
-  const std::vector<FrameFit> wide = {FrameDelay{1.0, 0.5}, FrameDelay{6.0, 1.0}, std::nullopt, FrameDelay{9.0, 1.0}};
-  const std::optional<DelayRound> w = PreferredDelay(0, wide, {true, true, true, false}, 2);
+  const std::vector<FrameFit> wide = {FrameDelay{1.0, 0.5}, FrameDelay{6.0, 1.0}, std::nullopt};
+  const std::optional<DelayMean> w = PreferredDelay(wide, 2);
   ASSERT_TRUE(w.has_value());
   EXPECT_DOUBLE_EQ(w->mean, 2.0);
   EXPECT_DOUBLE_EQ(w->se, 2.0);
-  EXPECT_FALSE(PreferredDelay(0, wide, all, 5).has_value());
-  EXPECT_FALSE(SettleRowDelay(0, kMost, 5, [](double) { return std::vector<FrameFit>(6); }).has_value());
+  EXPECT_FALSE(PreferredDelay(wide, 3).has_value());
+  const auto never = [](size_t, double) -> FrameFit { return std::nullopt; };
+  EXPECT_FALSE(SettleRowDelay(std::vector<FrameFit>(6), std::vector<double>(6, 0.0), 0, kMost, 5, never).has_value());
 }
 
-// On the brute-force picture of a phone's 25 ms readout, settled from a global shutter through the
-// fits themselves: the truth within 5 % (the flat ball's fit absorbs little of the shear: s ≈ 0).
-// One picture stands for two frames (the settling needs two), so only the delay is checked.
+// On the brute-force picture of a phone's 25 ms readout, two frames fitted at a global shutter's
+// 0 and settled through the fits themselves: the truth within 2 %. One picture stands for two
+// frames (the mean needs two), so only the delay is checked.
 TEST(RowDelaySettle, PhoneReadoutSettlesOnTheTruth) {
   constexpr double kReadout = 0.025;
   const ShearedClip clip(kReadout);
-  auto fit_frames = [&](double q) {
+  const auto fit = [&](double q) -> FrameFit {
     const FitOutcome f = clip.Fit(q);
-    const FrameFit fit = f.ok && f.row_delay_sigma > 0 ? FrameFit(FrameDelay{f.row_delay, f.row_delay_sigma}) : std::nullopt;
-    return std::vector<FrameFit>{fit, fit};
+    return f.ok && f.row_delay_sigma > 0 ? FrameFit(FrameDelay{f.row_delay, f.row_delay_sigma}) : std::nullopt;
   };
-  const std::optional<SettledDelay> settled = SettleRowDelay(0, kMost, 2, fit_frames);
+  const FrameFit first = fit(0);
+  const std::optional<SettledDelay> settled =
+      SettleRowDelay({first, first}, {0, 0}, 0.2 * kMost, kMost, 2, [&](size_t, double q) { return fit(q); });
   ASSERT_TRUE(settled.has_value());
-  std::printf("  settled %.2f ms (slope %.2f)\n", 1e3 * settled->delay * kHeight, settled->slope);
-  EXPECT_NEAR(settled->delay * kHeight, kReadout, 0.05 * kReadout);
+  std::printf("  settled %.2f ms (%d refitted)\n", 1e3 * settled->delay * kHeight, settled->refitted);
+  EXPECT_EQ(settled->refitted, 2);
+  EXPECT_NEAR(settled->delay * kHeight, kReadout, 0.02 * kReadout);
 }
 
 }  // namespace

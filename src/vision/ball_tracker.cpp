@@ -52,9 +52,10 @@ constexpr int kLearnEvery = 8;              // frames between background updates
 // reflections and the highlight leave 55-75 % of the rays inliers, and the exposure is the
 // median over the frames).
 constexpr double kExposureMinAgreement = 0.5;
-// The rolling shutter's readout, where measured: the row delay probed ± this share of a frame time
-// over the picture's height; measured on up to kReadoutFrames frames, used from kReadoutMinFrames.
-constexpr double kReadoutProbe = 0.25;
+// The rolling shutter's readout, where measured: on up to kReadoutFrames frames, used from
+// kReadoutMinFrames; at the end of the clip the frames fitted at a delay farther than this share
+// of a whole frame's readout from the clip's are fitted again (row_delay_settle.hpp).
+constexpr double kReadoutNear = 0.2;
 constexpr size_t kReadoutFrames = 15, kReadoutMinFrames = 5;
 
 struct Sample {
@@ -80,13 +81,15 @@ struct BallTracker::Impl {
   double row_delay = 0;                             // s per row
   std::vector<double> exposures;                    // per-frame measurements |D|/|V|
   std::vector<double> row_delays;                   // per-frame measurements of the row delay, s
-  // The frames that measured the row delay: a window of each and its last fit's request, fitted
-  // again at the end of the clip (SettleReadout).
+  // The frames that measured the row delay: a window of each, its last fit's request (made at
+  // request.row_delay) and that fit's estimate; the far ones fitted again at the end of the clip
+  // (SettleReadout).
   struct ReadoutFrame {
     cv::Mat window;
     cv::Point origin;
     double gain;
     FitRequest request;
+    internal::FrameDelay estimate;
   };
   std::vector<ReadoutFrame> readout_frames;
   std::optional<double> row_delay_u;                // s per row, once settled
@@ -148,7 +151,7 @@ struct BallTracker::Impl {
 
   // Whether this frame's fit measures the row delay (TrackerOptions::measure_readout): until
   // kReadoutFrames have, where a whole frame's readout would shear the body by over a pixel.
-  bool ProbesReadout(const Vector2d& centre, const Vector2d& velocity) const {
+  bool MeasuresReadout(const Vector2d& centre, const Vector2d& velocity) const {
     if (!options.measure_readout || row_delays.size() >= kReadoutFrames || velocity.isZero()) return false;
     const double px_per_s = velocity.norm() / MetresPerPx(centre.x(), centre.y());
     return px_per_s * 2 * RadiusPx(centre.x(), centre.y()) * FrameRowDelay() > 1;
@@ -235,7 +238,7 @@ struct BallTracker::Impl {
     q.light_inverse_distance = light_inverse_distance;
     q.half_width_px = half_width;
     q.row_delay = row_delay;
-    if (ProbesReadout(centre, velocity)) q.row_delay_probe = kReadoutProbe * FrameRowDelay();
+    q.estimate_row_delay = MeasuresReadout(centre, velocity);
     q.reference_row = geometry.Project(centre.x(), centre.y()).y();
     const double m_per_px = MetresPerPx(centre.x(), centre.y());
     if (moving_known) {
@@ -532,10 +535,10 @@ struct BallTracker::Impl {
     return cv::Rect(box.x - 24, box.y - 24, box.width + 48, box.height + 48) & cv::Rect(0, 0, frame.cols, frame.rows);
   }
 
-  // A frame that measured the row delay, for SettleReadout: the window its smear covers and the
-  // request of a narrow pass from its fit. The smear's prior stays the motion's prediction: one
-  // centred on the smear fitted at this frame's delay would hold part of the shear that delay got
-  // wrong, and pull the settled readout back toward it (on the phone clip by about 1 ms).
+  // A frame that measured the row delay, for SettleReadout: the window its smear covers, the
+  // request of a narrow pass from its fit, and its estimate. The smear's prior stays the motion's
+  // prediction: one centred on the smear fitted at this frame's delay would hold part of the
+  // shear that delay got wrong.
   void KeepReadoutFrame(const cv::Mat& frame, double gain, const FitOutcome& fit, FitRequest q) {
     q.centre = Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
     q.reference_row = geometry.Project(q.centre.x(), q.centre.y()).y();
@@ -543,29 +546,31 @@ struct BallTracker::Impl {
     q.fit_edge_shift = q.fit_light = true;
     q.iterations = kNarrowIterations;
     q.light_inverse_distance = fit.light_inverse_distance;
+    q.estimate_row_delay = true;
     const cv::Rect box = KeptWindow(q.centre, 2 * Vector2d(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]), frame);
-    if (!box.empty()) readout_frames.push_back({frame(box).clone(), box.tl(), gain, q});
+    if (!box.empty())
+      readout_frames.push_back({frame(box).clone(), box.tl(), gain, q, {fit.row_delay, fit.row_delay_sigma}});
   }
 
   // The clip's row delay, settled on the frames that measured it (row_delay_settle.hpp), and its
   // standard uncertainty; the running median of their estimates is kept when it cannot be.
   void SettleReadout() {
     if (readout_frames.size() < kReadoutMinFrames) return;
-    auto fit_frames = [&](double q) {
-      std::vector<internal::FrameFit> fits;
-      for (const ReadoutFrame& k : readout_frames) {
-        FitRequest r = k.request;
-        r.row_delay = q;
-        r.row_delay_probe = kReadoutProbe * FrameRowDelay();
-        const FitOutcome fit = internal::FitOutline(geometry, {k.window, k.origin, k.gain}, *background, r);
-        if (fit.ok && fit.row_delay_sigma > 0 && SeesShear(fit.row_delay))
-          fits.push_back(internal::FrameDelay{fit.row_delay, fit.row_delay_sigma});
-        else
-          fits.push_back(std::nullopt);
-      }
-      return fits;
+    std::vector<internal::FrameFit> fits;
+    std::vector<double> fitted_at;
+    for (const ReadoutFrame& k : readout_frames) fits.push_back(k.estimate), fitted_at.push_back(k.request.row_delay);
+    auto refit = [&](size_t i, double q) -> internal::FrameFit {
+      const ReadoutFrame& k = readout_frames[i];
+      FitRequest r = k.request;
+      r.row_delay = q;
+      const FitOutcome fit = internal::FitOutline(geometry, {k.window, k.origin, k.gain}, *background, r);
+      if (fit.ok && fit.row_delay_sigma > 0 && SeesShear(fit.row_delay))
+        return internal::FrameDelay{fit.row_delay, fit.row_delay_sigma};
+      return std::nullopt;
     };
-    if (const auto settled = internal::SettleRowDelay(row_delay, 0.999 * FrameRowDelay(), kReadoutMinFrames, fit_frames)) {
+    const double most = 0.999 * FrameRowDelay();
+    if (const auto settled = internal::SettleRowDelay(fits, fitted_at, kReadoutNear * FrameRowDelay(), most,
+                                                      kReadoutMinFrames, refit)) {
       row_delay = settled->delay;
       row_delay_u = settled->u;
       row_delay_frames = settled->frames;
@@ -881,7 +886,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
   };
 
   // The fast path: the edge fit, where the scene does not need the model (see the header).
-  if (predicted && !m.needs_model && m.row_delay == 0 && !m.ProbesReadout(centre, velocity)) {
+  if (predicted && !m.needs_model && m.row_delay == 0 && !m.MeasuresReadout(centre, velocity)) {
     const double px = 1 / m.MetresPerPx(centre.x(), centre.y());
     // With the exposure not yet known, and the body's shading known (so that the model measures
     // a long smear better than the edge fit), the blur is taken at its longest (a 360° shutter):

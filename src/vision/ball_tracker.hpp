@@ -62,9 +62,9 @@
 // timestamp. When the readout is unknown (TrackerOptions::measure_readout) it is measured from the
 // outline's shear on the frames where the body moves fast enough for a whole frame's readout to
 // shear it by a pixel: each such frame's fit gives the row delay its rays prefer (outline_fit.hpp,
-// the centre held) and, from five frames on, their median is used. Finish() settles it on those
-// frames, fitted again from windows kept of them, as the least-squares readout of the frames
-// with its standard uncertainty (row_delay_settle.hpp; ReadoutEstimate()). The
+// every parameter free) and, from five frames on, their median is used. Finish() settles it as
+// the frames' inverse-variance mean, the frames fitted far from it fitted again there from
+// windows kept of them, with its standard uncertainty (row_delay_settle.hpp; ReadoutEstimate()). The
 // exposure time is a camera setting (TrackerOptions::exposure); when unknown it is measured from
 // the fitted smear against the track's speed (ExposureEstimate()).
 //

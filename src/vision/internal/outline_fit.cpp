@@ -185,24 +185,28 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
 // with it, and Gauss–Newton converges only linearly (on fast-360-30 the step halved each
 // iteration). J is not formed: with g = AᵀJ₀ and H = N⁻¹·g,
 //   JᵀJ = J₀ᵀJ₀ − gᵀH − Hᵀg + Hᵀ·(AᵀA)·H   and   Jᵀr = J₀ᵀr − Hᵀ·(Aᵀr),
-// sums over the samples in one pass. `residuals`: the ray's r (Residuals).
-ReducedRows ProjectedGram(const RaySamples& ray, const std::vector<double>& c, const std::vector<SmearGradient>& grad,
-                          const std::vector<cv::Vec3d>& shade, const RayColours& colours, const double* residuals,
-                          double inv_noise) {
-  using Vector5 = Eigen::Matrix<double, kSmearParameters, 1>;
-  using Matrix5 = Eigen::Matrix<double, kSmearParameters, kSmearParameters>;
+// sums over the samples in one pass. `gradient(i)`: ∇c_i over the P parameters (the smear's, or
+// those and the rows' delay); `residuals`: the ray's r (Residuals).
+template <int P, typename Gradient>
+Eigen::Matrix<double, P + 1, P + 1> ProjectedGram(const RaySamples& ray, const std::vector<double>& c,
+                                                  const Gradient& gradient, const std::vector<cv::Vec3d>& shade,
+                                                  const RayColours& colours, const double* residuals, double inv_noise) {
+  using VectorP = Eigen::Matrix<double, P, 1>;
+  using MatrixP = Eigen::Matrix<double, P, P>;
   const size_t n = c.size();
   const bool known = !ray.back.empty();
   const auto body = [&](size_t i, int ch) { return shade.empty() ? c[i] : c[i] * shade[i][ch]; };
-  Matrix5 jj = Matrix5::Zero(), aj = Matrix5::Zero();  // J₀ᵀJ₀; AᵀJ₀ (known background)
-  Vector5 jr = Vector5::Zero(), ar = Vector5::Zero();  // J₀ᵀr; Aᵀr (known background)
-  std::array<Eigen::Matrix<double, 3, kSmearParameters>, 3> aj_ch{};  // per channel (unknown background)
+  MatrixP jj = MatrixP::Zero();                           // J₀ᵀJ₀
+  Eigen::Matrix<double, 5, P> aj = decltype(aj)::Zero();  // AᵀJ₀ (known background: 5 colour unknowns)
+  VectorP jr = VectorP::Zero();                           // J₀ᵀr
+  Eigen::Matrix<double, 5, 1> ar = decltype(ar)::Zero();  // Aᵀr (known background)
+  std::array<Eigen::Matrix<double, 3, P>, 3> aj_ch{};     // per channel (unknown background)
   std::array<Eigen::Vector3d, 3> ar_ch{};
   for (auto& m : aj_ch) m.setZero();
   for (auto& v : ar_ch) v.setZero();
   double rr = 0;
   for (size_t i = 0; i < n; ++i) {
-    const Eigen::Map<const Vector5> g(grad[i].data());
+    const VectorP g = gradient(i);
     const cv::Vec3d& B = colours.back[i];
     const cv::Vec3d F = !colours.ok ? B : shade.empty() ? colours.body : colours.body.mul(shade[i]);
     const double u = 1 - c[i], t = ray.along[i];
@@ -221,43 +225,45 @@ ReducedRows ProjectedGram(const RaySamples& ray, const std::vector<double>& c, c
       } else {
         const double w[3] = {u * k, u * t * k, a_body * k};
         for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < kSmearParameters; ++b) aj_ch[ch](a, b) += w[a] * g(b);
+          for (int b = 0; b < P; ++b) aj_ch[ch](a, b) += w[a] * g(b);
         ar_ch[ch] += Eigen::Vector3d(u, u * t, a_body) * r;
       }
     }
     // By hand: Eigen's rank updates do not unroll at this size, and this loop is the pass.
-    for (int a = 0; a < kSmearParameters; ++a) {
+    for (int a = 0; a < P; ++a) {
       const double kg = kk * g(a);
-      for (int b = a; b < kSmearParameters; ++b) jj(a, b) += kg * g(b);
+      for (int b = a; b < P; ++b) jj(a, b) += kg * g(b);
       jr(a) += kr * g(a);
     }
     if (colours.ok && known) {
       const double w[5] = {u * bk, u * t * bk, body_k[0], body_k[1], body_k[2]};
       for (int a = 0; a < 5; ++a)
-        for (int b = 0; b < kSmearParameters; ++b) aj(a, b) += w[a] * g(b);
+        for (int b = 0; b < P; ++b) aj(a, b) += w[a] * g(b);
       ar(0) += u * br, ar(1) += u * t * br;
     }
   }
-  for (int a = 0; a < kSmearParameters; ++a)
+  for (int a = 0; a < P; ++a)
     for (int b = 0; b < a; ++b) jj(a, b) = jj(b, a);
   if (colours.ok && known) {
-    const Matrix5 h = colours.known_inverse * aj;
+    const Eigen::Matrix<double, 5, P> h = colours.known_inverse * aj;
     jj += -aj.transpose() * h - h.transpose() * aj + h.transpose() * colours.known_design * h;
     jr -= h.transpose() * ar;
   } else if (colours.ok) {
     for (int ch = 0; ch < 3; ++ch) {
-      const Eigen::Matrix<double, 3, kSmearParameters> h = colours.unknown_inverse[ch] * aj_ch[ch];
+      const Eigen::Matrix<double, 3, P> h = colours.unknown_inverse[ch] * aj_ch[ch];
       jj += -aj_ch[ch].transpose() * h - h.transpose() * aj_ch[ch] + h.transpose() * colours.unknown_design[ch] * h;
       jr -= h.transpose() * ar_ch[ch];
     }
   }
-  ReducedRows gram;
-  gram.topLeftCorner<kSmearParameters, kSmearParameters>() = jj;
-  gram.topRightCorner<kSmearParameters, 1>() = jr;
-  gram.bottomLeftCorner<1, kSmearParameters>() = jr.transpose();
-  gram(kSmearParameters, kSmearParameters) = rr;
+  Eigen::Matrix<double, P + 1, P + 1> gram;
+  gram.template topLeftCorner<P, P>() = jj;
+  gram.template topRightCorner<P, 1>() = jr;
+  gram.template bottomLeftCorner<1, P>() = jr.transpose();
+  gram(P, P) = rr;
   return gram;
 }
+
+using DelayGramMatrix = Eigen::Matrix<double, kSmearParameters + 2, kSmearParameters + 2>;
 
 class RayCost : public ceres::CostFunction {
  public:
@@ -331,19 +337,39 @@ class RayCost : public ceres::CostFunction {
     Residuals(ray_.start_coverage, ShadeAtStart(), r->data() + at, nullptr);
   }
 
-  // The sum of squared residuals (units of the noise²) at p.
-  double ChiSquare(const double* p) const {
-    std::vector<double> r(3 * ray_.dirs.size());
-    Compute(p, ray_.shade, r.data(), nullptr);
-    double sum = 0;
-    for (double v : r) sum += v * v;
-    return sum;
-  }
+  // Keep each evaluation's coverages and gradients, for DelayGram at the solution.
+  void KeepGradients() { keep_gradients_ = true; }
 
-  // The rows' delay (s per row) from here on, instead of the request's.
-  void SetRowDelay(double row_delay) {
-    ray_.row_delay = row_delay;
-    last_.valid = accepted_.valid = false;
+  // The Gram matrix of [J r] at p (reduced_rows.hpp) over the smear's parameters and, last, the
+  // rows' delay (s per row). A change dδ of the delay moves the body that sample
+  // i sees by V·row_i·dδ (row_i the row its nodes are taken at), so the delay's column is
+  // row_i·(V·∇c_i), V·∇c_i along the centre's columns: exact to the rounding of the nodes'
+  // interpolation between the ray's first and last rows, which is linear in the row.
+  DelayGramMatrix DelayGram(const double* p) const {
+    const size_t n = ray_.dirs.size();
+    std::vector<double> c;
+    std::vector<SmearGradient> grad;
+    const Reduced* kept = nullptr;
+    for (const Reduced* known : {&accepted_, &last_})
+      if (!kept && known->At(p) && known->grad.size() == n) kept = known;
+    if (kept) {
+      c = kept->c, grad = kept->grad;
+    } else {
+      c.resize(n), grad.resize(n);
+      ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { c[i] = nodes.Coverage(ray_.dirs[i], &grad[i]); });
+    }
+    std::vector<double> r(3 * n);
+    RayColours colours;
+    Residuals(c, ray_.shade, r.data(), &colours);
+    const std::vector<double> rows = RowsSeen();
+    const auto gradient = [&](size_t i) {
+      Eigen::Matrix<double, kSmearParameters + 1, 1> g;
+      for (int j = 0; j < kSmearParameters; ++j) g(j) = grad[i][j];
+      const double along_motion = ray_.velocity.x() * grad[i][kCentreX] + ray_.velocity.y() * grad[i][kCentreZ];
+      g(kSmearParameters) = rows[i] * along_motion;
+      return g;
+    };
+    return ProjectedGram<kSmearParameters + 1>(ray_, c, gradient, ray_.shade, colours, r.data(), inv_noise_);
   }
 
  private:
@@ -369,6 +395,15 @@ class RayCost : public ceres::CostFunction {
     }
     const SmearNodes first = window(*lo), last = window(*hi);
     for (size_t i = 0; i < ray_.dirs.size(); ++i) visit(i, SmearNodes(first, last, (ray_.rows[i] - *lo) / (*hi - *lo)));
+  }
+
+  // The row (relative to the reference row) whose nodes each sample is evaluated with, as
+  // ForEachSample takes them: the rows' middle on a ray that shares one window, else its own.
+  std::vector<double> RowsSeen() const {
+    if (ray_.rows.empty()) return std::vector<double>(ray_.dirs.size(), 0.0);
+    const auto [lo, hi] = std::minmax_element(ray_.rows.begin(), ray_.rows.end());
+    if (*hi - *lo <= kSharedRows) return std::vector<double>(ray_.dirs.size(), 0.5 * (*lo + *hi));
+    return ray_.rows;
   }
 
   // S_i of every sample from its basis at the fit's start, under the body's light as it is now.
@@ -421,6 +456,8 @@ class RayCost : public ceres::CostFunction {
     std::array<double, kReduced> residuals{};
     std::array<double, kReduced * kSmearParameters> jacobian{};
     double sum_of_squares = 0, contrast = 0;
+    std::vector<double> c;              // the coverages and their gradients (KeepGradients)
+    std::vector<SmearGradient> grad;
     bool At(const double* q) const { return valid && std::equal(q, q + kSmearParameters, p.begin()); }
   };
 
@@ -434,7 +471,9 @@ class RayCost : public ceres::CostFunction {
     r.resize(3 * n);
     RayColours colours;
     Residuals(c, ray_.shade, r.data(), &colours);
-    const ReducedRows gram = ProjectedGram(ray_, c, grad, ray_.shade, colours, r.data(), inv_noise_);
+    const auto gradient = [&](size_t i) { return Eigen::Map<const Eigen::Matrix<double, kSmearParameters, 1>>(grad[i].data()); };
+    const ReducedRows gram = ProjectedGram<kSmearParameters>(ray_, c, gradient, ray_.shade, colours, r.data(), inv_noise_);
+    if (keep_gradients_) out->c = c, out->grad = grad;
     const ReducedRows factor = FactorGram(gram);
     for (int i = 0; i < kReduced; ++i) {
       out->residuals[i] = factor(i, kSmearParameters);
@@ -446,6 +485,7 @@ class RayCost : public ceres::CostFunction {
     out->valid = true;
   }
 
+  bool keep_gradients_ = false;
   mutable Reduced last_, accepted_;
   mutable std::vector<double> scratch_residuals_;  // the full ray's, kept for their memory only
 };
@@ -505,6 +545,45 @@ struct PriorCost {
     return true;
   }
 };
+
+// The rolling shutter's row delay (s per row) that the inlier rays prefer, every parameter free,
+// and its standard error: one Gauss–Newton step in (p, δ) from the solution p at the request's
+// delay, over the inlier rays' χ² and the priors. Its δ part is the least-squares delay of this
+// frame to first order (the Schur complement of the smear's parameters: what the centre and the
+// smear absorb of a wrong delay is given back), and the inverse's δ entry its variance (residuals
+// in units of the noise). {0, 0} where the step is not defined.
+std::pair<double, double> PreferredRowDelay(const std::vector<RayCost*>& costs, const std::vector<double>& squares,
+                                            double limit, const double* p, const FitRequest& q) {
+  DelayGramMatrix gram = DelayGramMatrix::Zero();
+  for (size_t k = 0; k < costs.size(); ++k)
+    if (squares[k] < limit) gram += costs[k]->DelayGram(p);
+  constexpr int kDelay = kSmearParameters, kUnknowns = kSmearParameters + 1;
+  using Matrix = Eigen::Matrix<double, kUnknowns, kUnknowns>;
+  using Vector = Eigen::Matrix<double, kUnknowns, 1>;
+  Matrix h = gram.topLeftCorner<kUnknowns, kUnknowns>();
+  Vector g = gram.topRightCorner<kUnknowns, 1>();
+  // The priors' rows (PriorCost): b/0.3 px and (D − D_pred)/σ_D; b held where it is.
+  const double wb = 1 / (kEdgeShiftPriorPx * kEdgeShiftPriorPx);
+  const double wd = 1 / std::pow(q.smear_sigma > 0 ? q.smear_sigma : 1e-9, 2);
+  h(kEdgeShift, kEdgeShift) += wb, g(kEdgeShift) += wb * p[kEdgeShift];
+  h(kSmearX, kSmearX) += wd, g(kSmearX) += wd * (p[kSmearX] - q.smear.x());
+  h(kSmearZ, kSmearZ) += wd, g(kSmearZ) += wd * (p[kSmearZ] - q.smear.y());
+  if (!q.fit_edge_shift) {
+    h.row(kEdgeShift).setZero(), h.col(kEdgeShift).setZero();
+    h(kEdgeShift, kEdgeShift) = 1, g(kEdgeShift) = 0;
+  }
+  // Solved with the columns scaled to unit diagonal (metres, pixels and seconds per row).
+  if (!(h.diagonal().array() > 0).all()) return {0, 0};
+  const Vector d = h.diagonal().cwiseSqrt().cwiseInverse();
+  const Eigen::LDLT<Matrix> ldlt(d.asDiagonal() * h * d.asDiagonal());
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return {0, 0};
+  const Vector step = -(d.asDiagonal() * ldlt.solve(d.asDiagonal() * g));
+  Vector unit = Vector::Zero();
+  unit(kDelay) = 1;
+  const double variance = d(kDelay) * d(kDelay) * ldlt.solve(unit)(kDelay);
+  if (!std::isfinite(step(kDelay)) || !(variance > 0)) return {0, 0};
+  return {q.row_delay + step(kDelay), std::sqrt(variance)};
+}
 
 bool InFront(const OutlineGeometry& g, double x, double z) {
   return (g.cal.pose.rotation * Vector3d(x, 0, z) + g.cal.pose.translation).z() > 2 * g.a &&
@@ -623,7 +702,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   for (size_t k = 0; k < rays.size(); ++k) {
     const Ray& ray = rays[k];
     RaySamples samples;
-    const bool rolling = q.row_delay > 0 || q.row_delay_probe > 0;
+    const bool rolling = q.row_delay > 0 || q.estimate_row_delay;
     samples.velocity = q.velocity;
     samples.row_delay = q.row_delay;
     samples.bend = q.bend;
@@ -678,6 +757,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
     if (fit_step > step) ThinOut(&samples, static_cast<int>(std::ceil(length / fit_step)) + 1);
     const double loss_scale = std::sqrt(kRayLossFactor * 3.0 * samples.dirs.size());
     auto* cost = new RayCost(body, std::move(samples), inv_noise, shaded, params);
+    if (q.estimate_row_delay) cost->KeepGradients();
     costs.push_back(cost);
     problem.AddResidualBlock(cost, new ceres::CauchyLoss(loss_scale), params);
   }
@@ -732,22 +812,9 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   out.misfit = std::sqrt(sum / out.inliers);
   out.noise = q.noise * std::sqrt(median);
   std::copy(std::begin(params), std::end(params), out.p.begin());
-  if (q.row_delay_probe > 0) {
-    // The rolling shutter's row delay that the inlier rays prefer, the centre and smear held (a
-    // shear about the reference row barely moves them): the vertex of the parabola through their
-    // χ² at three delays. Far from the minimum the χ² is no parabola and the vertex overshoots;
-    // probed again from there it lands (tests/vision_rolling_shutter_test.cpp).
-    double chi2[3] = {0, 0, 0};
-    for (int j = 0; j < 3; ++j) {
-      for (RayCost* cost : costs) cost->SetRowDelay(q.row_delay + (j - 1) * q.row_delay_probe);
-      for (size_t k = 0; k < costs.size(); ++k)
-        if (squares[k] < limit) chi2[j] += costs[k]->ChiSquare(params);
-    }
-    const double curvature = (chi2[0] - 2 * chi2[1] + chi2[2]) / (q.row_delay_probe * q.row_delay_probe);
-    if (curvature > 0) {
-      out.row_delay = q.row_delay - (chi2[2] - chi2[0]) / (2 * q.row_delay_probe * curvature);
-      out.row_delay_sigma = std::sqrt(2 / curvature);  // χ² = Σ r²: its Hessian is 2·JᵀJ
-    }
+  if (q.estimate_row_delay) {
+    const auto [delay, sigma] = PreferredRowDelay(costs, squares, limit, params, q);
+    out.row_delay = delay, out.row_delay_sigma = sigma;
   }
   out.ok = true;
   return out;

@@ -73,7 +73,7 @@ struct FitRequest {
   Eigen::Vector2d bend = {0, 0};        // A = ½·a·E² (smeared_outline.hpp), m: held, not fitted
   Eigen::Vector2d velocity = {0, 0};    // m/s, for the rolling shutter's row delays
   double row_delay = 0;                 // s per row (readout / rows); 0: global shutter
-  double row_delay_probe = 0;           // > 0: estimate the row delay (FitOutcome), probing ± this
+  bool estimate_row_delay = false;      // true: estimate the row delay (FitOutcome::row_delay)
   double reference_row = 0;             // the row whose time is the reference
   double half_width_px = 6;             // uncertainty of the prediction along each ray
   int rays = 64;
@@ -106,8 +106,9 @@ struct FitOutcome {
   double contrast = 0;  // median |F − B| of the inliers, linear units
   double noise = 0;     // RMS residual of the inlier rays, linear units (for the next frame)
   double light_inverse_distance = 0;  // 1/m: fitted on a shaded smear, else the prior's
-  // With FitRequest::row_delay_probe: the row delay the inlier rays prefer (s per row), the fit's
-  // centre and smear held, and its standard error; row_delay_sigma 0: not estimated.
+  // With FitRequest::estimate_row_delay: the row delay the inlier rays prefer (s per row), every
+  // parameter free (one Gauss–Newton step from the fit at the request's delay), and its standard
+  // error; row_delay_sigma 0: not estimated.
   double row_delay = 0, row_delay_sigma = 0;
 };
 
