@@ -52,9 +52,11 @@ struct RaySamples {
   // The body's relative colour over the part of it that passed over each sample (S_i below), at
   // the fit's starting point; empty: one colour per ray.
   std::vector<cv::Vec3d> shade;
-  // On a shaded ray, each sample's coverage and mean shading basis at the fit's start (smeared_outline.hpp):
-  // S_i under any light follows from them without another pass over the smear's nodes.
+  // On a shaded ray, each sample's coverage, its gradient and mean shading basis at the fit's
+  // start (smeared_outline.hpp): S_i under any light follows from them without another pass over
+  // the smear's nodes, and the solve's first evaluation, there, needs none either.
   std::vector<double> start_coverage;
+  std::vector<SmearGradient> start_gradient;
   std::vector<BodyShading::Basis> start_basis;
   Vector2d bend = Vector2d::Zero();    // A of smeared_outline.hpp, m
   int pieces = 1;
@@ -277,10 +279,12 @@ class RayCost : public ceres::CostFunction {
     if (shaded) {
       const size_t n = ray_.dirs.size();
       ray_.start_coverage.resize(n);
+      ray_.start_gradient.resize(n);
       ray_.start_basis.resize(n);
       ForEachSample(start, [&](size_t i, const SmearNodes& nodes) {
-        ray_.start_coverage[i] = nodes.Coverage(ray_.dirs[i], nullptr, &ray_.start_basis[i]);
+        ray_.start_coverage[i] = nodes.Coverage(ray_.dirs[i], &ray_.start_gradient[i], &ray_.start_basis[i]);
       });
+      std::copy(start, start + kSmearParameters, start_.begin());
       Shade();
     }
   }
@@ -464,9 +468,14 @@ class RayCost : public ceres::CostFunction {
   // The ray at p reduced to *out (see Evaluate).
   void Reduce(const double* p, Reduced* out) const {
     const size_t n = ray_.dirs.size();
-    std::vector<double> c(n);
-    std::vector<SmearGradient> grad(n);
-    ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { c[i] = nodes.Coverage(ray_.dirs[i], &grad[i]); });
+    std::vector<double> c;
+    std::vector<SmearGradient> grad;
+    if (!ray_.start_gradient.empty() && std::equal(p, p + kSmearParameters, start_.begin())) {
+      c = ray_.start_coverage, grad = ray_.start_gradient;
+    } else {
+      c.resize(n), grad.resize(n);
+      ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { c[i] = nodes.Coverage(ray_.dirs[i], &grad[i]); });
+    }
     std::vector<double>& r = scratch_residuals_;
     r.resize(3 * n);
     RayColours colours;
@@ -485,6 +494,7 @@ class RayCost : public ceres::CostFunction {
     out->valid = true;
   }
 
+  std::array<double, kSmearParameters> start_{};  // the fit's start, where the ray's start_* are
   bool keep_gradients_ = false;
   mutable Reduced last_, accepted_;
   mutable std::vector<double> scratch_residuals_;  // the full ray's, kept for their memory only
