@@ -204,6 +204,7 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, BodyShading:
   const size_t pieces = count - 1;
   double coverage = 0;
   double du[kMost];
+  double cdf[kMost];  // Φ at the live pieces' nodes, for the shading's weights
   size_t live[kMost], lives = 0;
   NodeCdf left(0.0);
   bool left_known = false;  // left is node j's: the piece before it was live
@@ -216,10 +217,12 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, BodyShading:
     }
     if (!left_known) {
       left = NodeCdf(a);
+      cdf[j] = left.cdf;
       du[j] = 0;
       live[lives++] = j;
     }
     const NodeCdf right(b);
+    cdf[j + 1] = right.cdf;
     du[j + 1] = 0;
     live[lives++] = j + 1;
     double d0, d1;
@@ -234,11 +237,13 @@ double SmearNodes::Coverage(const Vector3d& d, SmearGradient* grad, BodyShading:
     shade->setZero();
     if (body_.shading) {
       double weight = 0;
+      // A node not saturated ends a live piece, whose Φ the loop above kept.
       for (size_t n = 0; n < count; ++n) {
-        const double cdf = u[n] > kSaturated ? 1.0 : u[n] < -kSaturated ? 0.0 : NodeCdf(u[n]).cdf;
-        if (cdf < 1e-6) continue;
-        const double w = cdf * (n == 0 || n == pieces ? 0.5 : 1.0);
-        *shade += w * body_.shading->LearntBasisAt(d, nodes_[n].w * nodes_[n].norm, body_.a);
+        const double phi = u[n] > kSaturated ? 1.0 : u[n] < -kSaturated ? 0.0 : cdf[n];
+        if (phi < 1e-6) continue;
+        const double w = phi * (n == 0 || n == pieces ? 0.5 : 1.0);
+        const Node& node = nodes_[n];
+        *shade += w * body_.shading->LearntBasisAt(d, node.w * node.norm, body_.a);
         weight += w;
       }
       if (weight > 0) *shade /= weight;
