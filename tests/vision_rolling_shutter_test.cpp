@@ -110,7 +110,7 @@ struct ShearedClip {
 };
 
 // The readout (s) that the fit's rays prefer, fitted at `readout`.
-double ProbedReadout(const ShearedClip& clip, double readout) {
+double FittedReadout(const ShearedClip& clip, double readout) {
   const FitOutcome f = clip.Fit(readout / kHeight);
   EXPECT_TRUE(f.ok);
   EXPECT_GT(f.row_delay_sigma, 0);
@@ -125,26 +125,26 @@ double ProbedReadout(const ShearedClip& clip, double readout) {
 TEST(RollingShutter, ReadoutOfAPhoneIsFoundFromAGlobalShutter) {
   constexpr double kReadout = 0.025;
   const ShearedClip clip(kReadout);
-  EXPECT_NEAR(ProbedReadout(clip, kReadout), kReadout, 0.02 * kReadout);
-  const double first = ProbedReadout(clip, 0);
+  EXPECT_NEAR(FittedReadout(clip, kReadout), kReadout, 0.02 * kReadout);
+  const double first = FittedReadout(clip, 0);
   EXPECT_NEAR(first, kReadout, 0.05 * kReadout);
-  EXPECT_NEAR(ProbedReadout(clip, first), kReadout, 0.02 * kReadout);
+  EXPECT_NEAR(FittedReadout(clip, first), kReadout, 0.02 * kReadout);
 }
 
 // Twice as long: from a global shutter the step falls short by the square of its length
 // (measured 44.5 ms), the second lands within 2 % (measured 49.9 ms).
-TEST(RollingShutter, LongReadoutIsFoundInTwoProbes) {
+TEST(RollingShutter, LongReadoutIsFoundInTwoSteps) {
   constexpr double kReadout = 0.050;
   const ShearedClip clip(kReadout);
-  const double first = ProbedReadout(clip, 0);
+  const double first = FittedReadout(clip, 0);
   EXPECT_GT(first, 0.8 * kReadout);
-  EXPECT_NEAR(ProbedReadout(clip, first), kReadout, 0.02 * kReadout);
+  EXPECT_NEAR(FittedReadout(clip, first), kReadout, 0.02 * kReadout);
 }
 
 // A global shutter is measured as one (measured 0.5 ms of a 33 ms frame, ± 0.3).
 TEST(RollingShutter, GlobalShutterIsMeasuredAsOne) {
   const ShearedClip clip(0);
-  EXPECT_NEAR(ProbedReadout(clip, 0), 0, 0.001);
+  EXPECT_NEAR(FittedReadout(clip, 0), 0, 0.001);
 }
 
 // ---- The fit's convergence (outline_fit.hpp) ----------------------------------------------------
@@ -185,7 +185,7 @@ constexpr double kMost = 1.0 / kFps / kHeight;  // s per row: a readout of the w
 
 // Frames whose estimates are a Gauss–Newton step's, off by k·(q − truth)² from the truth when
 // fitted at q (each frame's scatter about it ± spread): two fitted at a global shutter's 0, far
-// from the truth, three near it. The first mean is pulled low by the far two (by 2/5 of their
+// from the truth, three near it. The first mean is pulled off by the far two (by 2/5 of their
 // 0.1·kMost); they are fitted again there, and the second mean is off by 2/5 of k·(first mean −
 // truth)² only. Truth: the closed form. A far frame whose refit fails is left out.
 TEST(RowDelaySettle, FarFramesAreFittedAgainAtTheMean) {

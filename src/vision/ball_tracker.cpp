@@ -56,12 +56,18 @@ constexpr double kExposureMinAgreement = 0.5;
 // kReadoutMinFrames; at the end of the clip the frames fitted at a delay farther than this share
 // of a whole frame's readout from the clip's are fitted again (row_delay_settle.hpp).
 constexpr double kReadoutNear = 0.2;
+// The readout's systematic uncertainty, s, added in quadrature to the frames' standard error: the
+// smear model errs most at the smear's ends, where the shear shows, and that leaks into the
+// delay the same way on every frame. Calibrated on the ray-traced matrix (docs/track.md): on the
+// four global-shutter fast clips `--readout auto` measured 0.2 to 9.8 ms of the true 0 with
+// standard errors of 0.7 to 3.4 ms (up to 10 of them off); with 3 ms more each lies within 2.5 u.
+constexpr double kReadoutSystematic = 0.003;
 constexpr size_t kReadoutFrames = 15, kReadoutMinFrames = 5;
 
 struct Sample {
   double t, x, z;  // s (clip time of the reported centre), m
   // The frame's time and the centre's row: under a rolling shutter t is frame_t + row·δ, δ the
-  // rows' delay as known when the frame was measured, and again whenever it is known better.
+  // rows' delay as known now (the samples are re-timed whenever it changes).
   double frame_t = 0, row = 0;
 };
 
@@ -287,6 +293,9 @@ struct BallTracker::Impl {
     // than a pixel (the windows follow), then a narrow pass around the result.
     q.fit_edge_shift = false;
     q.fit_light = false;
+    // The row delay is read from the last pass only.
+    const bool estimate_row_delay = q.estimate_row_delay;
+    q.estimate_row_delay = false;
     FitOutcome first;
     for (int pass = 0; pass < 3; ++pass) {
       first = internal::FitOutline(geometry, view, *background, q);
@@ -299,6 +308,7 @@ struct BallTracker::Impl {
       q.half_width_px = std::max(kNarrowHalfWidthPx + 1, 0.5 * q.half_width_px);
     }
     q.smear = Vector2d(first.p[internal::kSmearX], first.p[internal::kSmearZ]);
+    q.estimate_row_delay = estimate_row_delay;
     q.fit_light = true;
     q.half_width_px = kNarrowHalfWidthPx;
     q.iterations = kNarrowIterations;
@@ -586,7 +596,7 @@ struct BallTracker::Impl {
     if (const auto settled = internal::SettleRowDelay(fits, fitted_at, kReadoutNear * FrameRowDelay(), most,
                                                       kReadoutMinFrames, refit)) {
       SetRowDelay(settled->delay);
-      row_delay_u = settled->u;
+      row_delay_u = std::hypot(settled->u, kReadoutSystematic / geometry.cal.camera.height);
       row_delay_frames = settled->frames;
     }
   }
@@ -615,6 +625,7 @@ struct BallTracker::Impl {
       // Started at the frame's own fit, within a pixel or so: a narrow pass's iterations (the
       // ray-traced clips measure the same as with 3, in 2 % less of fast-360-30's time).
       q.iterations = kNarrowIterations;
+      q.estimate_row_delay = false;  // measured when the frame was first fitted
       const FitOutcome fit = Measure({it->window, it->origin, it->gain}, q);
       if (Accept(fit, 0.45)) {
         BallObservation o = Observe(fit, q);

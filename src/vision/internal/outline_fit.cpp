@@ -347,8 +347,8 @@ class RayCost : public ceres::CostFunction {
   // The Gram matrix of [J r] at p (reduced_rows.hpp) over the smear's parameters and, last, the
   // rows' delay (s per row). A change dδ of the delay moves the body that sample
   // i sees by V·row_i·dδ (row_i the row its nodes are taken at), so the delay's column is
-  // row_i·(V·∇c_i), V·∇c_i along the centre's columns: exact to the rounding of the nodes'
-  // interpolation between the ray's first and last rows, which is linear in the row.
+  // row_i·(V·∇c_i), V·∇c_i along the centre's columns: as exact as those columns, the nodes'
+  // interpolation between the ray's first and last rows being linear in the row.
   DelayGramMatrix DelayGram(const double* p) const {
     const size_t n = ray_.dirs.size();
     std::vector<double> c;
