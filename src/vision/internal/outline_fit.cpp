@@ -356,12 +356,8 @@ class RayCost : public ceres::CostFunction {
     const Reduced* kept = nullptr;
     for (const Reduced* known : {&accepted_, &last_})
       if (!kept && known->At(p) && known->grad.size() == n) kept = known;
-    if (kept) {
-      c = kept->c, grad = kept->grad;
-    } else {
-      c.resize(n), grad.resize(n);
-      ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { c[i] = nodes.Coverage(ray_.dirs[i], &grad[i]); });
-    }
+    if (kept) c = kept->c, grad = kept->grad;
+    else CoverageAt(p, &c, &grad);
     std::vector<double> r(3 * n);
     RayColours colours;
     Residuals(c, ray_.shade, r.data(), &colours);
@@ -399,6 +395,17 @@ class RayCost : public ceres::CostFunction {
     }
     const SmearNodes first = window(*lo), last = window(*hi);
     for (size_t i = 0; i < ray_.dirs.size(); ++i) visit(i, SmearNodes(first, last, (ray_.rows[i] - *lo) / (*hi - *lo)));
+  }
+
+  // Every sample's coverage at p and its gradient: kept from the pass at the fit's start where p
+  // is that start, else computed.
+  void CoverageAt(const double* p, std::vector<double>* c, std::vector<SmearGradient>* grad) const {
+    if (!ray_.start_gradient.empty() && std::equal(p, p + kSmearParameters, start_.begin())) {
+      *c = ray_.start_coverage, *grad = ray_.start_gradient;
+      return;
+    }
+    c->resize(ray_.dirs.size()), grad->resize(ray_.dirs.size());
+    ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { (*c)[i] = nodes.Coverage(ray_.dirs[i], &(*grad)[i]); });
   }
 
   // The row (relative to the reference row) whose nodes each sample is evaluated with, as
@@ -470,12 +477,7 @@ class RayCost : public ceres::CostFunction {
     const size_t n = ray_.dirs.size();
     std::vector<double> c;
     std::vector<SmearGradient> grad;
-    if (!ray_.start_gradient.empty() && std::equal(p, p + kSmearParameters, start_.begin())) {
-      c = ray_.start_coverage, grad = ray_.start_gradient;
-    } else {
-      c.resize(n), grad.resize(n);
-      ForEachSample(p, [&](size_t i, const SmearNodes& nodes) { c[i] = nodes.Coverage(ray_.dirs[i], &grad[i]); });
-    }
+    CoverageAt(p, &c, &grad);
     std::vector<double>& r = scratch_residuals_;
     r.resize(3 * n);
     RayColours colours;
@@ -543,6 +545,9 @@ double FitLightDistance(const BodyShading& learnt, BodyShading* lit, const std::
   return kappa;
 }
 
+// σ_D of the smear's prior, m: the request's, or the smear held where it gives none.
+double SmearPriorSigma(const FitRequest& q) { return q.smear_sigma > 0 ? q.smear_sigma : 1e-9; }
+
 // The priors: b ~ N(0, 0.3 px), D ~ N(D_pred, σ_D).
 struct PriorCost {
   Vector2d smear;
@@ -574,7 +579,7 @@ std::pair<double, double> PreferredRowDelay(const std::vector<RayCost*>& costs, 
   Vector g = gram.topRightCorner<kUnknowns, 1>();
   // The priors' rows (PriorCost): b/0.3 px and (D − D_pred)/σ_D; b held where it is.
   const double wb = 1 / (kEdgeShiftPriorPx * kEdgeShiftPriorPx);
-  const double wd = 1 / std::pow(q.smear_sigma > 0 ? q.smear_sigma : 1e-9, 2);
+  const double wd = 1 / std::pow(SmearPriorSigma(q), 2);
   h(kEdgeShift, kEdgeShift) += wb, g(kEdgeShift) += wb * p[kEdgeShift];
   h(kSmearX, kSmearX) += wd, g(kSmearX) += wd * (p[kSmearX] - q.smear.x());
   h(kSmearZ, kSmearZ) += wd, g(kSmearZ) += wd * (p[kSmearZ] - q.smear.y());
@@ -774,7 +779,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   out.rays_fitted = static_cast<int>(costs.size());
   out.rays_without_background = without_background;
   if (costs.size() < 8) return out;
-  const double sigma_d = q.smear_sigma > 0 ? q.smear_sigma : 1e-9;
+  const double sigma_d = SmearPriorSigma(q);
   problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, kSmearParameters>(
                                new PriorCost{q.smear, 1.0 / sigma_d}),
                            nullptr, params);
