@@ -157,7 +157,7 @@ const char* const kTrackMatrixMethod =
     "of (u, v), px, and (x, z), mm, over the frames where the body is at least half visible; found: of those "
     "frames. Peers start from the true first box; their (x, z) is their pixel's calibrated ray on the plane "
     "y = 0. render: wall time to ray-trace the clip on this machine (CPU seconds in brackets). ms/frame: uphill's "
-    "tracker alone (its thread's CPU time); vs decode: frames per CPU-second of decoding and tracking against "
+    "tracker alone, its set-up and the clip's end included (its thread's CPU time); vs decode: frames per CPU-second of decoding and tracking against "
     "decoding alone (VideoCapture::read, process CPU time; goal >= 80%); both times the best of 3 runs; model: share of the frames found that the "
     "full model (background, colours, smear) measured rather than the fast edge fit. The rolling-shutter clip is "
     "tracked with --readout auto (a phone: its readout measured from the clip; the note gives it).";

@@ -27,6 +27,13 @@ constexpr double kNarrowHalfWidthPx = 1.5;  // second pass, around the first fit
 // clips measure as with 3 (spheroid-band 0.251 px against 0.248, fast-360-30 0.238 against 0.237)
 // at 10 % less of the tracker's time.
 constexpr int kNarrowIterations = 2;
+// Ceres iterations of a pass started at a fit of the same frame or at a checked prediction,
+// within half a pixel or so, where Kaufman's step leaves about a quarter of the offset: the
+// narrow pass where the model measured the frame before (MeasureNear), both passes of a refit,
+// and the refit of a frame at the settled row delay. On the ray-traced clips one iteration there
+// instead of two measures fast-360-30 at 0.233 px (0.236), spheroid-band 0.258 (0.253) and
+// rolling-shutter 0.168 (0.159), in 12 % less of fast-360-30's instructions (docs/track.md).
+constexpr int kStartedNearIterations = 1;
 constexpr int kHistoryGap = 5;              // frames without the body after which we predict no more
 constexpr size_t kHistory = 6;              // samples the prediction is fitted to
 constexpr double kSceneChangeFactor = 4;    // scene residual jump (times its usual level, plus 0.01)
@@ -74,6 +81,10 @@ struct Sample {
 }  // namespace
 
 struct BallTracker::Impl {
+  // Whether a search follows the body (a prediction or a frame's own fit to start from) or
+  // looks for it anew.
+  enum class Search { kTracking, kAcquiring };
+
   Scene scene;
   TrackerOptions options;
   internal::OutlineGeometry geometry;
@@ -286,11 +297,18 @@ struct BallTracker::Impl {
            f.contrast >= options.min_contrast && f.contrast >= 6 * noise && f.misfit < 3;
   }
 
-  // Two passes: around the guess with the given half width, then narrow around the first fit.
-  FitOutcome Measure(const internal::FrameView& view, FitRequest q) {
+  // Two passes: around the guess with the given half width, then narrow around the first fit
+  // (with `narrow_iterations`; q.iterations caps the first passes).
+  FitOutcome Measure(const internal::FrameView& view, FitRequest q, Search search = Search::kTracking,
+                     int narrow_iterations = kNarrowIterations) {
     // First passes with the edge shift held: far from the edges it would rather shrink the
     // outline onto an inner edge than move it. Again from where it went while it moves more
-    // than a pixel (the windows follow), then a narrow pass around the result.
+    // than a pixel and its last iteration still moved it by a pixel or more (the windows follow
+    // a solve that had not settled; one that had moves by less than 0.25 px when repeated on the
+    // ray-traced clips), then a narrow pass around the result. A body found anew is fitted again
+    // whenever it moved more than a pixel: the repeat starts the smear afresh from its prior,
+    // where the first fit, far from the edges, may have taken a spurious one (on the phone clip
+    // the first frame then failed the inlier share a new body needs).
     q.fit_edge_shift = false;
     q.fit_light = false;
     // The row delay is read from the last pass only.
@@ -304,14 +322,14 @@ struct BallTracker::Impl {
                              geometry.Project(q.centre.x(), q.centre.y());
       q.centre = Vector2d(first.p[internal::kCentreX], first.p[internal::kCentreZ]);
       q.reference_row = geometry.Project(q.centre.x(), q.centre.y()).y();
-      if (moved.norm() < 1.0) break;
+      if (moved.norm() < 1.0 || (search == Search::kTracking && first.last_step_px < 1.0)) break;
       q.half_width_px = std::max(kNarrowHalfWidthPx + 1, 0.5 * q.half_width_px);
     }
     q.smear = Vector2d(first.p[internal::kSmearX], first.p[internal::kSmearZ]);
     q.estimate_row_delay = estimate_row_delay;
     q.fit_light = true;
     q.half_width_px = kNarrowHalfWidthPx;
-    q.iterations = kNarrowIterations;
+    q.iterations = narrow_iterations;
     FitOutcome second = internal::FitOutline(geometry, view, *background, q);
     return second.ok ? second : first;
   }
@@ -323,7 +341,7 @@ struct BallTracker::Impl {
     const FitRequest wide = q;
     q.half_width_px = kNarrowHalfWidthPx + 1;
     q.fit_edge_shift = true;
-    q.iterations = kNarrowIterations;
+    q.iterations = kStartedNearIterations;
     const FitOutcome one = internal::FitOutline(geometry, view, *background, q);
     if (one.ok && (geometry.Project(one.p[internal::kCentreX], one.p[internal::kCentreZ]) -
                    geometry.Project(q.centre.x(), q.centre.y())).norm() < 0.5)
@@ -568,7 +586,7 @@ struct BallTracker::Impl {
     q.reference_row = geometry.Project(q.centre.x(), q.centre.y()).y();
     q.half_width_px = kNarrowHalfWidthPx;
     q.fit_edge_shift = q.fit_light = true;
-    q.iterations = kNarrowIterations;
+    q.iterations = kStartedNearIterations;
     q.light_inverse_distance = fit.light_inverse_distance;
     q.estimate_row_delay = true;
     const cv::Rect box = KeptWindow(q.centre, 2 * Vector2d(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]), frame);
@@ -622,11 +640,10 @@ struct BallTracker::Impl {
       }
       if (!motion) velocity = acceleration = Vector2d::Zero();
       FitRequest q = Request(it->centre, velocity, motion, kNarrowHalfWidthPx + 1.5, acceleration);
-      // Started at the frame's own fit, within a pixel or so: a narrow pass's iterations (the
-      // ray-traced clips measure the same as with 3, in 2 % less of fast-360-30's time).
-      q.iterations = kNarrowIterations;
+      // Started at the frame's own fit, within a pixel or so.
+      q.iterations = kStartedNearIterations;
       q.estimate_row_delay = false;  // measured when the frame was first fitted
-      const FitOutcome fit = Measure({it->window, it->origin, it->gain}, q);
+      const FitOutcome fit = Measure({it->window, it->origin, it->gain}, q, Search::kTracking, kStartedNearIterations);
       if (Accept(fit, 0.45)) {
         BallObservation o = Observe(fit, q);
         const double moved = std::hypot(o.u - it->observed.u, o.v - it->observed.v);
@@ -984,7 +1001,7 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
     const Vector2d v = predicted ? velocity : Vector2d::Zero();
     const FitRequest q = m.Request(guess, v, predicted && m.history.size() >= 2, 2 * m.options.search_half_width_px,
                                    predicted ? acceleration : Vector2d::Zero());
-    const FitOutcome fit = m.Measure({frame, {0, 0}, gain}, q);
+    const FitOutcome fit = m.Measure({frame, {0, 0}, gain}, q, Impl::Search::kAcquiring);
     if (!m.Accept(fit, 0.6)) {
       if (!predicted) m.rejected.Remember(frame, window);
     } else {

@@ -132,7 +132,10 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
                                                    " px frames (calibrate the camera at the video's resolution)");
   TrackerOptions tracker_options = options.tracker;
   if (result.fps > 0 && std::isfinite(result.fps)) tracker_options.fps = result.fps;
+  // The tracker's own time: its set-up, every frame and the work at the end of the clip.
+  const double setup_cpu0 = ThreadCpuSeconds();
   BallTracker tracker(scene, calibration, tracker_options);
+  result.tracker_cpu_seconds += ThreadCpuSeconds() - setup_cpu0;
 
   std::optional<PendingFile> overlay_file;  // destroyed after the writer: it closes first
   std::optional<cv::VideoWriter> overlay;
@@ -194,7 +197,9 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
     result.rows.push_back(row);
     if (options.progress) options.progress(static_cast<int>(result.rows.size()), result.declared_frames);
   }
+  const double finish_cpu0 = ThreadCpuSeconds();
   tracker.Finish();
+  result.tracker_cpu_seconds += ThreadCpuSeconds() - finish_cpu0;
   for (auto& [k, revised] : tracker.TakeRevisions()) Revise(result.rows, k, revised);
   if (result.rows.empty())
     throw InputError(video_path, "has no frame that can be decoded (not a video, or corrupt from the start)");

@@ -42,7 +42,9 @@ struct TrackResult {
   double fps = 0;               // the container's nominal rate
   long declared_frames = 0;     // the container's frame count (0: unknown)
   int extrapolated_times = 0;   // timestamps replaced (see above)
-  double tracker_cpu_seconds = 0;  // CPU time of the tracker itself (this thread, decoding excluded)
+  // CPU time of the tracker itself: its set-up, the frames and the clip's end (refits, the
+  // readout's settling); this thread's, decoding excluded.
+  double tracker_cpu_seconds = 0;
   bool partial = false;
   bool input_problem = false;   // partial because of the input (exit status 2), not a ball lost at the end
   std::string partial_reason;

@@ -605,6 +605,30 @@ bool InFront(const OutlineGeometry& g, double x, double z) {
          (Vector3d(x, 0, z) - g.eye).norm() > 2 * std::max(g.a, g.a / g.s);
 }
 
+// The centre's move in the image at each successful iteration of a solve (the solver writes the
+// parameters back every iteration): the last one says whether a solve stopped by its cap of
+// iterations had settled.
+class CentreSteps : public ceres::IterationCallback {
+ public:
+  CentreSteps(const OutlineGeometry& g, const double* params)
+      : g_(g), params_(params), at_(g.Project(params[kCentreX], params[kCentreZ])) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (summary.iteration > 0 && summary.step_is_successful) {
+      const Vector2d now = g_.Project(params_[kCentreX], params_[kCentreZ]);
+      last_px_ = (now - at_).norm();
+      at_ = now;
+    }
+    return ceres::SOLVER_CONTINUE;
+  }
+  double last_px() const { return last_px_; }
+
+ private:
+  const OutlineGeometry& g_;
+  const double* params_;
+  Vector2d at_;
+  double last_px_ = 0;
+};
+
 }  // namespace
 
 std::vector<Vector3d> OutlineGeometry::OutlinePoints(double x, double z, int n) const {
@@ -795,6 +819,9 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   solver.function_tolerance = 1e-7;
   solver.parameter_tolerance = 1e-7;
   ceres::Solver::Summary summary;
+  CentreSteps steps(g, params);
+  solver.callbacks.push_back(&steps);
+  solver.update_state_every_iteration = true;  // for CentreSteps
   // The shading learnt where the body rested, lit from where this frame sees the lamp at the
   // fit's start (a first pass's result, or the prediction where the model measured the frame
   // before): solving first and then once more from there measures the same on the ray-traced
@@ -827,6 +854,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   out.misfit = std::sqrt(sum / out.inliers);
   out.noise = q.noise * std::sqrt(median);
   std::copy(std::begin(params), std::end(params), out.p.begin());
+  out.last_step_px = steps.last_px();
   if (q.estimate_row_delay) {
     const auto [delay, sigma] = PreferredRowDelay(costs, squares, limit, params, q);
     out.row_delay = delay, out.row_delay_sigma = sigma;

@@ -83,9 +83,9 @@ struct FitRequest {
   bool fit_light = true;                // false: held at its prior mean (a first pass)
   // Ceres iterations at most. With Kaufman's Jacobian the step shrinks about four-fold per
   // iteration: from a coarse search 3 (the ray-traced clips measure the same with 3 as with 6;
-  // with 2 the phone clip locks on a wrong place); a narrow pass around a fit or a checked
-  // prediction, started within half a pixel or so, is done in 2 (docs/track.md, "The fit's
-  // Jacobian").
+  // with 2 the phone clip locks on a wrong place); a narrow pass after a coarse search in 2; a
+  // pass started within half a pixel or so, at a fit of the same frame or a checked prediction,
+  // in 1 (ball_tracker.cpp; docs/track.md, "The fit's Jacobian").
   int iterations = 3;
 };
 
@@ -110,6 +110,9 @@ struct FitOutcome {
   // parameter free (one Gauss–Newton step from the fit at the request's delay), and its standard
   // error; row_delay_sigma 0: not estimated.
   double row_delay = 0, row_delay_sigma = 0;
+  // The centre's move in the image at the solve's last successful iteration, px: how far from
+  // settled a solve stopped by its cap of iterations was (0: no step taken).
+  double last_step_px = 0;
 };
 
 FitOutcome FitOutline(const OutlineGeometry& geometry, const FrameView& view, const BackgroundModel& background,
