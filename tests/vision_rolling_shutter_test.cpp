@@ -205,6 +205,7 @@ TEST(OutlineFit, LastStepIsTheCentresMoveInTheSolvesLastIteration) {
   const FitOutcome three = clip.Fit(0, offset, 3);
   ASSERT_TRUE(three.ok);
   std::printf("  one iteration: moved %.4f px; three: last step %.4f px\n", moved, three.last_step_px);
+  EXPECT_GT(three.last_step_px, 0);
   EXPECT_LT(three.last_step_px, 0.1 * moved);
 }
 

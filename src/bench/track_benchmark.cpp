@@ -131,7 +131,7 @@ constexpr const char* kMethod =
     "720p-clean (sharp, lossless FFV1), 720p-h264 and 1080p-h264 (motion blur over 1/60 s, noise sigma 2, "
     "flicker 1 %, H.264). Speed: frames per CPU-second of the whole process (one core's work; best of 3; "
     "OpenCV's parallel loops off): decoding alone (VideoCapture::read) and tracking with decoding included "
-    "(TrackVideo); ms/frame: the tracker alone. Accuracy: RMS of (u, v) against the truth, px, and of (x, z), "
+    "(TrackVideo); ms/frame: the tracker alone, its set-up and the clip's end included. Accuracy: RMS of (u, v) against the truth, px, and of (x, z), "
     "mm, over the frames where at least half the ball is visible. Peers (tools/bench/track_peers.py): OpenCV's "
     "CSRT and KCF trackers and HoughCircles on the same files, started from the true first box. \"peak RSS\": "
     "the process's peak resident memory over the row.";
@@ -195,8 +195,8 @@ void RunTrackBenchmark(const TrackBenchmarkOptions& f, std::ostream& out) {
          "k1 = -0.1), 120 frames at 30 fps, at rest for 1.8 s then rolling; clips in "
       << cache.string()
       << ".\nfps: frames per CPU-second of the process (one core's work; best of 3); decode = VideoCapture::read\n"
-         "only, track = uphill's tracker with the decoding included; ms/frame = the tracker alone (its\n"
-         "thread's CPU time). RMS over frames with the ball at least half visible.\n\n";
+         "only, track = uphill's tracker with the decoding included; ms/frame = the tracker alone, its\n"
+         "set-up and the clip's end included (its thread's CPU time). RMS over frames with the ball at least half visible.\n\n";
   Table table({{"clip", 12, true}, {"decode fps", 10}, {"track fps", 9}, {"ratio", 6}, {"ms/frame", 8},
                {"RMS (u,v)", 9}, {"RMS (x,z)", 9}, {"found", 7}, {"peak RSS", 8}});
   table.Start(out);

@@ -139,7 +139,7 @@ struct Run {
   std::string calibration_note;
   Score uphill;
   std::string uphill_says;  // error / partial / complete
-  double ms_per_frame = 0;         // the tracker alone (its thread's CPU time)
+  double ms_per_frame = 0;         // the tracker alone with its set-up and end (its thread's CPU time)
   double decode_ms_per_frame = 0;  // VideoCapture::read alone (process CPU time)
   double model_share = 0;          // frames measured by the full model, of those found
   std::map<std::string, Score> peers;

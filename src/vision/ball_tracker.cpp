@@ -23,16 +23,17 @@ using internal::FitOutcome;
 using internal::FitRequest;
 
 constexpr double kNarrowHalfWidthPx = 1.5;  // second pass, around the first fit
-// Ceres iterations of a narrow pass (outline_fit.hpp, FitRequest::iterations): the ray-traced
-// clips measure as with 3 (spheroid-band 0.251 px against 0.248, fast-360-30 0.238 against 0.237)
-// at 10 % less of the tracker's time.
+// Ceres iterations of the narrow pass after a coarse search (outline_fit.hpp,
+// FitRequest::iterations): the ray-traced clips measure as with 3 (spheroid-band 0.251 px against
+// 0.248, fast-360-30 0.238 against 0.237) at 10 % less of the tracker's time.
 constexpr int kNarrowIterations = 2;
 // Ceres iterations of a pass started at a fit of the same frame or at a checked prediction,
 // within half a pixel or so, where Kaufman's step leaves about a quarter of the offset: the
 // narrow pass where the model measured the frame before (MeasureNear), both passes of a refit,
 // and the refit of a frame at the settled row delay. On the ray-traced clips one iteration there
 // instead of two measures fast-360-30 at 0.233 px (0.236), spheroid-band 0.258 (0.253) and
-// rolling-shutter 0.168 (0.159), in 12 % less of fast-360-30's instructions (docs/track.md).
+// rolling-shutter 0.168 (0.159), in 12 % less of fast-360-30's instructions; with the coarse
+// pass's repeat below, 0.228, 0.250 and 0.159 px before both (docs/track.md).
 constexpr int kStartedNearIterations = 1;
 constexpr int kHistoryGap = 5;              // frames without the body after which we predict no more
 constexpr size_t kHistory = 6;              // samples the prediction is fitted to
@@ -305,7 +306,8 @@ struct BallTracker::Impl {
     // outline onto an inner edge than move it. Again from where it went while it moves more
     // than a pixel and its last iteration still moved it by a pixel or more (the windows follow
     // a solve that had not settled; one that had moves by less than 0.25 px when repeated on the
-    // ray-traced clips), then a narrow pass around the result. A body found anew is fitted again
+    // fast ray-traced clips; a refit's single iteration has moved the whole way, so there the
+    // move alone decides), then a narrow pass around the result. A body found anew is fitted again
     // whenever it moved more than a pixel: the repeat starts the smear afresh from its prior,
     // where the first fit, far from the edges, may have taken a spurious one (on the phone clip
     // the first frame then failed the inlier share a new body needs).
