@@ -10,6 +10,7 @@
 #include "model/input_error.hpp"
 #include "internal/background_model.hpp"
 #include "internal/edge_fit.hpp"
+#include "internal/motion_prediction.hpp"
 #include "internal/outline_fit.hpp"
 #include "internal/rejected_windows.hpp"
 #include "internal/row_delay_settle.hpp"
@@ -210,34 +211,13 @@ struct BallTracker::Impl {
   }
   double MetresPerPx(double x, double z) const { return 1.0 / (geometry.cal.camera.fx / (Vector3d(x, 0, z) - geometry.eye).norm()); }
 
-  // The centre, velocity and acceleration predicted at time t from the history: least squares
-  // through the last samples, a parabola in time from four on (constant acceleration), a line
-  // through two or three (no acceleration).
-  bool Predict(long f, double t, Vector2d* centre, Vector2d* velocity, Vector2d* acceleration) const {
-    if (history.empty() || f - history.back().first > kHistoryGap) return false;
-    const size_t n = history.size();
-    const int degree = n >= 4 ? 2 : n >= 2 ? 1 : 0;
-    const double t_last = history.back().second.t;
-    Eigen::MatrixXd a(n, degree + 1);
-    Eigen::MatrixXd y(n, 2);
-    for (size_t i = 0; i < n; ++i) {
-      const Sample& s = history[i].second;
-      const double dt = s.t - t_last;
-      for (int k = 0; k <= degree; ++k) a(i, k) = std::pow(dt, k);
-      y(i, 0) = s.x;
-      y(i, 1) = s.z;
-    }
-    const Eigen::MatrixXd coef = a.colPivHouseholderQr().solve(y);
-    const double dt = t - t_last;
-    *centre = Vector2d::Zero();
-    *velocity = Vector2d::Zero();
-    *acceleration = Vector2d::Zero();
-    for (int k = 0; k <= degree; ++k) {
-      *centre += coef.row(k).transpose() * std::pow(dt, k);
-      if (k >= 1) *velocity += coef.row(k).transpose() * (k * std::pow(dt, k - 1));
-    }
-    if (degree == 2) *acceleration = 2 * coef.row(2).transpose();
-    return centre->allFinite() && velocity->allFinite() && acceleration->allFinite();
+  // The motion through the history (motion_prediction.hpp), while the body may still be predicted
+  // from it.
+  std::optional<internal::MotionFit> Motion(long f) const {
+    if (history.empty() || f - history.back().first > kHistoryGap) return std::nullopt;
+    std::vector<internal::TimedCentre> timed;
+    for (const auto& [frame, s] : history) timed.push_back({s.t, Vector2d(s.x, s.z)});
+    return internal::MotionFit::Through(timed);
   }
 
   // The body's region (smeared silhouette, a radius around it, and its shadow below it), px.
@@ -302,8 +282,9 @@ struct BallTracker::Impl {
   // (with `narrow_iterations`; q.iterations caps the first passes).
   FitOutcome Measure(const internal::FrameView& view, FitRequest q, Search search = Search::kTracking,
                      int narrow_iterations = kNarrowIterations) {
-    // First passes with the edge shift held: far from the edges it would rather shrink the
-    // outline onto an inner edge than move it. Again from where it went while it moves more
+    // Every pass with the edge shift held: far from the edges it would rather shrink the outline
+    // onto an inner edge than move it, and near them it moves the centre across the motion
+    // (MeasureNear). The first pass again from where it went while it moves more
     // than a pixel and its last iteration still moved it by a pixel or more (the windows follow
     // a solve that had not settled; one that had moves by less than 0.25 px when repeated on the
     // fast ray-traced clips; a refit's single iteration has moved the whole way, so there the
@@ -336,13 +317,18 @@ struct BallTracker::Impl {
     return second.ok ? second : first;
   }
 
-  // One narrow pass with every parameter free, where the prediction is good (the model measured
-  // the previous frame, its background known): one Ceres solve instead of two or more. Measure() when
-  // the fit moves more than half a pixel from the prediction or fails.
+  // One narrow pass, where the prediction is good (the model measured the previous frame, its
+  // background known): one Ceres solve instead of two or more. Measure() when the fit moves more
+  // than half a pixel from the prediction or fails. The edge shift is held as in Measure(), so
+  // that both fit the same parameters: freed here alone, it moved the centre across the motion
+  // by up to 0.3 px on the fast clips' frames this pass measures (fast-180-30 0.216 px RMS
+  // against 0.190 held, fast-360-60 0.170 against 0.161, rolling-shutter 0.192 against 0.165
+  // with the prediction at the row's own time in both; fast-360-30 alone the other way, 0.241
+  // against 0.261; the renderer's camera). Freed in both it was worse on all four.
   FitOutcome MeasureNear(const internal::FrameView& view, FitRequest q) {
     const FitRequest wide = q;
     q.half_width_px = kNarrowHalfWidthPx + 1;
-    q.fit_edge_shift = true;
+    q.fit_edge_shift = false;
     q.iterations = kStartedNearIterations;
     const FitOutcome one = internal::FitOutline(geometry, view, *background, q);
     if (one.ok && (geometry.Project(one.p[internal::kCentreX], one.p[internal::kCentreZ]) -
@@ -523,24 +509,20 @@ struct BallTracker::Impl {
   // around it (a parabola in time through up to four on each side); false with fewer than two on
   // each side.
   bool VelocityAround(long f, double t, Vector2d* velocity, Vector2d* acceleration) const {
-    std::vector<Sample> near;
+    std::vector<internal::TimedCentre> near;
     int before = 0, after = 0;
     for (auto it = samples.lower_bound(f - 4); it != samples.end() && it->first <= f + 4; ++it) {
       if (it->first == f) continue;
-      near.push_back(it->second);
+      near.push_back({it->second.t, Vector2d(it->second.x, it->second.z)});
       (it->first < f ? before : after)++;
     }
     if (before < 2 || after < 2) return false;
-    Eigen::MatrixXd a(near.size(), 3), y(near.size(), 2);
-    for (size_t i = 0; i < near.size(); ++i) {
-      const double dt = near[i].t - t;
-      a(i, 0) = 1, a(i, 1) = dt, a(i, 2) = dt * dt;
-      y(i, 0) = near[i].x, y(i, 1) = near[i].z;
-    }
-    const Eigen::MatrixXd coef = a.colPivHouseholderQr().solve(y);
-    *velocity = coef.row(1).transpose();
-    *acceleration = 2 * coef.row(2).transpose();
-    return velocity->allFinite() && acceleration->allFinite();
+    const auto fit = internal::MotionFit::Through(near);
+    if (!fit) return false;
+    const internal::MotionState state = fit->At(t);
+    *velocity = state.velocity;
+    *acceleration = state.acceleration;
+    return true;
   }
 
   // Whether the background is known everywhere around the body centred at `centre` (its region,
@@ -587,6 +569,8 @@ struct BallTracker::Impl {
     q.centre = Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
     q.reference_row = geometry.Project(q.centre.x(), q.centre.y()).y();
     q.half_width_px = kNarrowHalfWidthPx;
+    // The edge shift free here alone (this refit places no centre): held, fast-360-30's readout
+    // with --readout auto came out 11.4 ± 4.0 ms of the true 0 (2.8 u) against 10.7 ± 4.6 free.
     q.fit_edge_shift = q.fit_light = true;
     q.iterations = kStartedNearIterations;
     q.light_inverse_distance = fit.light_inverse_distance;
@@ -794,7 +778,7 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
     last_at = at, last_radius = radius;
   }
   m.background = std::make_unique<internal::BackgroundModel>(
-      band, options.transfer == VideoTransfer::kLinear ? internal::Transfer::kLinear : internal::Transfer::kSrgb);
+      std::move(band), options.transfer == VideoTransfer::kLinear ? internal::Transfer::kLinear : internal::Transfer::kSrgb);
 }
 
 BallTracker::~BallTracker() = default;
@@ -853,14 +837,16 @@ BallObservation BallTracker::Track(const cv::Mat& input) {
   const long f = ++m.frame_index;
   const double t = f / m.options.fps;
 
-  Vector2d centre, velocity, acceleration;
-  const bool predicted = m.Predict(f, t, &centre, &velocity, &acceleration);
-  if (m.unconfirmed && !predicted) m.Withdraw();  // not found again while it could be predicted
-  if (predicted && m.row_delay > 0) {
-    // The reference time: the mid-exposure of the predicted centre's row.
-    const double row = m.geometry.Project(centre.x(), centre.y()).y();
-    centre += velocity * (row * m.row_delay);
+  // The reference time: the mid-exposure of the row where the centre lies at that time.
+  std::optional<internal::MotionState> motion;
+  if (const auto fit = m.Motion(f)) {
+    motion = fit->AtOwnRow(t, m.row_delay, [&](const Vector2d& c) { return m.geometry.Project(c.x(), c.y()).y(); });
+    if (!motion->centre.allFinite() || !motion->velocity.allFinite()) motion.reset();
   }
+  const bool predicted = motion.has_value();
+  if (m.unconfirmed && !predicted) m.Withdraw();  // not found again while it could be predicted
+  Vector2d centre, velocity, acceleration;
+  if (predicted) centre = motion->centre, velocity = motion->velocity, acceleration = motion->acceleration;
   cv::Rect region;
   if (predicted) region = m.BodyRegion(centre, velocity * m.Exposure());
   m.background->Measure(frame, region);

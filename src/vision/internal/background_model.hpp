@@ -32,8 +32,9 @@ class BackgroundModel {
  public:
   static constexpr int kAveraged = 8;
 
-  // band: CV_8U mask (non-zero: pixels the body can cover), the frame's size.
-  BackgroundModel(const cv::Mat& band, Transfer transfer);
+  // band: CV_8U mask (non-zero: pixels the body can cover), the frame's size; kept, its pixels
+  // shared (cv::Mat), so not to be changed afterwards.
+  BackgroundModel(cv::Mat band, Transfer transfer);
 
   // This frame's gain and scene residual (before Learn), `exclude` the body's region (may be
   // empty: nothing excluded). Returns false when too few known pixels (gain 1, residual unknown).
@@ -70,7 +71,7 @@ class BackgroundModel {
     int y, begin, end;
   };
   std::vector<Run> runs_;
-  cv::Mat background_;              // CV_32FC3 over box_ (zero outside the band)
+  cv::Mat background_;              // CV_32FC3 over box_, defined where count_ > 0
   cv::Mat count_;                   // CV_8U over box_, looks so far (saturating)
   std::vector<cv::Point> probes_;   // fixed pixels of the band for the gain
   std::vector<float> probe_luminance_;  // the background's B + G + R at each probe, 0 if unknown

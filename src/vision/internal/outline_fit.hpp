@@ -78,7 +78,7 @@ struct FitRequest {
   double half_width_px = 6;             // uncertainty of the prediction along each ray
   int rays = 64;
   double noise = 0.01;                  // expected RMS of a sample's residual, linear units
-  bool fit_edge_shift = true;           // false: b held at 0 (a first pass far from the edges)
+  bool fit_edge_shift = true;           // false: b held at 0 (the tracker's passes that place the centre)
   double light_inverse_distance = 0;    // 1/m: the lamp's, prior mean (BodyShading::LitFrom)
   bool fit_light = true;                // false: held at its prior mean (a first pass)
   // Ceres iterations at most. With Kaufman's Jacobian the step shrinks about four-fold per

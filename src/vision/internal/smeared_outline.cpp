@@ -144,6 +144,7 @@ SmearNodes::SmearNodes(const SmearedBody& body, const double* p, const Eigen::Ve
 
 SmearNodes::SmearNodes(const SmearNodes& a, const SmearNodes& b, double t)
     : body_(a.body_), shift_(a.shift_), count_(a.count_) {
+  reach_[0] = 0;  // before the loop: node 1's reach adds to it
   for (int n = 0; n < count_; ++n) {
     const Node &na = a.nodes_[n], &nb = b.nodes_[n];
     Node& node = nodes_[n];
@@ -157,7 +158,6 @@ SmearNodes::SmearNodes(const SmearNodes& a, const SmearNodes& b, double t)
       reach_[n] = reach_[n - 1] + step * (1 + 1e-3);
     }
   }
-  reach_[0] = 0;
 }
 
 double SmearNodes::DistanceAtMiddle(const Vector3d& d) const {
