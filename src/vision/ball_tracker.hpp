@@ -31,11 +31,12 @@
 // coverage of internal/smeared_outline.hpp, blurred by the optics' point spread. Rays from the
 // predicted centre across the predicted smeared outline are sampled in linear light and the
 // model I = (1 − c)·g·B + c·F (c·S·F on a long smear, S the body's shading learnt at rest,
-// lit by a lamp overhead whose distance is fitted frame by frame: internal/body_shading.hpp) is fitted with Ceres to all of them at once (centre and
-// smear; per-ray Cauchy loss: a painted band's edges, highlights, the shadow and the crossbar do
-// not fit one limb colour and drop out). The model's uniform edge shift (outline_fit.hpp) is held
-// at 0 by every pass that places the centre: freed, it moved the centre across the motion. Rays through the near rail's
-// band are not used. (u, v) is the projection of the fitted C, not the centre of the outline's
+// lit by a lamp overhead whose distance is fitted frame by frame: internal/body_shading.hpp) is
+// fitted with Ceres to all of them at once (centre and smear; per-ray Cauchy loss: a painted
+// band's edges, highlights, the shadow and the crossbar do not fit one limb colour and drop
+// out). The model's uniform edge shift (outline_fit.hpp) is held at 0 by every pass that places
+// the centre: freed, it moved the centre across the motion. Rays through the near rail's band
+// are not used. (u, v) is the projection of the fitted C, not the centre of the outline's
 // ellipse, which perspective shifts.
 //
 // Model only what the scene needs (the fast path): most frames of most clips are a body that
