@@ -40,9 +40,19 @@ TEST(VideoReportCli, ReportsTheVideoTrialsAndNamesTheBadOne) {
   const CommandResult r = RunUphill("report " + exp.string() + " -o " + (dir / "out").string() + " --mc-trials 1000");
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("trial 'b' (videos/notes.mp4)"), std::string::npos) << r.err;
+  // The video's error is printed once (with the videos), not again for the row it leaves without Y.
+  const auto count = [](const std::string& text, const std::string& part) {
+    std::size_t n = 0;
+    for (auto at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count(r.err, "notes.mp4: is not a video"), 1u) << r.err;
+  EXPECT_NE(r.err.find("trial 'b' (videos/notes.mp4): Y is empty and its video could not be analysed"),
+            std::string::npos) << r.err;
   const std::string md = ReadBytes(dir / "out" / "report.md");
   EXPECT_NE(md.find("Rest positions from the videos"), std::string::npos);
   EXPECT_NE(md.find("| a | videos/rest.mp4 | \\- |"), std::string::npos) << md;
+  EXPECT_EQ(count(md, "notes.mp4: is not a video"), 1u) << md;
   EXPECT_TRUE(fs::exists(dir / "out" / "video_01_x_vs_t.svg"));
   EXPECT_TRUE(fs::exists(exp / ".uphill-cache" / "video"));
 

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstdint>
 #include <filesystem>
 #include <stdexcept>
@@ -109,6 +110,38 @@ TEST(FigurePool, AFailingScriptIsNamedWithItsFileAndTheOthersAreWritten) {
   ExpectNoRenderFolders(dir);
   pool.Wait();  // the failure was reported once
   fs::remove_all(dir);
+}
+
+// A machine without gnuplot: every figure fails for the same reason, which is the machine's,
+// not a figure's. The truth is the rule of figure_pool.hpp: the reason is given once, with the
+// number of figures it stopped (it used to be repeated for each figure). PATH is pointed at an
+// empty folder, so posix_spawnp finds no gnuplot.
+TEST(FigurePool, AMissingGnuplotIsReportedOnceWithTheNumberOfFigures) {
+  const fs::path dir = FreshFolder("figure-pool-no-gnuplot");
+  const fs::path empty = FreshFolder("figure-pool-empty-path");
+  const char* old_path = std::getenv("PATH");
+  const std::string saved = old_path ? old_path : "";
+  ::setenv("PATH", empty.c_str(), 1);
+  std::string message;
+  {
+    FigurePool pool(2);
+    for (int k = 1; k <= 5; ++k) pool.Render(Series(k), dir.string());
+    try {
+      pool.Wait();
+    } catch (const EnvironmentError& e) {
+      message = e.what();
+    }
+  }
+  ::setenv("PATH", saved.c_str(), 1);
+  const std::string reason = "gnuplot not found (install Debian's gnuplot-nox)";
+  ASSERT_NE(message.find(reason), std::string::npos) << message;
+  EXPECT_EQ(message.find(reason), message.rfind(reason)) << message;
+  EXPECT_NE(message.find("5 figures failed"), std::string::npos) << message;
+  EXPECT_NE(message.find("(5 figures)"), std::string::npos) << message;
+  for (int k = 1; k <= 5; ++k) EXPECT_FALSE(fs::exists(dir / ("series_" + std::to_string(k) + ".svg")));
+  ExpectNoRenderFolders(dir);
+  fs::remove_all(dir);
+  fs::remove_all(empty);
 }
 
 TEST(FigurePool, AFigureSubmittedTwiceIsDrawnOnceAndDifferentContentIsRefused) {

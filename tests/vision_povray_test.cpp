@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -23,6 +24,7 @@
 #include "cli_test_support.hpp"
 #include "io/csv_table.hpp"
 #include "motion/motion.hpp"
+#include "vision/footage_clip.hpp"
 #include "vision/footage_conditions.hpp"
 #include "vision/lens_remap.hpp"
 #include "vision/povray_render.hpp"
@@ -141,6 +143,27 @@ class PovrayTest : public ::testing::Test {
 
 // POV-Ray's pinhole camera as povray_scene.hpp sets it up is OpenCV's pinhole: a glowing point
 // lands on cv::projectPoints' pixel (no distortion, so no remap is involved).
+// The footage cache is keyed on the generator's code, not on a version constant someone must
+// remember to bump. Truth: coreutils' sha256sum over the generator's files (the list CMake hashes,
+// UPHILL_FOOTAGE_GENERATOR_SOURCES), combined as src/vision/CMakeLists.txt states; the clip's
+// description (hence its cache key) and the chessboard views' must carry that digest.
+TEST(FootageCache, KeyHoldsTheDigestOfTheGeneratorsCode) {
+  std::string command = "for f in";
+  std::stringstream sources(UPHILL_FOOTAGE_GENERATOR_SOURCES);
+  int files = 0;
+  for (std::string file; std::getline(sources, file, '|'); ++files) command += " '" + file + "'";
+  command += "; do sha256sum \"$f\" | cut -c1-64; done | sha256sum | cut -c1-64";
+  ASSERT_GE(files, 20) << "the generator's files were not passed to the test";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  char digest[65] = {};
+  ASSERT_EQ(std::fread(digest, 1, 64, pipe), 64u);
+  ASSERT_EQ(::pclose(pipe), 0);
+  const nlohmann::ordered_json description = DescribeFootage(FootageByName("tiny").condition);
+  EXPECT_EQ(description.at("generator").get<std::string>(), std::string(digest));
+  EXPECT_EQ(description.at("boards").at("generator").get<std::string>(), std::string(digest));
+}
+
 TEST_F(PovrayTest, PinholeCameraMatchesProjectPoints) {
   SceneCalibration cal;
   cal.camera = {320, 180, 300.0, 297.0, 163.3, 86.8, {}};

@@ -386,7 +386,9 @@ ExperimentAnalysis AnalyseExperimentWithVideos(Experiment* experiment, const std
     for (ExperimentRow& row : experiment->rows) {
       if (row.row != t.row || !row.error.empty() || row.y_typed) continue;
       if (!t.error.empty()) {
-        row.error = t.error;
+        // The video's own error is reported once, with the videos; the row says only why it
+        // has no Y.
+        row.error = "trial '" + t.trial + "' (" + t.video + "): Y is empty and its video could not be analysed (above)";
       } else if (!t.rest) {
         row.error = "trial '" + t.trial + "' (" + t.video + "): Y is empty and the video gives none: " + t.no_rest;
       } else {

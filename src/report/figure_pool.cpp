@@ -64,11 +64,19 @@ void FigurePool::Wait() {
   std::unique_lock<std::mutex> lock(mutex_);
   work_done_.wait(lock, [this] { return queue_.empty() && running_ == 0; });
   if (failures_.empty()) return;
-  std::vector<std::string> failures;
-  failures.swap(failures_);
-  std::sort(failures.begin(), failures.end());  // the same report whatever order they ran in
-  std::string message = failures.size() == 1 ? "" : std::to_string(failures.size()) + " figures failed: ";
-  for (std::size_t i = 0; i < failures.size(); ++i) message += (i ? "; " : "") + failures[i];
+  // Sorted, the same report whatever order they ran in; a message met by several figures (a
+  // missing gnuplot names no figure) is given once, with how many figures it stopped.
+  std::map<std::string, std::size_t> failures;
+  for (std::string& f : failures_) ++failures[std::move(f)];
+  const std::size_t failed = failures_.size();
+  failures_.clear();
+  std::string message = failed == 1 ? "" : std::to_string(failed) + " figures failed: ";
+  bool first = true;
+  for (const auto& [text, count] : failures) {
+    message += (first ? "" : "; ") + text;
+    if (count > 1) message += " (" + std::to_string(count) + " figures)";
+    first = false;
+  }
   throw EnvironmentError(message);
 }
 

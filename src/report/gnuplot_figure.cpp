@@ -59,8 +59,10 @@ void SyncFile(const fs::path& path, const std::string& figure) {
 
 // Runs `gnuplot -e ASSIGNMENTS SCRIPT` in `dir`, its output into `log`; spawned directly (no
 // shell), so that several figures can be drawn at once from threads (figure_pool.hpp) and each
-// call waits for its own child only. Throws EnvironmentError starting with `what` when gnuplot is
-// missing or fails (with gnuplot's complaint, which names the script's line).
+// call waits for its own child only. Throws EnvironmentError starting with `what` when gnuplot
+// fails (with gnuplot's complaint, which names the script's line) or cannot be started; a missing
+// gnuplot is the machine's problem, not the figure's, so that message names no figure and is the
+// same for every figure (FigurePool reports it once).
 void RunGnuplot(const fs::path& dir, const std::string& assignments, const std::string& script, const fs::path& log,
                 const std::string& what) {
   posix_spawn_file_actions_t actions;
@@ -74,7 +76,7 @@ void RunGnuplot(const fs::path& dir, const std::string& assignments, const std::
   pid_t pid = 0;
   const int spawned = ::posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
   posix_spawn_file_actions_destroy(&actions);
-  if (spawned == ENOENT) throw EnvironmentError(what + ": gnuplot not found (install Debian's gnuplot-nox)");
+  if (spawned == ENOENT) throw EnvironmentError("gnuplot not found (install Debian's gnuplot-nox)");
   if (spawned != 0) throw EnvironmentError(what + ": gnuplot cannot be started: " + std::strerror(spawned));
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {

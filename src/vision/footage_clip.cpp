@@ -37,8 +37,9 @@ using Eigen::Vector2d;
 using Eigen::Vector3d;
 using ordered_json = nlohmann::ordered_json;
 
-// Bump when the renderer changes what a condition's pixels are.
-constexpr int kGeneratorVersion = 1;
+// A digest of the generator's code (src/vision/CMakeLists.txt): what the same condition's pixels
+// and truth are depends on it, so it is part of every cache key.
+constexpr const char* kGeneratorDigest = UPHILL_FOOTAGE_GENERATOR_DIGEST;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 ordered_json DescribeCamera(const CameraIntrinsics& c) {
@@ -57,7 +58,7 @@ ordered_json DescribeSensor(const SensorModel& s, double gain, double vignetting
 }
 
 ordered_json DescribeBoards(const FootageCondition& c) {
-  return {{"generator", kGeneratorVersion},
+  return {{"generator", kGeneratorDigest},
           {"camera", DescribeCamera(c.camera.camera)},
           {"sensor", DescribeSensor(c.sensor, c.gain, c.vignetting)},
           {"boards", c.boards},
@@ -747,7 +748,7 @@ std::vector<std::string> EnsureBoards(const FootageCondition& c, const fs::path&
 ordered_json DescribeFootage(const FootageCondition& c) {
   const Body& body = c.scene.body();
   ordered_json j;
-  j["generator"] = kGeneratorVersion;
+  j["generator"] = kGeneratorDigest;
   j["name"] = c.name;
   j["body"] = {{"kind", body.kind == BodyKind::kSphere ? "sphere" : "spheroid"},
                {"across_m", body.across},

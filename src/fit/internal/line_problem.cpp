@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "fit/solver_logs.hpp"
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
 
@@ -160,6 +161,7 @@ StandardisedView ValidateAndView(const LineData& data, UncertaintyUse use, const
 namespace {
 
 ceres::Solver::Options SolverOptions(const FitOptions& options) {
+  QuietSolverLogs();
   ceres::Solver::Options solver;
   solver.minimizer_type = ceres::TRUST_REGION;
   solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
@@ -325,6 +327,7 @@ int RefineGaussNewton(const std::vector<const ceres::CostFunction*>& costs, doub
 
 std::optional<Eigen::MatrixXd> CeresCovariance(ceres::Problem* problem, const double* block,
                                                int size, bool apply_loss_function) {
+  QuietSolverLogs();
   ceres::Covariance::Options options;
   // SVD of the dense N×p Jacobian (thin: O(N·p²) time, O(N·p) memory, p ≤ 2 here): 4× faster
   // than Eigen's sparse QR on 10^6 rows, and it reports rank deficiency (reciprocal condition

@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "fit/solver_logs.hpp"
 #include "reduced_rows.hpp"
 
 namespace uphill::internal {
@@ -808,6 +809,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
                                new PriorCost{q.smear, 1.0 / sigma_d}),
                            nullptr, params);
   if (!q.fit_edge_shift) problem.SetManifold(params, new ceres::SubsetManifold(kSmearParameters, {kEdgeShift}));
+  QuietSolverLogs();
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;
   // The request's cap (FitRequest::iterations). Each iteration costs a Jacobian of every sample.

@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 
+#include "fit/solver_logs.hpp"
 #include "model/input_error.hpp"
 #include "motion/motion.hpp"
 #include "track_fit_errors.hpp"
@@ -265,6 +266,7 @@ void FitModel(const Series& s, int begin, int end, int direction, const Scene& s
   problem.SetParameterLowerBound(q.data(), 0, lo);
   problem.SetParameterUpperBound(q.data(), 0, hi);
   problem.SetParameterLowerBound(q.data(), 2, fit_g ? 1e-6 * o.g : 0.0);
+  QuietSolverLogs();
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
   so.max_num_iterations = 100;
