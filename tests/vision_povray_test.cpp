@@ -401,10 +401,11 @@ TEST_F(PovrayTest, UserPathOnATinyClip) {
   ASSERT_GT(compared, 0);
   const double rms_px = std::sqrt(s_px / compared), rms_mm = std::sqrt(s_mm / compared);
   std::printf("tiny clip: %d/%zu frames found, RMS %.3f px, %.3f mm\n", found, truth.size(), rms_px, rms_mm);
-  // Today's tracker on this clip: 10/10 frames, RMS 0.05 px, 0.08 mm (the lab's grey-level ball).
+  // About 1.5 times what the tracker measures on this seeded clip: 10/10 frames, RMS 0.092 px,
+  // 0.123 mm (the lab's grey-level ball).
   EXPECT_EQ(found, 10);
-  EXPECT_LT(rms_px, 0.15);
-  EXPECT_LT(rms_mm, 0.3);
+  EXPECT_LT(rms_px, 0.14);
+  EXPECT_LT(rms_mm, 0.19);
   fs::remove_all(dir);
 }
 

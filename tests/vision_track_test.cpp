@@ -87,7 +87,10 @@ ClipRun RenderAndTrack(const ClipRenderer& renderer, const Scene& scene, const M
 }
 
 // Found wherever the ball is in the picture; compared in at least min_frames; within the bounds.
-void ExpectAccurate(const Errors& e, int min_frames, double max_rms_uv_px, double max_rms_xz_mm = 0.5) {
+// Each test's bounds are about 1.5 times what the tracker measures on its clip (stated beside
+// them; the clips are seeded, so a run measures the same), so that a regression of half as much
+// again fails.
+void ExpectAccurate(const Errors& e, int min_frames, double max_rms_uv_px, double max_rms_xz_mm) {
   EXPECT_EQ(e.found, e.truth_present);
   EXPECT_GE(e.compared, min_frames);
   EXPECT_LE(e.rms_uv, max_rms_uv_px) << "max " << e.max_uv;
@@ -129,7 +132,7 @@ TEST_F(DefaultView, CleanLosslessClipWithinATenthOfAPixel) {
   const Motion motion(setup_->scene, setup_->x0);
   const ClipRun run = RenderAndTrack(*renderer_, setup_->scene, motion, s, "clean.avi");
   ASSERT_EQ(run.track.rows.size(), run.truth.size());
-  ExpectAccurate(run.errors, 27, 0.1);
+  ExpectAccurate(run.errors, 27, 0.05, 0.05);  // measured: 0.032 px, 0.033 mm
   EXPECT_FALSE(run.track.partial) << run.track.partial_reason;
   for (const TrackRow& r : run.track.rows) {
     EXPECT_NEAR(r.t, r.frame / 30.0, 1e-3);
@@ -149,7 +152,8 @@ TEST_F(DefaultView, BlurNoiseFlickerAndH264WithinThreeTenthsOfAPixel) {
   s.flicker = 0.02;
   s.seed = 7;
   const Motion motion(setup_->scene, setup_->x0);
-  ExpectAccurate(RenderAndTrack(*renderer_, setup_->scene, motion, s, "noisy.mp4").errors, 27, 0.3);
+  // measured: 0.079 px, 0.083 mm
+  ExpectAccurate(RenderAndTrack(*renderer_, setup_->scene, motion, s, "noisy.mp4").errors, 27, 0.12, 0.125);
 }
 
 // With a rolling shutter each row's time is the frame's plus the centre row's delay, also on the
@@ -174,6 +178,7 @@ TEST_F(DefaultView, RowTimesOfARollingShutterHoldOnFramesWithoutTimestamps) {
     ++checked;
   }
   EXPECT_EQ(checked, s.frames);
+  EXPECT_LE(run.errors.rms_uv, 0.15);  // measured: 0.095 px
 }
 
 TEST_F(DefaultView, InitialGuessAndLostBallKeepTheirRows) {
@@ -200,7 +205,7 @@ TEST_F(DefaultView, InitialGuessAndLostBallKeepTheirRows) {
   EXPECT_TRUE(track.partial);
   EXPECT_NE(track.partial_reason.find("lost"), std::string::npos) << track.partial_reason;
   const Errors e = Compare(truth, track);
-  EXPECT_LE(e.rms_uv, 0.1);
+  EXPECT_LE(e.rms_uv, 0.08);  // measured: 0.055 px
 
   const std::string csv = (TempDir() / "falls.csv").string();
   WriteTrack(csv, track, {video, "cam.json", "scene.json", "sphere"});
@@ -280,15 +285,18 @@ TEST_F(DefaultView, CameraThatMovedIsPartialWithoutPositionsAfterIt) {
   EXPECT_TRUE(track.input_problem);
   EXPECT_NE(track.partial_reason.find("changed at frame 12"), std::string::npos) << track.partial_reason;
   EXPECT_NE(track.partial_reason.find("camera moved"), std::string::npos) << track.partial_reason;
+  double worst = 0;
   for (int i = 0; i < 24; ++i) {
     const BallObservation& b = track.rows[i].ball;
     if (i >= 12) {
       EXPECT_FALSE(b.found) << "frame " << i << ": a position after the camera moved is invented";
     } else {
       ASSERT_TRUE(b.found) << "frame " << i;
-      EXPECT_LT(std::hypot(b.u - uv[i].x(), b.v - uv[i].y()), 0.3) << "frame " << i;
+      worst = std::max(worst, std::hypot(b.u - uv[i].x(), b.v - uv[i].y()));
     }
   }
+  std::printf("  frames before the move: largest error %.4f px\n", worst);
+  EXPECT_LT(worst, 0.04);  // measured: 0.027 px
 }
 
 TEST_F(DefaultView, ExposureThatChangedIsPartialAndKeepsPositions) {
@@ -304,11 +312,14 @@ TEST_F(DefaultView, ExposureThatChangedIsPartialAndKeepsPositions) {
   EXPECT_NE(track.partial_reason.find("exposure changed at frame 10"), std::string::npos) << track.partial_reason;
   ASSERT_EQ(track.exposure_changes.size(), 1u);
   EXPECT_EQ(track.exposure_changes[0], 10);
+  double worst = 0;
   for (int i = 0; i < 20; ++i) {
     const BallObservation& b = track.rows[i].ball;
     ASSERT_TRUE(b.found) << "frame " << i;
-    EXPECT_LT(std::hypot(b.u - uv[i].x(), b.v - uv[i].y()), 0.5) << "frame " << i;
+    worst = std::max(worst, std::hypot(b.u - uv[i].x(), b.v - uv[i].y()));
   }
+  std::printf("  largest error %.4f px\n", worst);
+  EXPECT_LT(worst, 0.07);  // measured: 0.047 px
 }
 
 TEST(VisionTrack, SpheroidCleanClip) {
@@ -319,7 +330,8 @@ TEST(VisionTrack, SpheroidCleanClip) {
   ClipSettings s;
   s.frames = 12;
   s.release_time = -1.4;
-  ExpectAccurate(RenderAndTrack(renderer, setup.scene, motion, s, "spheroid.avi").errors, 10, 0.1);
+  // measured: 0.028 px, 0.029 mm
+  ExpectAccurate(RenderAndTrack(renderer, setup.scene, motion, s, "spheroid.avi").errors, 10, 0.045, 0.045);
 }
 
 // A fast ball under a long exposure (issue 10's 360° shutter at 30 fps): steep rails (H = 250 mm,
@@ -352,8 +364,8 @@ TEST(VisionTrack, FastBallUnderA360DegreeShutterIsMeasuredAtMidExposure) {
   s.blur_samples = 32;
   s.noise_sigma = 1;
   const ClipRun run = RenderAndTrack(renderer, setup.scene, motion, s, "fast360.avi");
-  ExpectAccurate(run.errors, 28, 0.1);
-  EXPECT_LE(run.errors.max_uv, 0.3);
+  ExpectAccurate(run.errors, 28, 0.055, 0.03);  // measured: 0.035 px, 0.018 mm
+  EXPECT_LE(run.errors.max_uv, 0.12);           // measured: 0.078 px
   // The exposure, not given, measured from the smear against the speed.
   ASSERT_TRUE(run.track.measured_exposure.has_value());
   EXPECT_NEAR(*run.track.measured_exposure, 1.0 / 30, 0.002);
