@@ -31,6 +31,29 @@ void OutputPaths::AddInput(const std::string& path, const std::string& what) {
   inputs_.push_back({st.st_dev, st.st_ino, path, what});
 }
 
+void OutputPaths::AddInputFolder(const std::string& path, const std::string& what) {
+  struct stat st {};
+  if (path.empty() || ::stat(path.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) return;
+  input_folders_.push_back({st.st_dev, st.st_ino, path, what});
+}
+
+void OutputPaths::RefuseInsideInputFolder(const std::string& path, const std::string& context) const {
+  if (input_folders_.empty()) return;
+  std::error_code ec;
+  fs::path folder = fs::weakly_canonical(fs::absolute(FolderOf(path)), ec);
+  if (ec) return;
+  for (;;) {
+    struct stat st {};
+    if (::stat(folder.c_str(), &st) == 0)
+      for (const Input& in : input_folders_)
+        if (in.device == st.st_dev && in.inode == st.st_ino)
+          throw InputError(context, "is inside " + in.what + " " + in.path +
+                                        ": an output is never written among the inputs; write elsewhere");
+    if (!folder.has_parent_path() || folder.parent_path() == folder) return;
+    folder = folder.parent_path();
+  }
+}
+
 void OutputPaths::CheckWritableFolder(const std::string& folder, const std::string& context) const {
   // The nearest folder on the path that exists: it must be a folder this user can write.
   fs::path existing = fs::path(folder);
@@ -64,6 +87,7 @@ void OutputPaths::CheckFile(const std::string& path, const std::string& flag) {
       if (in.device == followed.st_dev && in.inode == followed.st_ino)
         throw InputError(context, "is " + in.what + " " + in.path +
                                       " (the same file): an output never replaces an input; write elsewhere");
+  RefuseInsideInputFolder(path, context);
   struct stat st {};
   if (::lstat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
     throw InputError(context, "is " + internal::FileKindName(st.st_mode) + ", not a regular file: never replaced (write to a file)");

@@ -53,7 +53,7 @@ std::vector<GnuplotFigure> TrackFigures(const TrackFigureData& a, const std::str
                                         const std::string& title_suffix) {
   std::vector<GnuplotFigure> figures;
   GnuplotFigure x;
-  x.name = stem + "_x_vs_t";
+  x.name = stem + kXVsT;
   x.title = "Measured x(t) against the fitted model" + title_suffix;
   x.caption = "Each point is one video frame where the ball was found (x of its centre in the apparatus frame); "
               "the line is the model motion fitted to them (x0, t0 and " +
@@ -73,7 +73,7 @@ std::vector<GnuplotFigure> TrackFigures(const TrackFigureData& a, const std::str
   figures.push_back(x);
   if (a.fit_available) {
     GnuplotFigure r;
-    r.name = stem + "_residuals";
+    r.name = stem + kResiduals;
     r.title = "Residuals of the model fit" + title_suffix;
     r.caption = "Measured minus fitted x for every frame of the fit window, with the stated u_x as error bars. "
                 "Structure (a trend, a wave) means the model misses something.";

@@ -93,8 +93,10 @@ std::optional<MotionMu> WeightedMotionMu(const std::vector<VideoTrial>& trials);
 nlohmann::json VideoTrialToJson(const VideoTrial& trial, bool with_figure = true);
 VideoTrial VideoTrialFromJson(const nlohmann::json& j);
 
-// The two figures of a trial, named `stem` + "_x_vs_t" and `stem` + "_residuals" (the residuals
-// only when the fit is available). Lengths in mm in the figures.
+// The two figures of a trial, named `stem` + kXVsT and `stem` + kResiduals (the residuals only
+// when the fit is available). Lengths in mm in the figures.
+inline constexpr const char* kXVsT = "_x_vs_t";
+inline constexpr const char* kResiduals = "_residuals";
 std::vector<GnuplotFigure> TrackFigures(const TrackFigureData& data, const std::string& stem,
                                         const std::string& title_suffix = "");
 
