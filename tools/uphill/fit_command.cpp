@@ -134,11 +134,13 @@ ExperimentAnalysis Analyse(const FitFlags& f, Experiment* keep, FigurePool* figu
           for (GnuplotFigure& figure : list) figures->Render(std::move(figure), f.output);
         });
     if (display) display->Finish();
-    for (const VideoTrial& t : trials)
+    for (const VideoTrial& t : trials) {
+      if (!t.cache_note.empty()) std::cerr << "uphill: note: " << t.cache_note << "\n";
       if (!t.error.empty()) {
         std::cerr << "uphill: " << t.error << " (video left out)\n";
         ExitStatus() = 2;
       }
+    }
     a = AnalyseExperimentWithVideos(keep, trials, options);
   } else {
     a = AnalyseExperiment(*keep, options);
