@@ -171,6 +171,28 @@ TEST(OutputPaths, AnOutputIsNeverAnInputHoweverItIsSpelled) {
   fs::remove_all(dir);
 }
 
+// No output inside a folder the command keeps (the experiment's video cache), however the path is
+// spelled (a link to it, "..", a missing folder below it). Truth: the identity of each folder above
+// the output (device and inode).
+TEST(OutputPaths, NoOutputInsideAnInputFolder) {
+  const fs::path dir = FreshFolder("output-paths-folder");
+  fs::create_directories(dir / "cache" / "video");
+  fs::create_directory_symlink(dir / "cache", dir / "link");
+  OutputPaths outputs;
+  outputs.AddInputFolder((dir / "cache").string(), "the experiment's video cache");
+  for (const fs::path& spelling : {dir / "cache" / "report.html", dir / "link" / "video" / "report.html",
+                                   dir / "cache" / "video" / ".." / "fit.json", dir / "cache" / "new" / "fit.json"}) {
+    try {
+      outputs.CheckFile(spelling.string(), "-o");
+      ADD_FAILURE() << spelling << " was allowed";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("is inside the experiment's video cache"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(outputs.CheckFile((dir / "report.html").string(), "-o"));
+  fs::remove_all(dir);
+}
+
 // Issue 11: as root, `-o /dev/full` replaced the device node with a regular file. Only a regular
 // file is ever replaced; a file where a folder is needed is named. Truth: lstat before and after.
 TEST(OutputPaths, OnlyRegularFilesAndFoldersThatCanBeMade) {

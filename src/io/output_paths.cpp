@@ -31,6 +31,14 @@ void OutputPaths::AddInput(const std::string& path, const std::string& what) {
   inputs_.push_back({st.st_dev, st.st_ino, path, what});
 }
 
+const OutputPaths::Input* OutputPaths::SameFile(const std::vector<Input>& inputs, const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return nullptr;
+  for (const Input& in : inputs)
+    if (in.device == st.st_dev && in.inode == st.st_ino) return &in;
+  return nullptr;
+}
+
 void OutputPaths::AddInputFolder(const std::string& path, const std::string& what) {
   struct stat st {};
   if (path.empty() || ::stat(path.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) return;
@@ -43,12 +51,9 @@ void OutputPaths::RefuseInsideInputFolder(const std::string& path, const std::st
   fs::path folder = fs::weakly_canonical(fs::absolute(FolderOf(path)), ec);
   if (ec) return;
   for (;;) {
-    struct stat st {};
-    if (::stat(folder.c_str(), &st) == 0)
-      for (const Input& in : input_folders_)
-        if (in.device == st.st_dev && in.inode == st.st_ino)
-          throw InputError(context, "is inside " + in.what + " " + in.path +
-                                        ": an output is never written among the inputs; write elsewhere");
+    if (const Input* in = SameFile(input_folders_, folder.string()))
+      throw InputError(context, "is inside " + in->what + " " + in->path +
+                                    ": an output is never written among the inputs; write elsewhere");
     if (!folder.has_parent_path() || folder.parent_path() == folder) return;
     folder = folder.parent_path();
   }
@@ -81,12 +86,9 @@ void OutputPaths::CheckFile(const std::string& path, const std::string& flag) {
   const std::string context = flag + " " + path;
   if (path.empty()) throw InputError(flag, "is empty (give a file name)");
   if (path.back() == '/') throw InputError(context, "names a folder; give a file name");
-  struct stat followed {};
-  if (::stat(path.c_str(), &followed) == 0)
-    for (const Input& in : inputs_)
-      if (in.device == followed.st_dev && in.inode == followed.st_ino)
-        throw InputError(context, "is " + in.what + " " + in.path +
-                                      " (the same file): an output never replaces an input; write elsewhere");
+  if (const Input* in = SameFile(inputs_, path))
+    throw InputError(context, "is " + in->what + " " + in->path +
+                                  " (the same file): an output never replaces an input; write elsewhere");
   RefuseInsideInputFolder(path, context);
   struct stat st {};
   if (::lstat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))

@@ -51,6 +51,8 @@ class OutputPaths {
     std::string path, what;
   };
   void CheckWritableFolder(const std::string& folder, const std::string& context) const;
+  // The entry of `inputs` that is the file or folder at `path` (followed), or nullptr.
+  static const Input* SameFile(const std::vector<Input>& inputs, const std::string& path);
   void RefuseInsideInputFolder(const std::string& path, const std::string& context) const;
   std::vector<Input> inputs_;
   std::vector<Input> input_folders_;
