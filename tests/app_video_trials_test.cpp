@@ -3,21 +3,29 @@
 // ground truth is exact: the body's true rest position (truth CSV) and the μ the clip's motion was
 // made with. Clips are small (640 × 360, ~1–2 s) to keep the suite fast.
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
+#include <optional>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
 #include <sstream>
+#include <thread>
 
 #include "app/video_trials.hpp"
 #include "file_test_support.hpp"
 #include "io/experiment.hpp"
 #include "report/fit_document.hpp"
 #include "report/fit_json.hpp"
+#include "report/report_outputs.hpp"
+#include "model/input_error.hpp"
 
 namespace uphill::testing {
 namespace {
@@ -49,6 +57,38 @@ long MtimeNs(const fs::path& p) {
   struct stat st {};
   if (::stat(p.c_str(), &st) != 0) return -1;
   return st.st_mtim.tv_sec * 1000000000L + st.st_mtim.tv_nsec;
+}
+
+// Sets an environment variable for the scope, restoring it after.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnv() {
+    if (old_) ::setenv(name_, old_->c_str(), 1);
+    else ::unsetenv(name_);
+  }
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+// The cache entries (folders) directly in `cache`, and any staging folder left there.
+std::vector<fs::path> Entries(const fs::path& cache) {
+  std::vector<fs::path> out;
+  if (!fs::is_directory(cache)) return out;
+  for (const auto& e : fs::directory_iterator(cache)) out.push_back(e.path());
+  return out;
+}
+
+// Every number of a JSON document replaced by `value` (booleans and text kept).
+void SetEveryNumber(nlohmann::json* j, double value) {
+  if (j->is_number()) *j = value;
+  if (!j->is_structured()) return;
+  for (auto& child : *j) SetEveryNumber(&child, value);
 }
 
 constexpr double kMu = 0.05;
@@ -87,6 +127,24 @@ class VideoTrials : public ::testing::Test {
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);
     delete dir_;
+  }
+  // A copy of the experiment (files, calibration, videos; no cache) in a fresh folder.
+  static fs::path CopyExperiment(const std::string& name) {
+    const fs::path copy = FreshFolder(name);
+    for (const char* f : {"experiment.json", "measurements.csv"}) fs::copy_file(*dir_ / f, copy / f);
+    for (const char* d : {"calibration", "videos"}) fs::copy(*dir_ / d, copy / d, fs::copy_options::recursive);
+    return copy;
+  }
+  // The rest trial (the first row, a short clip) of the folder, and whether it was served from a
+  // cache entry (the progress said kCached) rather than tracked.
+  static std::pair<VideoTrial, bool> RestTrial(const fs::path& folder) {
+    const Experiment experiment = LoadExperiment(folder.string());
+    bool cached = false;
+    VideoTrial t = TrackTrialVideo(experiment, experiment.rows[0], 0, [&](const VideoProgress& p) {
+      cached |= p.stage == VideoProgress::Stage::kCached;
+    });
+    EXPECT_EQ(cached, t.from_cache);
+    return {t, cached};
   }
   static inline fs::path* dir_ = nullptr;
   static inline double true_rest_ = 0;
@@ -230,6 +288,209 @@ TEST(VideoTrialsReport, WeightedMotionMuIsTheInverseVarianceMean) {
   EXPECT_NEAR(m->u, 1.0 / std::sqrt(12500.0), 1e-15);
   // χ² = (0.004/0.01)² + (0.016/0.02)² = 0.16 + 0.64, ν = 1.
   EXPECT_NEAR(*m->reduced_chi2, 0.8, 1e-12);
+}
+
+// Guards: parallel `uphill fit --jobs 1` runs of one fresh folder failed 1 in 2 with "cannot
+// rename .staging-… to it: File exists" when two finished the same entry. Four threads fill the
+// same entry at once: each waits (an event, not a time) until all four have missed the cache and
+// tracked, so all four commit together. Truth: every thread succeeds, with the same numbers, and
+// one entry is left, with no staging folder.
+TEST_F(VideoTrials, RunsFillingTheSameEntryAtOnceAllSucceedWithTheSameNumbers) {
+  const fs::path folder = CopyExperiment("parallel-fill");
+  const Experiment experiment = LoadExperiment(folder.string());
+  constexpr int kRuns = 4;
+  std::mutex m;
+  std::condition_variable cv;
+  int analysing = 0;
+  std::vector<VideoTrial> trials(kRuns);
+  std::vector<std::thread> threads;
+  for (int i = 0; i < kRuns; ++i)
+    threads.emplace_back([&, i] {
+      trials[i] = TrackTrialVideo(experiment, experiment.rows[0], 0, [&](const VideoProgress& p) {
+        if (p.stage != VideoProgress::Stage::kAnalysing) return;
+        std::unique_lock lock(m);
+        ++analysing;
+        cv.notify_all();
+        cv.wait(lock, [&] { return analysing >= kRuns; });
+      });
+    });
+  for (std::thread& t : threads) t.join();
+  ASSERT_EQ(analysing, kRuns) << "a run did not track";
+  for (int i = 0; i < kRuns; ++i) {
+    ASSERT_TRUE(trials[i].error.empty()) << trials[i].error;
+    ASSERT_TRUE(trials[i].rest.has_value());
+    EXPECT_EQ(trials[i].rest->value, trials[0].rest->value);
+    EXPECT_EQ(trials[i].rest->u, trials[0].rest->u);
+    EXPECT_EQ(trials[i].frames, trials[0].frames);
+  }
+  const std::vector<fs::path> entries = Entries(folder / ".uphill-cache" / "video");
+  ASSERT_EQ(entries.size(), 1u);
+  EXPECT_EQ(entries[0].filename().string().size(), 32u) << entries[0];
+  fs::remove_all(folder);
+}
+
+// Guards: a cache entry whose numbers were all set to 1e308 was trusted, and `fit` printed
+// "inf ± inf". The entry is input: checked as any input (keys, types, finite and in range), and a
+// damaged one is tracked again and replaced, with a one-line note. Truth: the first run's results.
+TEST_F(VideoTrials, ADamagedCacheEntryIsTrackedAgainAndReplaced) {
+  const fs::path folder = CopyExperiment("damaged-entry");
+  const VideoTrial first = RestTrial(folder).first;
+  ASSERT_TRUE(first.error.empty()) << first.error;
+  const std::vector<fs::path> entries = Entries(folder / ".uphill-cache" / "video");
+  ASSERT_EQ(entries.size(), 1u);
+  const fs::path trial_json = entries[0] / "trial.json";
+  nlohmann::json doc = nlohmann::json::parse(ReadBytes(trial_json));
+  SetEveryNumber(&doc, 1e308);
+  std::ofstream(trial_json) << doc.dump();
+  const auto [second, second_cached] = RestTrial(folder);
+  EXPECT_FALSE(second_cached);
+  ASSERT_TRUE(second.error.empty()) << second.error;
+  EXPECT_NE(second.cache_note.find("damaged"), std::string::npos) << second.cache_note;
+  EXPECT_EQ(std::count(second.cache_note.begin(), second.cache_note.end(), '\n'), 0);
+  EXPECT_EQ(VideoTrialToJson(second).dump(), VideoTrialToJson(first).dump());
+  // Replaced: the next run reads it.
+  const auto [third, third_cached] = RestTrial(folder);
+  EXPECT_TRUE(third_cached);
+  EXPECT_TRUE(third.cache_note.empty()) << third.cache_note;
+  EXPECT_EQ(third.rest->value, first.rest->value);
+  fs::remove_all(folder);
+}
+
+// Guards: a read-only experiment folder lost every video trial (.uphill-cache could not be made).
+// A file where the cache folder should be stands for it (permission bits do not stop root): the
+// entries go into $XDG_CACHE_HOME/uphill/video, and with no user cache either the trial is tracked
+// without caching, its temporary folder removed. Truth: the entries on disk, the trial's numbers.
+TEST_F(VideoTrials, AFolderThatCannotHoldItsCacheUsesTheUsersOrNone) {
+  const fs::path folder = CopyExperiment("unwritable-cache");
+  std::ofstream(folder / ".uphill-cache") << "in the way\n";
+  const fs::path elsewhere = FreshFolder("unwritable-cache-user");
+  {
+    const ScopedEnv xdg("XDG_CACHE_HOME", (elsewhere / "xdg").string());
+    const auto [first, first_cached] = RestTrial(folder);
+    ASSERT_TRUE(first.error.empty()) << first.error;
+    EXPECT_FALSE(first_cached);
+    EXPECT_EQ(Entries(elsewhere / "xdg" / "uphill" / "video").size(), 1u);
+    const auto [second, second_cached] = RestTrial(folder);
+    EXPECT_TRUE(second_cached);
+    EXPECT_EQ(second.rest->value, first.rest->value);
+  }
+  std::ofstream(elsewhere / "afile") << "x\n";
+  fs::create_directories(elsewhere / "tmp");
+  const ScopedEnv xdg("XDG_CACHE_HOME", (elsewhere / "afile" / "xdg").string());
+  const ScopedEnv home("HOME", (elsewhere / "afile" / "home").string());
+  const ScopedEnv tmp("TMPDIR", (elsewhere / "tmp").string());
+  const auto [none, none_cached] = RestTrial(folder);
+  ASSERT_TRUE(none.error.empty()) << none.error;
+  EXPECT_FALSE(none_cached);
+  EXPECT_TRUE(none.rest.has_value());
+  EXPECT_TRUE(Entries(elsewhere / "tmp").empty());
+  EXPECT_EQ(ReadBytes(folder / ".uphill-cache"), "in the way\n");
+  fs::remove_all(elsewhere);
+  fs::remove_all(folder);
+}
+
+// The cache's content key (data/README.md, "The video cache"): a video replaced by other bytes of
+// the same size and modification time, a changed camera file, a changed scene file: each is
+// tracked again, never served from the old entry. Truth: the progress (kCached or not).
+TEST_F(VideoTrials, AnyChangeOfTheKeyedFilesTracksAgain) {
+  const fs::path folder = CopyExperiment("content-key");
+  ASSERT_TRUE(RestTrial(folder).first.error.empty());
+  ASSERT_TRUE(RestTrial(folder).second);  // unchanged: from the cache
+  // One byte in the middle of the video, size and mtime kept.
+  const fs::path video = folder / "videos" / "rest.mp4";
+  struct stat before {};
+  ASSERT_EQ(::stat(video.c_str(), &before), 0);
+  std::string bytes = ReadBytes(video);
+  bytes[bytes.size() / 2] ^= 0x01;
+  std::ofstream(video, std::ios::binary | std::ios::trunc) << bytes;
+  const timespec times[2] = {before.st_atim, before.st_mtim};
+  ASSERT_EQ(::utimensat(AT_FDCWD, video.c_str(), times, 0), 0);
+  struct stat after {};
+  ASSERT_EQ(::stat(video.c_str(), &after), 0);
+  ASSERT_EQ(after.st_size, before.st_size);
+  ASSERT_EQ(MtimeNs(video), before.st_mtim.tv_sec * 1000000000L + before.st_mtim.tv_nsec);
+  EXPECT_FALSE(RestTrial(folder).second) << "a changed video was served from the cache";
+  ASSERT_TRUE(RestTrial(folder).second);
+  for (const char* file : {"calibration/camera.json", "calibration/scene-main.json"}) {
+    std::ofstream(folder / file, std::ios::app) << "\n";  // the same calibration, other bytes
+    EXPECT_FALSE(RestTrial(folder).second) << file << " changed, yet served from the cache";
+    ASSERT_TRUE(RestTrial(folder).second);
+  }
+  fs::remove_all(folder);
+}
+
+// The tracker's version is part of the key (a compile-time constant: the key function is asked
+// with two versions). Truth: the key's definition: 32 hex digits, the video's hash first.
+TEST(VideoCacheKey, TheTrackerVersionIsPartOfTheKey) {
+  Configuration c;
+  const VideoAnalysisSettings v;
+  const std::string a = VideoCacheKey("0123456789abcdef", "camera", "scene", c, v, 15);
+  EXPECT_EQ(a.size(), 32u);
+  EXPECT_EQ(a.substr(0, 16), "0123456789abcdef");
+  EXPECT_EQ(a, VideoCacheKey("0123456789abcdef", "camera", "scene", c, v, 15));
+  EXPECT_NE(a, VideoCacheKey("0123456789abcdef", "camera", "scene", c, v, 16));
+  EXPECT_NE(a, VideoCacheKey("0123456789abcdef", "camera2", "scene", c, v, 15));
+  EXPECT_NE(a, VideoCacheKey("0123456789abcdef", "camera", "scene2", c, v, 15));
+  EXPECT_EQ(VideoCacheKey("0123456789abcdef", "camera", "scene", c, v), VideoCacheKey("0123456789abcdef", "camera", "scene", c, v, kVideoTrackerVersion));
+}
+
+// A cached trial.json is read as input: out-of-range, non-finite or mistyped values are named.
+// Truth: the ranges VideoTrialFromJson states (report/video_trials.hpp).
+TEST(VideoTrialsReport, ACachedTrialIsCheckedAsInput) {
+  VideoTrial t;
+  t.trial = "a";
+  t.row = 2;
+  t.video = "v.mp4";
+  t.frames = 10;
+  t.found = 9;
+  t.rest = MeasuredValue{0.3, 0.001};
+  const nlohmann::json good = VideoTrialToJson(t);
+  EXPECT_EQ(VideoTrialFromJson(good).rest->value, 0.3);
+  const auto refused = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& key) {
+    nlohmann::json j = good;
+    edit(j);
+    try {
+      VideoTrialFromJson(j);
+      ADD_FAILURE() << j.dump() << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.quantity(), key) << e.what();
+    }
+  };
+  refused([](auto& j) { j["rest_x"]["value"] = 1e308; }, "rest_x.value");
+  refused([](auto& j) { j["rest_x"]["u"] = -1.0; }, "rest_x.u");
+  refused([](auto& j) { j["found"] = 11; }, "found");
+  refused([](auto& j) { j["frames"] = 1e308; }, "frames");
+  refused([](auto& j) { j["fitted"] = "x"; }, "fitted");
+  refused([](auto& j) { j.erase("notes"); }, "notes");
+  refused([](auto& j) { j["figure"]["measured"] = {{0.0, 1e300}}; }, "figure.measured");
+}
+
+// Guards: POST /api/report of `uphill serve` wrote the report into EXP/report/ over an input named
+// there ("camera": "report/fit.json"). The handler and `uphill report` share CheckReportOutputs.
+// Truth: the rule (no output is an input), and the message naming both.
+TEST(ReportOutputs, ThePagesReportFolderNeverReplacesAnInput) {
+  const fs::path folder = FreshFolder("page-report-inputs");
+  fs::create_directories(folder / "report");
+  std::ofstream(folder / "experiment.json") << R"({"format": "uphill-experiment/2",
+    "body": {"type": "sphere", "R": "25.4 mm"}, "apparatus": {"L": "1000 mm", "H": "100 mm"},
+    "camera": "report/fit.json", "scenes": {"main": "report/report.md"}})";
+  std::ofstream(folder / "measurements.csv") << "trial,D_mm,Y_mm,video\na,150,340,report/fit_offset.png\n";
+  const auto refused = [&](const std::string& input, const std::string& what) {
+    std::ofstream(folder / input) << "input\n";
+    try {
+      CheckReportOutputs(LoadExperiment(folder.string()), (folder / "report").string(), "report");
+      ADD_FAILURE() << input << " was not named";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find((folder / input).string()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+    fs::remove(folder / input);
+  };
+  refused("report/fit.json", "camera file");
+  refused("report/report.md", "scene file 'main'");
+  refused("report/fit_offset.png", "video of trial 'a'");
+  EXPECT_NO_THROW(CheckReportOutputs(LoadExperiment(folder.string()), (folder / "report").string(), "report"));
+  fs::remove_all(folder);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // interface, the hard cases with their exit codes, the sample experiments, and the report folder.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -9,6 +10,7 @@
 #include <sstream>
 
 #include "cli_test_support.hpp"
+#include "file_test_support.hpp"
 
 namespace uphill::testing {
 namespace {
@@ -210,6 +212,57 @@ TEST(FitCli, ReportOfABadExperimentNamesTheProblem) {
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err, "uphill: /nonexistent/exp: is not an experiment folder\n");
   EXPECT_FALSE(std::filesystem::exists("/tmp/uphill_never_written"));
+}
+
+// Guards: `uphill report EXP -o EXP` replaced the camera file when experiment.json named it
+// "fit.json", and a scene named like a figure; every later `fit` then failed. Truth: the inputs'
+// bytes before and after, and docs/exit-codes.md (status 2, one line naming the output and the
+// input). The inputs are compared by identity: a hard link under another name is refused too.
+TEST(FitCli, ReportNeverReplacesAnInputOfTheExperiment) {
+  namespace fs = std::filesystem;
+  const fs::path exp = FreshFolder("report-inputs");
+  std::ofstream(exp / "experiment.json") << R"({"format": "uphill-experiment/2",
+    "body": {"type": "sphere", "R": "25.4 mm"}, "apparatus": {"L": "1000 mm", "H": "100 mm"},
+    "uncertainties": {"D": "0.2 mm", "Y": "0.5 mm"},
+    "camera": "fit.json", "scenes": {"main": "fit_y_vs_x.svg"}})";
+  std::ofstream(exp / "measurements.csv") << "trial,D_mm,Y_mm\na,150,340\nb,160,330\nc,140,350\n";
+  std::ofstream(exp / "fit.json") << "{\"camera\": true}\n";
+  std::ofstream(exp / "fit_y_vs_x.svg") << "{\"scene\": true}\n";
+  const auto unchanged = [&] {
+    EXPECT_EQ(ReadBytes(exp / "fit.json"), "{\"camera\": true}\n");
+    EXPECT_EQ(ReadBytes(exp / "fit_y_vs_x.svg"), "{\"scene\": true}\n");
+    EXPECT_FALSE(fs::exists(exp / "report.html"));
+  };
+  auto r = RunUphill("report " + exp.string() + " -o " + exp.string() + " --mc-trials 1000");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("camera file"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find((exp / "fit.json").string()), std::string::npos) << r.err;
+  unchanged();
+  // The same file under another name: a report folder whose fit.json is a hard link to the camera.
+  const fs::path out = exp / "out";
+  fs::create_directories(out);
+  fs::create_hard_link(exp / "fit.json", out / "fit.json");
+  r = RunUphill("report " + exp.string() + " -o " + out.string() + " --mc-trials 1000");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("camera file"), std::string::npos) << r.err;
+  unchanged();
+  // The scene file alone in the way (the camera moved elsewhere).
+  fs::remove(out / "fit.json");
+  fs::create_hard_link(exp / "fit_y_vs_x.svg", out / "fit_y_vs_x.svg");
+  r = RunUphill("report " + exp.string() + " -o " + out.string() + " --mc-trials 1000");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("scene file 'main'"), std::string::npos) << r.err;
+  unchanged();
+  // Nor into the folder's video cache.
+  fs::create_directories(exp / ".uphill-cache" / "video");
+  r = RunUphill("report " + exp.string() + " -o " + (exp / ".uphill-cache" / "video").string() + " --mc-trials 1000");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("video cache"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(exp / ".uphill-cache" / "video" / "report.html"));
+  // And `fit` still reads the experiment.
+  EXPECT_EQ(RunUphill("fit " + exp.string() + " --mc-trials 1000").status, 0);
+  fs::remove_all(exp);
 }
 
 }  // namespace

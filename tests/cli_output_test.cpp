@@ -151,5 +151,46 @@ TEST_F(TrackOutputCli, OverlayAndTrackGoIntoFoldersThatDoNotExistYet) {
   fs::remove_all(work);
 }
 
+// `uphill track`'s exit status on partial tracks (docs/track.md, "Output"): a video cut mid-file
+// (FFV1 in .avi, cut at 60 % of its bytes) keeps the frames read and exits 2; a ball that drops
+// between the rails near the end is how runs end: partial, exit 0. Truth: the sidecar's own
+// count of rows against the CSV, and docs/exit-codes.md. Clips: tools/make_video.
+TEST(TrackExitCli, ACutVideoExitsTwoAndABallLostAtTheEndZero) {
+  const fs::path work = testing::FreshFolder("track-exit");
+  const auto make = [&](const std::string& flags) {
+    const std::string command = std::string(UPHILL_MAKE_VIDEO) + " " + work.string() +
+                                " --width 480 --height 270 --boards 0 " + flags + " > /dev/null 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  };
+  const auto track = [&](const std::string& video, const std::string& csv) {
+    return RunUphill("track " + (work / video).string() + " --camera " + (work / "cam.json").string() + " --scene " +
+                     (work / "scene.json").string() +
+                     " --body sphere --R 25.4mm --L 1000mm --H 100mm --D 150mm --rod-diameter 8mm --quiet -o " +
+                     (work / csv).string());
+  };
+  const auto rows = [&](const std::string& csv) {
+    const std::string text = Slurp(work / csv);
+    return static_cast<int>(std::count(text.begin(), text.end(), '\n')) - 1;  // without the header
+  };
+  make("--frames 24 --lossless --name cut");
+  fs::resize_file(work / "cut.avi", fs::file_size(work / "cut.avi") * 6 / 10);
+  auto r = track("cut.avi", "cut.csv");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("partial track"), std::string::npos) << r.err;
+  const json cut = json::parse(Slurp(work / "cut.csv.json"));
+  EXPECT_EQ(cut.at("partial"), true);
+  EXPECT_EQ(rows("cut.csv"), cut.at("frames").get<int>());
+  EXPECT_GT(rows("cut.csv"), 0);
+  EXPECT_LT(rows("cut.csv"), 24);
+
+  make("--mu 0.05 --x0-band 0.3 --release-time 0.2 --until-end --name falls");
+  r = track("falls.mp4", "falls.csv");
+  EXPECT_EQ(r.status, 0) << r.err;
+  const json falls = json::parse(Slurp(work / "falls.csv.json"));
+  EXPECT_EQ(falls.at("partial"), true) << falls.dump();
+  EXPECT_EQ(rows("falls.csv"), falls.at("frames").get<int>());
+  fs::remove_all(work);
+}
+
 }  // namespace
 }  // namespace uphill

@@ -4,9 +4,11 @@
 // never an input however it is spelled. Truth: the file system's own
 // answer (lstat, the bytes) before and after each call.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -58,6 +60,37 @@ TEST(AtomicFile, NeverReplacesAFolderALinkAPipeOrADevice) {
   EXPECT_THROW(WriteFileAtomically("/dev/full", "x"), EnvironmentError);
   EXPECT_TRUE(fs::is_character_file("/dev/full"));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 4);  // no temporaries
+  fs::remove_all(dir);
+}
+
+// The contract "a failure at any step leaves the target exactly as before" (atomic_file.hpp),
+// with the write made to fail once the target exists: the file size limit (RLIMIT_FSIZE, as a
+// full disk would, and as root too) stops the temporary's write with EFBIG. Truth: the target's
+// bytes before and after, and the folder's listing (no temporary left).
+TEST(AtomicFile, AFailedWriteLeavesTheExistingTargetAsItWas) {
+  const fs::path dir = FreshFolder("atomic-failed-write");
+  const fs::path target = dir / "fit.json";
+  const std::string old_bytes = "{\"old\": true}\n";
+  WriteFileAtomically(target.string(), old_bytes);
+  rlimit saved {};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &saved), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);  // the write fails instead of killing
+  rlimit small = saved;
+  small.rlim_cur = 1024;
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  std::string message;
+  try {
+    WriteFileAtomically(target.string(), std::string(64 * 1024, 'x'));
+  } catch (const EnvironmentError& e) {
+    message = e.what();
+  }
+  ::setrlimit(RLIMIT_FSIZE, &saved);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_NE(message.find(target.string()), std::string::npos) << "no failure, or not named: " << message;
+  EXPECT_EQ(Slurp(target), old_bytes);
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  EXPECT_EQ(names, std::vector<std::string>{"fit.json"});
   fs::remove_all(dir);
 }
 
@@ -135,6 +168,28 @@ TEST(OutputPaths, AnOutputIsNeverAnInputHoweverItIsSpelled) {
   // Two outputs of one command that are the same file would overwrite each other.
   EXPECT_THROW(outputs.CheckFile(base + "/./overlay.mp4", "-o"), InputError);
   EXPECT_EQ(Slurp(dir / "clip.mp4"), "recording");
+  fs::remove_all(dir);
+}
+
+// No output inside a folder the command keeps (the experiment's video cache), however the path is
+// spelled (a link to it, "..", a missing folder below it). Truth: the identity of each folder above
+// the output (device and inode).
+TEST(OutputPaths, NoOutputInsideAnInputFolder) {
+  const fs::path dir = FreshFolder("output-paths-folder");
+  fs::create_directories(dir / "cache" / "video");
+  fs::create_directory_symlink(dir / "cache", dir / "link");
+  OutputPaths outputs;
+  outputs.AddInputFolder((dir / "cache").string(), "the experiment's video cache");
+  for (const fs::path& spelling : {dir / "cache" / "report.html", dir / "link" / "video" / "report.html",
+                                   dir / "cache" / "video" / ".." / "fit.json", dir / "cache" / "new" / "fit.json"}) {
+    try {
+      outputs.CheckFile(spelling.string(), "-o");
+      ADD_FAILURE() << spelling << " was allowed";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("is inside the experiment's video cache"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(outputs.CheckFile((dir / "report.html").string(), "-o"));
   fs::remove_all(dir);
 }
 

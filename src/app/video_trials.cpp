@@ -33,7 +33,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-constexpr const char* kCacheFolder = ".uphill-cache/video";
+const std::string kCacheFolder = std::string(kVideoCacheFolder) + "/video";
 constexpr const char* kTrialFile = "trial.json";
 constexpr std::size_t kMaxCalibrationBytes = 16u << 20;
 
@@ -41,28 +41,6 @@ std::string Hex16(std::uint64_t h) {
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
   return text;
-}
-
-// The second half of the cache key: everything besides the video that decides the results.
-std::string CalibrationKey(const std::string& camera_bytes, const std::string& scene_bytes,
-                           const Configuration& c, const VideoAnalysisSettings& v) {
-  std::string text = "uphill-video-trial/" + std::to_string(kVideoTrackerVersion) + "\n";
-  text += std::to_string(camera_bytes.size()) + "\n" + camera_bytes + "\n";
-  text += std::to_string(scene_bytes.size()) + "\n" + scene_bytes + "\n";
-  const auto value = [&](const char* name, const Uncertain& u) { text += std::string(name) + " " + Printf("%.17g", u.value) + "\n"; };
-  text += "body " + std::to_string(static_cast<int>(c.body_kind)) + "\n";
-  value("across", c.across);
-  value("along", c.along);
-  text += c.from_apparatus ? "apparatus\n" : "angles\n";
-  value("L", c.L);
-  value("H", c.H);
-  value("D", c.D);
-  text += "convention " + std::to_string(static_cast<int>(c.convention)) + "\n";
-  value("theta", c.theta);
-  value("alpha", c.alpha);
-  value("rod_radius", c.rod_radius);
-  text += "fit " + v.fit + "\nu_x " + Printf("%.17g", v.u_x) + "\ng " + Printf("%.17g", v.g) + "\n";
-  return Hex16(XXH3_64bits(text.data(), text.size()));
 }
 
 TrackAnalysisOptions AnalysisOptionsOf(const VideoAnalysisSettings& v) {
@@ -126,26 +104,94 @@ void FillFromAnalysis(const TrackAnalysis& a, VideoTrial* t) {
   t->figure = TrackFigureDataOf(a);
 }
 
-// Reads the cached trial, or nullopt when it is absent or damaged (then tracked again).
-std::optional<VideoTrial> ReadCached(const ContainedDirectory& root, const std::string& key) {
-  try {
-    const auto text = root.ReadFile(std::string(kCacheFolder) + "/" + key + "/" + kTrialFile, 64u << 20);
-    if (!text) return std::nullopt;
-    VideoTrial t = VideoTrialFromJson(json::parse(*text));
-    t.from_cache = true;
-    return t;
-  } catch (const std::exception&) {
-    return std::nullopt;
+// The folders a trial is looked up in, in order, and the one a new entry is written into.
+struct CacheFolders {
+  std::vector<ContainedDirectory> lookup;
+  std::optional<std::size_t> write;  // into lookup; none: results are not cached
+};
+
+bool Writable(const ContainedDirectory& d) { return ::faccessat(d.fd(), ".", W_OK | X_OK, AT_EACCESS) == 0; }
+
+// The user's cache for folders that cannot hold their own: $XDG_CACHE_HOME/uphill/video (an
+// absolute path), else $HOME/.cache/uphill/video; nullopt when neither can be made.
+std::optional<ContainedDirectory> UserCache() {
+  std::vector<fs::path> bases;
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && fs::path(xdg).is_absolute()) bases.emplace_back(xdg);
+  if (const char* home = std::getenv("HOME"); home && fs::path(home).is_absolute()) bases.push_back(fs::path(home) / ".cache");
+  for (const fs::path& base : bases) {
+    try {
+      std::error_code ignored;
+      fs::create_directories(base / "uphill" / "video", ignored);
+      ContainedDirectory d = ContainedDirectory::Open((base / "uphill" / "video").string());
+      if (Writable(d)) return d;
+    } catch (const EnvironmentError&) {
+    }
   }
+  return std::nullopt;
 }
 
-// Renames the entry written into `staging` into place whole (replacing a damaged one).
-void CommitCache(const ContainedDirectory& cache, const ContainedDirectory& staging, const std::string& key) {
+// EXP/.uphill-cache/video, created when needed. When it cannot be written (a read-only folder, a
+// file or a link in the way) its entries are still read, and new ones go into the user's cache,
+// or nowhere: a trial is then tracked on every run.
+CacheFolders OpenCacheFolders(const ContainedDirectory& root) {
+  CacheFolders c;
+  try {
+    c.lookup.push_back(root.Subdirectory(kCacheFolder, true));
+    if (Writable(c.lookup.back())) c.write = 0;
+  } catch (const EnvironmentError&) {
+    try {
+      c.lookup.push_back(root.Subdirectory(kCacheFolder, false));
+    } catch (const EnvironmentError&) {
+    }
+  }
+  if (!c.write)
+    if (std::optional<ContainedDirectory> user = UserCache()) {
+      c.lookup.push_back(std::move(*user));
+      c.write = c.lookup.size() - 1;
+    }
+  return c;
+}
+
+// A cache entry read as input: its trial.json checked as any input is (report/video_trials.hpp).
+struct CachedEntry {
+  std::optional<VideoTrial> trial;  // absent or damaged: nullopt
+  std::string damage;               // why a present entry was not used ("" absent)
+};
+
+CachedEntry ReadCached(const ContainedDirectory& cache, const std::string& key) {
+  CachedEntry entry;
+  try {
+    const auto text = cache.ReadFile(key + "/" + kTrialFile, 64u << 20);
+    if (!text) {
+      if (cache.KindOf(key) != ContainedDirectory::Kind::kAbsent) entry.damage = std::string(kTrialFile) + " is missing";
+      return entry;
+    }
+    VideoTrial t = VideoTrialFromJson(json::parse(*text));
+    t.from_cache = true;
+    entry.trial = std::move(t);
+  } catch (const std::exception& e) {
+    entry.damage = e.what();
+  }
+  return entry;
+}
+
+// Renames the entry written into `staging` into place as `key`. Another run may have made the
+// entry meanwhile (the rename finds it there): a sound one is theirs to keep, returned, and ours
+// is left for the caller to remove; a damaged one is replaced. nullopt: ours is in place.
+std::optional<VideoTrial> CommitCache(const ContainedDirectory& cache, const ContainedDirectory& staging,
+                                      const std::string& key) {
   const std::string staging_name = fs::path(staging.path()).filename().string();
   staging.Sync();
-  if (cache.KindOf(key) != ContainedDirectory::Kind::kAbsent)  // a damaged entry: replaced
-    ContainedDirectory::RemoveStaging(cache, cache.Subdirectory(key, false));
-  cache.RenameNoReplace(staging_name, key);
+  for (int attempt = 0;; ++attempt) {
+    try {
+      cache.RenameNoReplace(staging_name, key);
+      return std::nullopt;
+    } catch (const EnvironmentError&) {
+      if (attempt > 0 || cache.KindOf(key) == ContainedDirectory::Kind::kAbsent) throw;
+    }
+    if (CachedEntry theirs = ReadCached(cache, key); theirs.trial) return theirs.trial;
+    ContainedDirectory::RemoveStaging(cache, cache.Subdirectory(key, false));  // damaged: replaced
+  }
 }
 
 VideoTrial Failed(VideoTrial t, const std::string& message) {
@@ -154,6 +200,28 @@ VideoTrial Failed(VideoTrial t, const std::string& message) {
 }
 
 }  // namespace
+
+std::string VideoCacheKey(const std::string& video_hash, const std::string& camera_bytes, const std::string& scene_bytes,
+                          const Configuration& c, const VideoAnalysisSettings& v, int tracker_version) {
+  // The second half: everything besides the video that decides the results.
+  std::string text = "uphill-video-trial/" + std::to_string(tracker_version) + "\n";
+  text += std::to_string(camera_bytes.size()) + "\n" + camera_bytes + "\n";
+  text += std::to_string(scene_bytes.size()) + "\n" + scene_bytes + "\n";
+  const auto value = [&](const char* name, const Uncertain& u) { text += std::string(name) + " " + Printf("%.17g", u.value) + "\n"; };
+  text += "body " + std::to_string(static_cast<int>(c.body_kind)) + "\n";
+  value("across", c.across);
+  value("along", c.along);
+  text += c.from_apparatus ? "apparatus\n" : "angles\n";
+  value("L", c.L);
+  value("H", c.H);
+  value("D", c.D);
+  text += "convention " + std::to_string(static_cast<int>(c.convention)) + "\n";
+  value("theta", c.theta);
+  value("alpha", c.alpha);
+  value("rod_radius", c.rod_radius);
+  text += "fit " + v.fit + "\nu_x " + Printf("%.17g", v.u_x) + "\ng " + Printf("%.17g", v.g) + "\n";
+  return video_hash + Hex16(XXH3_64bits(text.data(), text.size()));
+}
 
 std::string HashFileContent(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
@@ -193,8 +261,9 @@ std::vector<const ExperimentRow*> VideoRows(const Experiment& experiment) {
 
 namespace {
 
+// The trial, tracked or from a cache entry; `track_out`, when given, receives its track.
 VideoTrial TrackTrial(const Experiment& experiment, const ExperimentRow& row, std::size_t index,
-                      const VideoProgressCallback& progress, std::string* key_out) {
+                      const VideoProgressCallback& progress, Track* track_out) {
   VideoTrial trial;
   trial.trial = row.trial;
   trial.row = row.row;
@@ -205,6 +274,15 @@ VideoTrial TrackTrial(const Experiment& experiment, const ExperimentRow& row, st
   const auto tell = [&](VideoProgress::Stage stage) {
     p.stage = stage;
     if (progress) progress(p);
+  };
+  // The trial as a cache entry holds it, with this row's labels.
+  const auto served = [&](VideoTrial cached, const ContainedDirectory& cache, const std::string& key) {
+    cached.trial = row.trial;
+    cached.row = row.row;
+    cached.video = row.video;
+    cached.cache_note = trial.cache_note;
+    if (track_out) *track_out = ReadTrackFile((fs::path(cache.path()) / key / "track.csv").string());
+    return cached;
   };
   try {
     if (!row.configuration) throw InputError("row " + std::to_string(row.row), "has no usable apparatus values");
@@ -223,15 +301,18 @@ VideoTrial TrackTrial(const Experiment& experiment, const ExperimentRow& row, st
       throw InputError(row.video, "is not a regular file in the folder (links are not followed)");
     const std::string video_path = (fs::path(root.path()) / row.video).string();
     tell(VideoProgress::Stage::kHashing);
-    const std::string key = HashFileContent(video_path) +
-                            CalibrationKey(*camera_bytes, *scene_bytes, *row.configuration, experiment.video_analysis);
-    if (key_out) *key_out = key;
-    if (std::optional<VideoTrial> cached = ReadCached(root, key)) {
-      cached->trial = row.trial;
-      cached->row = row.row;
-      cached->video = row.video;
-      tell(VideoProgress::Stage::kCached);
-      return *cached;
+    const std::string key = VideoCacheKey(HashFileContent(video_path), *camera_bytes, *scene_bytes,
+                                          *row.configuration, experiment.video_analysis);
+    const CacheFolders caches = OpenCacheFolders(root);
+    for (const ContainedDirectory& cache : caches.lookup) {
+      CachedEntry entry = ReadCached(cache, key);
+      if (entry.trial) {
+        tell(VideoProgress::Stage::kCached);
+        return served(std::move(*entry.trial), cache, key);
+      }
+      if (!entry.damage.empty())
+        trial.cache_note = "trial '" + row.trial + "' (" + row.video + "): the cached result " + (fs::path(cache.path()) / key).string() + " is damaged (" +
+                           entry.damage + "): tracked again";
     }
     const std::string camera_path = (fs::path(root.path()) / experiment.camera).string();
     const std::string scene_path = (fs::path(root.path()) / scene_file).string();
@@ -249,12 +330,16 @@ VideoTrial TrackTrial(const Experiment& experiment, const ExperimentRow& row, st
     trial.partial_reason = track.partial_reason;
     trial.tracker_cpu_seconds = track.tracker_cpu_seconds;
     tell(VideoProgress::Stage::kAnalysing);
-    // The entry is written into a staging folder and renamed into place whole. The analysis
-    // reads the track as the cache keeps it (the CSV's millimetres), so that a fresh run and a
-    // cached one agree: the track is written first, once, and read back.
+    // The entry is written into a staging folder and renamed into place whole (without a
+    // writable cache, a private temporary folder, removed after). The analysis reads the track as
+    // the cache keeps it (the CSV's millimetres), so that a fresh run and a cached one agree: the
+    // track is written first, once, and read back.
     const TrackSources sources{row.video, experiment.camera, scene_file, scene.body().Name()};
-    const ContainedDirectory cache = root.Subdirectory(kCacheFolder, true);
-    ContainedDirectory staging = cache.MakeStagingDirectory(".staging-");
+    std::optional<ContainedDirectory> temporary;
+    if (!caches.write) temporary = ContainedDirectory::Open(fs::temp_directory_path().string());
+    const ContainedDirectory& parent = caches.write ? caches.lookup[*caches.write] : *temporary;
+    ContainedDirectory staging = parent.MakeStagingDirectory(caches.write ? ".staging-" : "uphill-track-");
+    std::optional<VideoTrial> theirs;
     try {
       const std::string csv = (fs::path(staging.path()) / "track.csv").string();
       WriteTrack(csv, track, sources);
@@ -262,19 +347,20 @@ VideoTrial TrackTrial(const Experiment& experiment, const ExperimentRow& row, st
       read.source = row.video;
       const TrackAnalysis analysis = AnalyseTrack(read, scene, AnalysisOptionsOf(experiment.video_analysis));
       FillFromAnalysis(analysis, &trial);
+      if (track_out) *track_out = std::move(read);
       staging.WriteFileAtomically("track_analysis.json", TrackAnalysisJson(analysis).dump(2) + "\n");
       staging.WriteFileAtomically(kTrialFile, VideoTrialToJson(trial).dump() + "\n");
+      if (caches.write) theirs = CommitCache(parent, staging, key);
     } catch (...) {
-      ContainedDirectory::RemoveStaging(cache, std::move(staging));
+      ContainedDirectory::RemoveStaging(parent, std::move(staging));
       throw;
     }
-    try {
-      CommitCache(cache, staging, key);
-    } catch (...) {
-      ContainedDirectory::RemoveStaging(cache, std::move(staging));
-      throw;
+    if (!caches.write || theirs) ContainedDirectory::RemoveStaging(parent, std::move(staging));
+    if (caches.write) parent.Sync();
+    if (theirs) {  // another run made the entry meanwhile: the results are theirs
+      tell(VideoProgress::Stage::kCached);
+      return served(std::move(*theirs), parent, key);
     }
-    cache.Sync();
     tell(VideoProgress::Stage::kDone);
     return trial;
   } catch (const InputError& e) {
@@ -305,12 +391,7 @@ VideoTrialResult TrackTrialVideo(const std::string& folder, std::size_t row_inde
   }
   if (row.video.empty()) throw InputError(folder + "/measurements.csv, row " + std::to_string(row.row) + ", column video", "is empty");
   VideoTrialResult result;
-  std::string key;
-  result.trial = TrackTrial(experiment, row, 0, progress, &key);
-  if (result.trial.error.empty()) {
-    result.cache_folder = std::string(kCacheFolder) + "/" + key;
-    result.track = ReadTrackFile((fs::path(experiment.directory) / result.cache_folder / "track.csv").string());
-  }
+  result.trial = TrackTrial(experiment, row, 0, progress, &result.track);
   return result;
 }
 

@@ -11,7 +11,14 @@
 // digits) + XXH3-64 of the camera and scene files' bytes, the row's body and apparatus values, the
 // analysis options and kVideoTrackerVersion (16 hex digits). A hit reads trial.json only (and
 // hashes the video: XXH3 runs at memory speed, so 20 videos of 1080p, 10 s take well under 1 s
-// from the page cache). A damaged cache entry is tracked again and replaced.
+// from the page cache). A cache entry is input: its trial.json is checked as any input is
+// (report/video_trials.hpp: keys, types, finite numbers in range); a damaged one is tracked again
+// and replaced, and VideoTrial::cache_note says so in one line.
+// Several runs may fill the same entry at once (parallel `uphill fit`): the first rename wins and
+// the others take its entry (checked the same way) and drop their own.
+// A folder whose cache cannot be written (read-only, a file or a link at .uphill-cache) keeps its
+// entries readable; new ones go into the user's cache, $XDG_CACHE_HOME/uphill/video (else
+// $HOME/.cache/uphill/video), or, when that cannot be written either, nowhere (tracked each run).
 //
 // Files: the camera, scene and video paths are relative to the folder and opened through
 // io/contained_directory.hpp: a symbolic link at any level is refused, as is anything that is not
@@ -64,13 +71,12 @@ VideoTrial TrackTrialVideo(const Experiment& experiment, const ExperimentRow& ro
                            const VideoProgressCallback& progress = {});
 
 // For the page: the trial of data row `row_index` (0-based, file order) of the folder's
-// measurements.csv, loaded as LoadExperiment reads it, with its track (the frames of the cached
-// track.csv, SI) and the cache entry's folder (relative to the experiment folder; "" on error).
-// Throws what LoadExperiment throws, and InputError when the row has no video or is out of range.
+// measurements.csv, loaded as LoadExperiment reads it, with its track (the frames of track.csv as
+// the cache keeps them, SI; empty on error). Throws what LoadExperiment throws, and InputError
+// when the row has no video or is out of range.
 struct VideoTrialResult {
   VideoTrial trial;
   Track track;
-  std::string cache_folder;
 };
 VideoTrialResult TrackTrialVideo(const std::string& folder, std::size_t row_index,
                                  const VideoProgressCallback& progress = {});
@@ -103,5 +109,12 @@ void OneDecodeThreadPerVideo();
 
 // XXH3-64 of a file's bytes as 16 lower-case hex digits. Throws EnvironmentError naming the file.
 std::string HashFileContent(const std::string& path);
+
+// A trial's cache key: `video_hash` (HashFileContent of the video), then 16 hex digits of XXH3-64
+// over the camera and scene files' bytes, the row's body and apparatus values, the analysis
+// options and `tracker_version`. Any change of these is another key, so the trial is tracked again.
+std::string VideoCacheKey(const std::string& video_hash, const std::string& camera_bytes,
+                          const std::string& scene_bytes, const Configuration& configuration,
+                          const VideoAnalysisSettings& analysis, int tracker_version = kVideoTrackerVersion);
 
 }  // namespace uphill

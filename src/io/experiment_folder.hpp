@@ -30,6 +30,8 @@ inline constexpr const char* kExperimentFormat2 = "uphill-experiment/2";
 inline constexpr const char* kExperimentFormat = kExperimentFormat1;
 inline constexpr const char* kExperimentJsonFile = "experiment.json";
 inline constexpr const char* kMeasurementsCsvFile = "measurements.csv";
+// The folder's cache of the trials' tracked videos (app/video_trials.hpp): never an output's place.
+inline constexpr const char* kVideoCacheFolder = ".uphill-cache";
 
 // The keys experiment.json may have: at the top, in "body", in "apparatus" (constants of the
 // apparatus), in "uncertainties" (default standard uncertainties) and in "video_analysis" (the

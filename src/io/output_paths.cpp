@@ -31,6 +31,34 @@ void OutputPaths::AddInput(const std::string& path, const std::string& what) {
   inputs_.push_back({st.st_dev, st.st_ino, path, what});
 }
 
+const OutputPaths::Input* OutputPaths::SameFile(const std::vector<Input>& inputs, const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return nullptr;
+  for (const Input& in : inputs)
+    if (in.device == st.st_dev && in.inode == st.st_ino) return &in;
+  return nullptr;
+}
+
+void OutputPaths::AddInputFolder(const std::string& path, const std::string& what) {
+  struct stat st {};
+  if (path.empty() || ::stat(path.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) return;
+  input_folders_.push_back({st.st_dev, st.st_ino, path, what});
+}
+
+void OutputPaths::RefuseInsideInputFolder(const std::string& path, const std::string& context) const {
+  if (input_folders_.empty()) return;
+  std::error_code ec;
+  fs::path folder = fs::weakly_canonical(fs::absolute(FolderOf(path)), ec);
+  if (ec) return;
+  for (;;) {
+    if (const Input* in = SameFile(input_folders_, folder.string()))
+      throw InputError(context, "is inside " + in->what + " " + in->path +
+                                    ": an output is never written among the inputs; write elsewhere");
+    if (!folder.has_parent_path() || folder.parent_path() == folder) return;
+    folder = folder.parent_path();
+  }
+}
+
 void OutputPaths::CheckWritableFolder(const std::string& folder, const std::string& context) const {
   // The nearest folder on the path that exists: it must be a folder this user can write.
   fs::path existing = fs::path(folder);
@@ -58,12 +86,10 @@ void OutputPaths::CheckFile(const std::string& path, const std::string& flag) {
   const std::string context = flag + " " + path;
   if (path.empty()) throw InputError(flag, "is empty (give a file name)");
   if (path.back() == '/') throw InputError(context, "names a folder; give a file name");
-  struct stat followed {};
-  if (::stat(path.c_str(), &followed) == 0)
-    for (const Input& in : inputs_)
-      if (in.device == followed.st_dev && in.inode == followed.st_ino)
-        throw InputError(context, "is " + in.what + " " + in.path +
-                                      " (the same file): an output never replaces an input; write elsewhere");
+  if (const Input* in = SameFile(inputs_, path))
+    throw InputError(context, "is " + in->what + " " + in->path +
+                                  " (the same file): an output never replaces an input; write elsewhere");
+  RefuseInsideInputFolder(path, context);
   struct stat st {};
   if (::lstat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
     throw InputError(context, "is " + internal::FileKindName(st.st_mode) + ", not a regular file: never replaced (write to a file)");

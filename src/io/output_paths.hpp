@@ -29,6 +29,10 @@ class OutputPaths {
   // A file the command reads, with what to call it in messages ("the input video"). Absent
   // paths and "-" (stdin) are ignored: their readers say what is wrong with them.
   void AddInput(const std::string& path, const std::string& what);
+  // A folder the command reads or keeps (a cache): no output is written inside it, however the
+  // path is spelled (each folder above the output is compared by device and inode). Absent
+  // folders are ignored.
+  void AddInputFolder(const std::string& path, const std::string& what);
 
   // Checks the output file `path` given by `flag`, and that no earlier checked output is the same
   // path (two outputs of one command would overwrite each other). Throws InputError.
@@ -47,7 +51,11 @@ class OutputPaths {
     std::string path, what;
   };
   void CheckWritableFolder(const std::string& folder, const std::string& context) const;
+  // The entry of `inputs` that is the file or folder at `path` (followed), or nullptr.
+  static const Input* SameFile(const std::vector<Input>& inputs, const std::string& path);
+  void RefuseInsideInputFolder(const std::string& path, const std::string& context) const;
   std::vector<Input> inputs_;
+  std::vector<Input> input_folders_;
   std::vector<std::pair<std::string, std::string>> outputs_;  // resolved path, flag
 };
 

@@ -134,6 +134,10 @@ std::vector<GnuplotFigure> VideoTrialFigures(const VideoTrial& t, std::size_t in
   return TrackFigures(t.figure, Stem(index), " (trial " + t.trial + ")");
 }
 
+std::vector<std::string> VideoTrialFigureNames(std::size_t index) {
+  return {Stem(index) + kXVsT, Stem(index) + kResiduals};
+}
+
 std::vector<GnuplotFigure> VideoTrialFigures(const ExperimentAnalysis& a) {
   std::vector<GnuplotFigure> out;
   for (std::size_t i = 0; i < a.video_trials.size(); ++i)

@@ -27,6 +27,8 @@ std::vector<GnuplotFigure> VideoTrialFigures(const ExperimentAnalysis& analysis)
 // The figures of one trial, the `index`-th of the video trials (from 0): what
 // VideoTrialFigures(analysis) holds for it, so that they can be drawn as soon as it is tracked.
 std::vector<GnuplotFigure> VideoTrialFigures(const VideoTrial& trial, std::size_t index);
+// The names every figure of the `index`-th video trial may have (x_vs_t, residuals).
+std::vector<std::string> VideoTrialFigureNames(std::size_t index);
 // fit.json's "video_trials" (VideoTrialToJson without figure data) and "motion_mu".
 void AddVideoJson(const ExperimentAnalysis& analysis, nlohmann::ordered_json* j);
 

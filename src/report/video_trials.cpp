@@ -3,6 +3,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "internal/strict_json.hpp"
+#include "model/input_error.hpp"
 #include "model/number_text.hpp"
 
 namespace uphill {
@@ -53,7 +55,7 @@ std::vector<GnuplotFigure> TrackFigures(const TrackFigureData& a, const std::str
                                         const std::string& title_suffix) {
   std::vector<GnuplotFigure> figures;
   GnuplotFigure x;
-  x.name = stem + "_x_vs_t";
+  x.name = stem + kXVsT;
   x.title = "Measured x(t) against the fitted model" + title_suffix;
   x.caption = "Each point is one video frame where the ball was found (x of its centre in the apparatus frame); "
               "the line is the model motion fitted to them (x0, t0 and " +
@@ -73,7 +75,7 @@ std::vector<GnuplotFigure> TrackFigures(const TrackFigureData& a, const std::str
   figures.push_back(x);
   if (a.fit_available) {
     GnuplotFigure r;
-    r.name = stem + "_residuals";
+    r.name = stem + kResiduals;
     r.title = "Residuals of the model fit" + title_suffix;
     r.caption = "Measured minus fitted x for every frame of the fit window, with the stated u_x as error bars. "
                 "Structure (a trend, a wave) means the model misses something.";
@@ -99,29 +101,23 @@ namespace {
 
 using nlohmann::json;
 
+// The ranges a trial's numbers keep (the apparatus is a few metres long, a recording a few
+// minutes; μ and g_eff are of order 1 and 10): far wider than any real trial, narrow enough that
+// nothing derived from them (mm, squares, sums) overflows.
+constexpr double kMaxLength = 1e3;     // m, |x| and its uncertainty
+constexpr double kMaxTime = 1e6;       // s
+constexpr double kMaxFitValue = 1e6;   // μ or g_eff (m/s²)
+constexpr int kMaxCount = 1 << 30;     // rows, frames, degrees of freedom
+
 json ValueJson(const std::optional<MeasuredValue>& v) {
   if (!v) return nullptr;
   return {{"value", std::isfinite(v->value) ? json(v->value) : json(nullptr)}, {"u", v->u ? json(*v->u) : json(nullptr)}};
-}
-
-std::optional<MeasuredValue> ValueFrom(const json& j) {
-  if (j.is_null()) return std::nullopt;
-  MeasuredValue v;
-  v.value = j.at("value").is_null() ? std::nan("") : j.at("value").get<double>();
-  if (!j.at("u").is_null()) v.u = j.at("u").get<double>();
-  return v;
 }
 
 json PairsJson(const std::vector<std::pair<double, double>>& pairs) {
   json a = json::array();
   for (const auto& [t, x] : pairs) a.push_back({t, x});
   return a;
-}
-
-std::vector<std::pair<double, double>> PairsFrom(const json& j) {
-  std::vector<std::pair<double, double>> out;
-  for (const json& p : j) out.emplace_back(p.at(0).get<double>(), p.at(1).get<double>());
-  return out;
 }
 
 }  // namespace
@@ -160,43 +156,44 @@ json VideoTrialToJson(const VideoTrial& t, bool with_figure) {
 }
 
 VideoTrial VideoTrialFromJson(const json& j) {
+  const internal::StrictJson r(j, "");
   VideoTrial t;
-  t.trial = j.at("trial").get<std::string>();
-  t.row = j.at("row").get<int>();
-  t.video = j.at("video").get<std::string>();
-  t.error = j.at("error").get<std::string>();
-  t.frames = j.at("frames").get<int>();
-  t.found = j.at("found").get<int>();
-  t.partial = j.at("partial").get<bool>();
-  t.partial_reason = j.at("partial_reason").get<std::string>();
-  t.rest = ValueFrom(j.at("rest_x"));
-  t.no_rest = j.at("no_rest").get<std::string>();
-  t.release_x = ValueFrom(j.at("release_x"));
-  t.release_t = ValueFrom(j.at("release_t"));
-  t.fit_available = j.at("fit_available").get<bool>();
-  t.fit_unavailable = j.at("fit_unavailable").get<std::string>();
-  t.fitted = j.at("fitted").get<std::string>();
-  t.fit_value = ValueFrom(j.at("fit_value"));
-  t.reduced_chi2 = j.at("reduced_chi2").get<double>();
-  t.dof = j.at("dof").get<int>();
-  t.notes = j.at("notes").get<std::vector<std::string>>();
-  for (const json& e : j.at("events")) {
+  t.trial = r.Text("trial");
+  t.row = r.Integer("row", 1, kMaxCount);
+  t.video = r.Text("video");
+  t.error = r.Text("error");
+  t.frames = r.Integer("frames", 0, kMaxCount);
+  t.found = r.Integer("found", 0, t.frames);
+  t.partial = r.Bool("partial");
+  t.partial_reason = r.Text("partial_reason");
+  t.rest = r.Value("rest_x", kMaxLength, kMaxLength);
+  t.no_rest = r.Text("no_rest");
+  t.release_x = r.Value("release_x", kMaxLength, kMaxLength);
+  t.release_t = r.Value("release_t", kMaxTime, kMaxTime);
+  t.fit_available = r.Bool("fit_available");
+  t.fit_unavailable = r.Text("fit_unavailable");
+  t.fitted = r.OneOf("fitted", {"", "g", "mu"});
+  t.fit_value = r.Value("fit_value", kMaxFitValue, kMaxFitValue);
+  t.reduced_chi2 = r.Number("reduced_chi2", 0, std::numeric_limits<double>::max());
+  t.dof = r.Integer("dof", 0, kMaxCount);
+  t.notes = r.Texts("notes");
+  r.ForEach("events", [&](const internal::StrictJson& e) {
     VideoTrialEvent ev;
-    ev.kind = e.at("kind").get<std::string>();
-    if (auto v = ValueFrom(e.at("t"))) ev.t = *v;
-    if (auto v = ValueFrom(e.at("x"))) ev.x = *v;
+    ev.kind = e.Text("kind");
+    ev.t = e.Value("t", kMaxTime, kMaxTime).value_or(MeasuredValue{});
+    ev.x = e.Value("x", kMaxLength, kMaxLength).value_or(MeasuredValue{});
     t.events.push_back(ev);
-  }
+  });
   if (j.contains("figure")) {
-    const json& f = j.at("figure");
-    t.figure.measured = PairsFrom(f.at("measured"));
-    t.figure.curve = PairsFrom(f.at("curve"));
-    t.figure.fitted = f.at("fitted").get<std::string>();
-    t.figure.fit_available = f.at("fit_available").get<bool>();
-    t.figure.fit_t = f.at("fit_t").get<std::vector<double>>();
-    t.figure.fit_residual = f.at("fit_residual").get<std::vector<double>>();
-    t.figure.u_x = f.at("u_x").get<double>();
-    t.figure.rms_residual = f.at("rms_residual").get<double>();
+    const internal::StrictJson f = r.Object("figure");
+    t.figure.measured = f.Pairs("measured", kMaxTime, kMaxLength);
+    t.figure.curve = f.Pairs("curve", kMaxTime, kMaxLength);
+    t.figure.fitted = f.OneOf("fitted", {"", "g", "mu"});
+    t.figure.fit_available = f.Bool("fit_available");
+    t.figure.fit_t = f.Numbers("fit_t", kMaxTime);
+    t.figure.fit_residual = f.Numbers("fit_residual", kMaxLength);
+    t.figure.u_x = f.Number("u_x", 0, kMaxLength);
+    t.figure.rms_residual = f.Number("rms_residual", 0, kMaxLength);
   }
   return t;
 }

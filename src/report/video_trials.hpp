@@ -51,6 +51,7 @@ struct VideoTrial {
   std::string video;    // relative to the experiment folder
   std::string error;    // non-empty: the video could not be analysed (file, rule); nothing below
   bool from_cache = false;
+  std::string cache_note;  // one line when a damaged cache entry was tracked again (not in JSON)
   int frames = 0, found = 0;
   double tracker_cpu_seconds = 0;  // the tracker's own CPU time, decoding excluded (0 from the cache)
   bool partial = false;
@@ -88,13 +89,17 @@ struct MotionMu {
 std::optional<MotionMu> WeightedMotionMu(const std::vector<VideoTrial>& trials);
 
 // A trial as JSON (SI units; in fit.json's "video_trials" and the video cache's trial.json) and
-// back. `with_figure` adds the figure data. VideoTrialFromJson throws nlohmann::json::exception
-// (or InputError) for a document it did not write.
+// back. `with_figure` adds the figure data. VideoTrialFromJson reads the document as input (a
+// cache entry may be damaged or edited): every key present with its type, every number finite and
+// in range (|x| ≤ 1 km, |t| ≤ 10⁶ s, uncertainties ≥ 0, 0 ≤ found ≤ frames); else InputError
+// naming the key and the rule.
 nlohmann::json VideoTrialToJson(const VideoTrial& trial, bool with_figure = true);
 VideoTrial VideoTrialFromJson(const nlohmann::json& j);
 
-// The two figures of a trial, named `stem` + "_x_vs_t" and `stem` + "_residuals" (the residuals
-// only when the fit is available). Lengths in mm in the figures.
+// The two figures of a trial, named `stem` + kXVsT and `stem` + kResiduals (the residuals only
+// when the fit is available). Lengths in mm in the figures.
+inline constexpr const char* kXVsT = "_x_vs_t";
+inline constexpr const char* kResiduals = "_residuals";
 std::vector<GnuplotFigure> TrackFigures(const TrackFigureData& data, const std::string& stem,
                                         const std::string& title_suffix = "");
 

@@ -16,6 +16,7 @@
 #include "model/input_error.hpp"
 #include "report/analysis.hpp"
 #include "report/fit_document.hpp"
+#include "report/report_outputs.hpp"
 #include "vision/camera.hpp"
 #include "internal/calibration_api.hpp"
 #include "internal/folder_claim.hpp"
@@ -677,6 +678,7 @@ struct Server::Impl {
     analysis_options.mc_trials = options.report_mc_trials;
     Experiment experiment;
     const ExperimentAnalysis analysis = internal::AnalyseFolder(store.directory(), analysis_options, &experiment);
+    CheckReportOutputs(experiment, (fs::path(store.directory()) / "report").string(), "report");  // 422: never over an input
     ClaimFolder();
     ContainedDirectory staging = folder->MakeStagingDirectory(internal::kReportStagingPrefix);
     std::vector<std::string> names;

@@ -7,7 +7,6 @@
 // (vision_program.hpp), whose build of this file does that work.
 #include <unistd.h>
 
-#include <filesystem>
 #include <optional>
 #include <iostream>
 
@@ -16,12 +15,12 @@
 #include "fit/least_squares_line.hpp"
 #include "fit/robust_line.hpp"
 #include "fit/york_line.hpp"
-#include "io/output_paths.hpp"
 #include "io/xy_table.hpp"
 #include "model/input_error.hpp"
 #include "report/fit_document.hpp"
 #include "report/fit_json.hpp"
 #include "report/figure_pool.hpp"
+#include "report/report_outputs.hpp"
 #include "report/video_report.hpp"
 #include "vision_program.hpp"
 #if UPHILL_VISION_PROGRAM
@@ -105,10 +104,10 @@ void RunXy(const FitFlags& f) {
   }
 }
 
-// `figures`, when given (`uphill report`), draws each video trial's figures into f.output as soon
-// as the trial is tracked, while the other videos are tracked.
+// `keep` is the loaded experiment (the analysis points into it). `figures`, when given
+// (`uphill report`), draws each video trial's figures into f.output as soon as the trial is
+// tracked, while the other videos are tracked.
 ExperimentAnalysis Analyse(const FitFlags& f, Experiment* keep, FigurePool* figures = nullptr) {
-  *keep = LoadExperiment(f.experiment);
   AnalysisOptions options;
   // Per row; 10^7 take about half a second a row. Fewer than 100 give no usable u(X): 0 gave
   // u_MC = 0 on every row.
@@ -135,11 +134,13 @@ ExperimentAnalysis Analyse(const FitFlags& f, Experiment* keep, FigurePool* figu
           for (GnuplotFigure& figure : list) figures->Render(std::move(figure), f.output);
         });
     if (display) display->Finish();
-    for (const VideoTrial& t : trials)
+    for (const VideoTrial& t : trials) {
+      if (!t.cache_note.empty()) std::cerr << "uphill: note: " << t.cache_note << "\n";
       if (!t.error.empty()) {
         std::cerr << "uphill: " << t.error << " (video left out)\n";
         ExitStatus() = 2;
       }
+    }
     a = AnalyseExperimentWithVideos(keep, trials, options);
   } else {
     a = AnalyseExperiment(*keep, options);
@@ -157,7 +158,7 @@ ExperimentAnalysis Analyse(const FitFlags& f, Experiment* keep, FigurePool* figu
 }
 
 void RunExperiment(const FitFlags& f) {
-  Experiment experiment;
+  Experiment experiment = LoadExperiment(f.experiment);
   const ExperimentAnalysis a = Analyse(f, &experiment);
   if (f.json) {
     std::cout << AnalysisToJson(a).dump(2) << "\n";
@@ -202,11 +203,8 @@ void AddFitCommand(CLI::App& app) {
   report->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials per row for u(X)")->capture_default_str();
   AddVideoFlags(report, flags.get());
   report->callback([flags] {
-    OutputPaths outputs;  // checked before any work: never over the experiment's own files
-    outputs.AddInput((std::filesystem::path(flags->experiment) / "experiment.json").string(), "the experiment's");
-    outputs.AddInput((std::filesystem::path(flags->experiment) / "measurements.csv").string(), "the experiment's");
-    outputs.CheckFolder(flags->output, "-o", FitReportFiles());
-    Experiment experiment;
+    Experiment experiment = LoadExperiment(flags->experiment);
+    CheckReportOutputs(experiment, flags->output, "-o");  // before any work: never over an input
     FigurePool figures(flags->jobs);  // drawing while the videos are tracked, one gnuplot per core
     const ExperimentAnalysis a = Analyse(*flags, &experiment, &figures);
     WriteFitReport(a, flags->output, &figures);
