@@ -228,14 +228,42 @@ TEST(SecurityStartTest, AFileAMissingParentOrAReadOnlyFolderIsRefusedBeforeListe
   refused((base / "afile").string(), "is a file, not a folder");
   refused((base / "missing" / "EXP").string(), "does not exist");
   refused((base / "afile" / "EXP").string(), "not a folder");
-  // Not writable: as root the permission bits do not stop writes, but /proc/sys does.
+  // Not writable: a folder whose permission bits allow reading only (r-x for everyone). Root's
+  // writes are not stopped by permission bits, so as root (CI) the check runs in a child process
+  // that has dropped to the unprivileged user `nobody` (uid and gid 65534), for whom the bits hold.
+  fs::create_directories(base / "ro");
+  fs::permissions(base / "ro", fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
+                                   fs::perms::group_exec | fs::perms::others_read | fs::perms::others_exec);
   if (::geteuid() != 0) {
-    fs::create_directories(base / "ro");
-    fs::permissions(base / "ro", fs::perms::owner_read | fs::perms::owner_exec);
     refused((base / "ro").string(), "cannot be written");
     refused((base / "ro" / "EXP").string(), "cannot be written");
-    fs::permissions(base / "ro", fs::perms::owner_all);
+  } else {
+    const auto refused_as_nobody = [](const std::string& path) {
+      const pid_t pid = ::fork();
+      if (pid == 0) {
+        if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(3);
+        ServerOptions options;
+        options.directory = path;
+        try {
+          Server server(options);
+        } catch (const EnvironmentError& e) {
+          ::_exit(std::string(e.what()).find("cannot be written") != std::string::npos ? 0 : 2);
+        } catch (...) {
+          ::_exit(4);
+        }
+        ::_exit(1);  // accepted
+      }
+      int status = 0;
+      ::waitpid(pid, &status, 0);
+      EXPECT_TRUE(WIFEXITED(status)) << path;
+      // 0: refused as "cannot be written"; 1: accepted; 2: refused for another reason; 3: could
+      // not become nobody; 4: another exception.
+      EXPECT_EQ(WEXITSTATUS(status), 0) << path;
+    };
+    refused_as_nobody((base / "ro").string());
+    refused_as_nobody((base / "ro" / "EXP").string());
   }
+  fs::permissions(base / "ro", fs::perms::owner_all);
   refused("/proc/sys", "cannot be written");
   refused("/proc/sys/uphill-experiment", "cannot be written");
   fs::remove_all(base);
