@@ -414,14 +414,16 @@ TEST(ServeProcessTest, KillNineLosesNoAcknowledgedRow) {
     ASSERT_TRUE(r);
     ASSERT_EQ(r->status, 200);
     std::int64_t version = json::parse(r->body)["version"];
+    // Killed in the middle of the burst: once 20 writes have been acknowledged (an event, not a
+    // time), while the writer goes on sending.
     std::atomic<bool> killed{false};
+    std::atomic<int> acknowledged_count{0};
     std::thread killer([&] {
-      std::this_thread::sleep_for(std::chrono::milliseconds(150));
+      WaitUntil([&] { return acknowledged_count >= 20; });
       serve.Kill(SIGKILL);
       killed = true;
     });
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    for (int i = 0; i < 2000 && std::chrono::steady_clock::now() < deadline; ++i) {
+    for (int i = 0; i < 100000 && !killed; ++i) {
       const std::string trial = std::string("k").append(std::to_string(i));  // not "k" + …: GCC 12 -Wrestrict
       auto w = c.Post("/api/rows", json({{"version", version}, {"row", Row(trial, 110 + (i % 100), 400 + i % 7)}}).dump(), kJson);
       if (!w) {
@@ -430,6 +432,7 @@ TEST(ServeProcessTest, KillNineLosesNoAcknowledgedRow) {
       }
       ASSERT_EQ(w->status, 200) << w->body;
       acknowledged.insert(trial);
+      ++acknowledged_count;
       version = json::parse(w->body)["version"];
     }
     killer.join();

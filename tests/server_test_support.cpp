@@ -5,8 +5,10 @@
 #include <poll.h>
 #include <sys/socket.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <thread>
 
 namespace uphill::testing {
 
@@ -43,6 +45,40 @@ int ConnectLoopback(int port) {
     return -1;
   }
   return sock;
+}
+
+bool WaitUntil(const std::function<bool()>& condition, std::chrono::seconds limit) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  for (;;) {
+    if (condition()) return true;
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));  // a poll's pace, not a wait for the event
+  }
+}
+
+int StartStalledUpload(int port, const std::string& path, std::size_t declared, std::size_t sent) {
+  const int sock = ConnectLoopback(port);
+  if (sock < 0) return -1;
+  const std::string head = "PUT " + path + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
+                           "\r\nContent-Type: application/octet-stream\r\nContent-Length: " + std::to_string(declared) +
+                           "\r\n\r\n" + std::string(sent, 'x');
+  if (::send(sock, head.data(), head.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(head.size())) {
+    ::close(sock);
+    return -1;
+  }
+  return sock;
+}
+
+bool ClosedByServer(int sock, std::string& answer) {
+  char buffer[4096];
+  for (;;) {
+    const ssize_t n = ::recv(sock, buffer, sizeof buffer, MSG_DONTWAIT);
+    if (n > 0) {
+      answer.append(buffer, static_cast<std::size_t>(n));
+      continue;
+    }
+    return n == 0 || (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR);
+  }
 }
 
 std::string RawExchange(int port, const std::string& request, std::chrono::milliseconds timeout) {

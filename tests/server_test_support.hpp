@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -43,6 +45,19 @@ std::string RawExchange(int port, const std::string& request, std::chrono::milli
 
 // The status code of a raw HTTP answer ("HTTP/1.1 413 …" → 413), 0 if none.
 int StatusOf(const std::string& answer);
+
+// Waits for an event: polls `condition` until it holds (returns true at once then) or until the
+// generous `limit` has passed (false). The limit only ends a test that would otherwise hang; it
+// is never what the test measures.
+bool WaitUntil(const std::function<bool()>& condition, std::chrono::seconds limit = std::chrono::seconds(60));
+
+// Opens a connection that sends the head of an upload PUT `path` declaring `declared` bytes and
+// then `sent` bytes of its body, and stalls. Returns the socket (the caller closes it), or -1.
+int StartStalledUpload(int port, const std::string& path, std::size_t declared, std::size_t sent);
+
+// Whether the server has closed `sock`, without waiting: what it sent meanwhile is appended to
+// `answer` (whole once this returns true).
+bool ClosedByServer(int sock, std::string& answer);
 
 class ServerFixture : public ::testing::Test {
  protected:

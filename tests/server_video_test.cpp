@@ -5,7 +5,12 @@
 // decoded by OpenCV directly; files compared byte for byte.
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+#include <sys/socket.h>
+
 #include <algorithm>
+#include <csignal>
+#include <future>
 #include <cstdlib>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -13,7 +18,9 @@
 #include <sstream>
 
 #include "file_test_support.hpp"
+#include "oversized_media_support.hpp"
 #include "vision/camera.hpp"
+#include "vision/decode_limits.hpp"
 #include "server_test_support.hpp"
 
 namespace uphill::testing {
@@ -297,13 +304,223 @@ TEST_F(UploadTest, UploadIsStoredWholeOrNotAtAll) {
   const std::string head = "PUT /api/videos/cut.mp4 HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port_) +
                            "\r\nContent-Type: application/octet-stream\r\nContent-Length: " +
                            std::to_string(clip.size()) + "\r\n\r\n";
-  RawExchange(port_, head + clip.substr(0, clip.size() / 2), std::chrono::milliseconds(300));
-  for (int i = 0; i < 50 && Leftovers().size() > 1; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const int cut = ConnectLoopback(port_);
+  ASSERT_GE(cut, 0);
+  const std::string half = head + clip.substr(0, clip.size() / 2);
+  ASSERT_EQ(::send(cut, half.data(), half.size(), MSG_NOSIGNAL), static_cast<ssize_t>(half.size()));
+  ::close(cut);
+  // The event: the staging folder is gone (the server reads the close and cleans up).
+  EXPECT_TRUE(WaitUntil([&] { return Leftovers() == std::vector<std::string>{"trial1.mp4"}; }));
   EXPECT_EQ(Leftovers(), std::vector<std::string>{"trial1.mp4"});
   // Only application/octet-stream is an upload.
   auto form = client_->Put("/api/videos/form.mp4", clip, "multipart/form-data");
   ASSERT_TRUE(form);
   EXPECT_EQ(form->status, 415);
+}
+
+// An upload request as sent by a client that does not wait for the answer before its body.
+std::string UploadRequest(int port, const std::string& path, const std::string& body) {
+  return "PUT " + path + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
+         "\r\nContent-Type: application/octet-stream\r\nContent-Length: " + std::to_string(body.size()) + "\r\n\r\n" +
+         body;
+}
+
+// Guards: a PNG of 389 KB declaring 20,000 × 20,000 pixels was accepted as a view (13 of them took
+// the calibration to 5.2 GB), an MJPEG AVI of 1.3 MB declaring 8,000 × 8,000 as a video. Truth: the
+// limit of vision/decode_limits.hpp (60 million pixels; docs/serve.md "Limits") against the size
+// each file declares (what ffprobe reads from the same bytes); a 4K video passes.
+TEST_F(UploadTest, PicturesOverThePixelLimitAreRefusedBeforeDecoding) {
+  Start();
+  Create();
+  auto view = client_->Put("/api/views/huge.png", PngDeclaring(20000, 20000), "application/octet-stream");
+  ASSERT_TRUE(view);
+  EXPECT_EQ(view->status, 422);
+  EXPECT_NE(view->body.find("huge.png: an image of 20000 × 20000 pixels is more than uphill decodes: at most 60 "
+                            "million pixels"),
+            std::string::npos) << view->body;
+  EXPECT_FALSE(fs::exists(dir_ / "calibration" / "views" / "huge.png"));
+  const fs::path media = FreshFolder("oversized-media");
+  WriteAviDeclaring(media / "huge.avi", 8000, 8000);
+  auto video = client_->Put("/api/videos/huge.avi", ReadBytes(media / "huge.avi"), "application/octet-stream");
+  ASSERT_TRUE(video);
+  EXPECT_EQ(video->status, 422);
+  EXPECT_NE(video->body.find("huge.avi: a video with frames of 8000 × 8000 pixels is more than uphill decodes"),
+            std::string::npos) << video->body;
+  EXPECT_EQ(Leftovers(), std::vector<std::string>{});
+  WriteAviDeclaring(media / "uhd.avi", 3840, 2160);
+  auto uhd = client_->Put("/api/videos/uhd.avi", ReadBytes(media / "uhd.avi"), "application/octet-stream");
+  ASSERT_TRUE(uhd);
+  EXPECT_EQ(uhd->status, 200) << uhd->body;
+  // A view copied into a folder by hand: refused by the calibration, naming the file.
+  fs::create_directories(dir_ / "copied");
+  std::ofstream(dir_ / "copied" / "big.png", std::ios::binary) << PngDeclaring(20000, 20000);
+  auto [status, answer] = Send("POST", "/api/camera/calibrate",
+                               {{"version", State()["version"]}, {"folder", "copied"}, {"cols", 9}, {"rows", 6},
+                                {"square", 20}});
+  EXPECT_EQ(status, 422);
+  EXPECT_NE(answer.value("error", "").find("copied/big.png: an image of 20000 × 20000 pixels"), std::string::npos)
+      << answer.dump();
+  fs::remove_all(media);
+}
+
+// Guards: a disk that filled during an upload answered 422, as if the file were wrong, where
+// docs/serve.md's error table gives 500 for the server's own disk. Truth: that table. The full
+// disk is played by RLIMIT_FSIZE: a write beyond it fails (EFBIG), as one on a full disk (ENOSPC).
+TEST_F(UploadTest, ADiskThatFillsDuringAnUploadIs500AndLeavesNothing) {
+  Start();
+  Create();
+  const std::string clip = ReadBytes(*clip_ / "clip.mp4");
+  std::signal(SIGXFSZ, SIG_IGN);
+  rlimit old{};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
+  rlimit full = old;
+  full.rlim_cur = clip.size() / 2;
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &full), 0);
+  const std::string answer = RawExchange(port_, UploadRequest(port_, "/api/videos/full.mp4", clip), std::chrono::seconds(60));
+  ::setrlimit(RLIMIT_FSIZE, &old);
+  EXPECT_EQ(StatusOf(answer), 500) << answer;
+  EXPECT_NE(answer.find("videos/full.mp4: cannot be written to the experiment folder's disk"), std::string::npos)
+      << answer;
+  EXPECT_EQ(Leftovers(), std::vector<std::string>{});
+}
+
+// Guards: a name holding %2F or %00, or longer than 120 characters, was answered 415 ("must be
+// application/json") because the upload's route did not match it. Truth: the name's rule
+// (docs/serve.md: 1 to 100 letters, digits, '.', '-', '_'), checked before the content type.
+TEST_F(UploadTest, NamesThatBreakTheRuleAreRefusedByTheRule) {
+  Start();
+  Create();
+  for (const std::string& name : {std::string("a%2Fb.mp4"), std::string("a%00b.mp4"), std::string(121, 'n') + ".mp4",
+                                   std::string(101, 'n') + ".mp4"}) {
+    const std::string answer = RawExchange(port_, UploadRequest(port_, "/api/videos/" + name, "x"), std::chrono::seconds(60));
+    EXPECT_EQ(StatusOf(answer), 422) << name << ": " << answer;
+    EXPECT_NE(answer.find("a file name of 1 to 100 letters, digits"), std::string::npos) << answer;
+  }
+  // The name is shown as sent: the decoded '/' and NUL as %2F and %00 again.
+  const std::string slash = RawExchange(port_, UploadRequest(port_, "/api/videos/a%2Fb.mp4", "x"), std::chrono::seconds(60));
+  EXPECT_NE(slash.find("(got \\\"a%2Fb.mp4\\\""), std::string::npos) << slash;
+  EXPECT_EQ(Leftovers(), std::vector<std::string>{});
+}
+
+// Guards: a link at an intermediate folder answered 500 where a link at the file answered 422.
+// Truth: docs/serve.md "What it reads and writes" (never through a link, at any level) and the
+// rule that bad input is a 4xx: both are 422, naming the path.
+TEST_F(VideoApiTest, LinksAtAnyLevelAre422) {
+  MakeClipExperiment();
+  fs::create_directory_symlink(dir_ / "videos", dir_ / "linked");
+  fs::create_symlink(dir_ / "videos" / "clip.mp4", dir_ / "videos" / "leaf.mp4");
+  const std::int64_t id = FirstRowId();
+  for (const std::string video : {"linked/clip.mp4", "videos/leaf.mp4"}) {
+    auto frame = client_->Get(("/api/video/frame?video=" + video + "&frame=0").c_str());
+    ASSERT_TRUE(frame);
+    EXPECT_EQ(frame->status, 422) << video << ": " << frame->body;
+    EXPECT_NE(frame->body.find(video), std::string::npos) << frame->body;
+    EXPECT_NE(frame->body.find("link"), std::string::npos) << frame->body;
+    auto [status, answer] = Send("POST", "/api/rows/" + std::to_string(id) + "/video", {{"version", Version()}, {"video", video}});
+    EXPECT_EQ(status, 422) << video << ": " << answer.dump();
+  }
+  fs::create_directory_symlink(dir_ / "videos", dir_ / "calibration" / "views");
+  auto view = client_->Put("/api/views/a.png", PngDeclaring(16, 16), "application/octet-stream");
+  ASSERT_TRUE(view);
+  EXPECT_EQ(view->status, 422) << view->body;
+  EXPECT_NE(view->body.find("symbolic link"), std::string::npos) << view->body;
+  EXPECT_FALSE(fs::exists(dir_ / "videos" / "a.png"));
+}
+
+// Guards: `cols: 2147483648` was reported as "got -2147483648", `row=1e300` became row
+// -9223372036854775808 and `row=1.9` row 1; marks off the rails were left out without a word.
+// Truth: the rules as documented (a whole number in its range, reported as sent; a mark on the
+// rails, 0 < x < L = 1000 mm for this clip's apparatus, calibration/README.md).
+TEST_F(VideoApiTest, NumbersAreTakenAsSentAndMarksOffTheRailsAreRefused) {
+  MakeClipExperiment();
+  for (const std::string row : {"1e300", "1.9", "-1", "99999999999999999999"}) {
+    auto r = client_->Get(("/api/scene/points?row=" + row).c_str());
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, 422) << row;
+    EXPECT_NE(r->body.find("row: must be a row id, a whole number from 1 to 999999999999 (got \\\"" + row + "\\\")"),
+              std::string::npos) << r->body;
+  }
+  auto frame = client_->Get("/api/video/frame?video=videos/clip.mp4&frame=2147483648");
+  ASSERT_TRUE(frame);
+  EXPECT_EQ(frame->status, 422);
+  EXPECT_NE(frame->body.find("(got \\\"2147483648\\\")"), std::string::npos) << frame->body;
+  fs::create_directories(dir_ / "views");
+  std::ofstream(dir_ / "views" / "a.png", std::ios::binary) << PngDeclaring(16, 16);
+  for (const json& cols : {json(2147483648LL), json(2.5), json(-3)}) {
+    auto [status, answer] = Send("POST", "/api/camera/calibrate",
+                                 {{"version", Version()}, {"folder", "views"}, {"cols", cols}, {"rows", 6}, {"square", 20}});
+    EXPECT_EQ(status, 422) << cols;
+    EXPECT_EQ(answer.value("error", ""), "cols: must be the count of inner corners, a whole number from 2 to 100 (got " +
+                                             cols.dump() + ")");
+  }
+  auto marks = client_->Get(("/api/scene/points?row=" + std::to_string(FirstRowId()) + "&marks=300,1500").c_str());
+  ASSERT_TRUE(marks);
+  EXPECT_EQ(marks->status, 422);
+  EXPECT_NE(marks->body.find("marks: mark 2 at 1500 mm is not on the rails between O and the crossbar"), std::string::npos)
+      << marks->body;
+}
+
+// Guards: OpenCV's assertions escaped as 500 for a square of 1e50 mm (and 1e308, 1e-50,
+// 1e-300 mm) and for clicks 1e100 times too far from O. Truth: the ranges of
+// vision/calibration.hpp, documented in docs/calibrate.md (a square 0.1 mm to 1 m, a point's
+// coordinate within ±100 m of O): refused 422 naming the quantity, its value and the range.
+TEST_F(VideoApiTest, CalibrationInputsOutOfRangeAre422) {
+  MakeClipExperiment();
+  fs::create_directories(dir_ / "views");
+  std::ofstream(dir_ / "views" / "a.png", std::ios::binary) << PngDeclaring(16, 16);
+  for (const double square : {1e50, 1e308, 1e-50, 1e-300}) {
+    auto [status, answer] = Send("POST", "/api/camera/calibrate",
+                                 {{"version", Version()}, {"folder", "views"}, {"cols", 9}, {"rows", 6}, {"square", square}});
+    EXPECT_EQ(status, 422) << square << ": " << answer.dump();
+    EXPECT_EQ(answer.value("field", ""), "square");
+    EXPECT_NE(answer.value("error", "").find("is outside the allowed range 0.1 mm to 1000 mm"), std::string::npos)
+        << answer.dump();
+  }
+  json clicks = Clicks(ReadPoints(*clip_ / "points.csv"));
+  for (json& c : clicks)
+    for (const char* k : {"x", "y", "z"}) c[k] = c[k].get<double>() * 1e100;
+  auto [solve, solved] = Send("POST", "/api/scene/solve", {{"video", "videos/clip.mp4"}, {"clicks", clicks}});
+  EXPECT_EQ(solve, 422) << solved.dump();
+  EXPECT_NE(solved.value("error", "").find("is outside the allowed range -100000 mm to 100000 mm"), std::string::npos)
+      << solved.dump();
+  auto [save, saved] = Send("PUT", "/api/scenes/far", {{"version", Version()}, {"video", "videos/clip.mp4"}, {"clicks", clicks}});
+  EXPECT_EQ(save, 422) << saved.dump();
+}
+
+// A frame request larger than the whole decode budget is refused at once. Guards: four concurrent
+// frame requests of an 8000 × 8000 video took 2 GB. Truth: FrameDecodeBytes of a 480 × 270 frame,
+// 480 · 270 · 6 bytes, is more than a budget of 1000 bytes.
+class FrameBudgetTest : public VideoApiTest {
+ protected:
+  void Configure(ServerOptions& options) override { options.frame_decode_budget_bytes = 1000; }
+};
+
+TEST_F(FrameBudgetTest, AFrameLargerThanTheBudgetIs503) {
+  MakeClipExperiment();
+  auto r = client_->Get("/api/video/frame?video=videos/clip.mp4&frame=0");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 503);
+  EXPECT_NE(r->body.find("videos/clip.mp4: decoding it takes 760 KiB, more than the server's budget for decoding (1 KiB)"),
+            std::string::npos) << r->body;
+}
+
+// The budget's arithmetic, with events: a decode that does not fit waits (its waiting is seen),
+// and goes on when another returns its bytes; one larger than the whole budget never waits.
+TEST(DecodeBudgetTest, ADecodeWaitsForTheBytesOthersReturn) {
+  DecodeBudget budget(100);
+  std::optional<DecodeBudget::Lease> first;
+  first.emplace(budget.Acquire(60, std::chrono::milliseconds(0), "first"));
+  EXPECT_EQ(budget.in_use(), 60u);
+  EXPECT_THROW(budget.Acquire(50, std::chrono::milliseconds(0), "now"), DecodeBusy);
+  std::future<std::size_t> second = std::async(std::launch::async, [&budget] {
+    const DecodeBudget::Lease lease = budget.Acquire(50, std::chrono::minutes(10), "second");
+    return budget.in_use();
+  });
+  ASSERT_TRUE(WaitUntil([&] { return budget.waiting() == 1; }));
+  first.reset();
+  EXPECT_EQ(second.get(), 50u);
+  EXPECT_EQ(budget.in_use(), 0u);
+  EXPECT_THROW(budget.Acquire(101, std::chrono::minutes(10), "too big"), DecodeBusy);
 }
 
 // Attaching a video: the row names it (measurements.csv gains `video`, the folder becomes format

@@ -19,6 +19,8 @@
 #include "model/input_error.hpp"
 #include "vision/calibration.hpp"
 #include "vision/chessboard_render.hpp"
+#include "vision/decode_limits.hpp"
+#include "oversized_media_support.hpp"
 #include "vision_test_support.hpp"
 
 namespace uphill::testing {
@@ -432,6 +434,84 @@ TEST(CalibrateTargetCommand, WritesAnSvgOfExactSizeAndAPngThatIsDetected) {
   const auto bad = RunUphill("calibrate target --cols 1 --square 20mm -o " + (dir / "b.svg").string());
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("--cols: must be 2 to 100"), std::string::npos) << bad.err;
+  fs::remove_all(dir);
+}
+
+// ---- the pixel limit and the ranges (vision/decode_limits.hpp, "ranges" in calibration.hpp) ----
+
+// ImageHeaderSize reads the size OpenCV's own encoders wrote (a round trip), for each format whose
+// size is checked before decoding; the limit is the documented one (docs/calibrate.md): a 4K frame
+// and a 50-megapixel photo pass, 8000 × 8000 and 20,000 × 20,000 do not.
+TEST(DecodeLimits, HeaderSizesAreThoseTheEncodersWroteAndTheLimitIsTheDocumentedOne) {
+  const fs::path dir = CliDir();
+  for (const std::string ext : {".png", ".jpg", ".bmp", ".tif"}) {
+    const std::string path = (dir / ("view" + ext)).string();
+    ASSERT_TRUE(cv::imwrite(path, cv::Mat(23, 37, CV_8UC3, cv::Scalar(10, 20, 30))));
+    const std::optional<PixelSize> size = ImageHeaderSize(path);
+    ASSERT_TRUE(size) << ext;
+    EXPECT_EQ(size->width, 37) << ext;
+    EXPECT_EQ(size->height, 23) << ext;
+  }
+  { std::ofstream(dir / "text.png") << "not an image at all"; }
+  EXPECT_FALSE(ImageHeaderSize((dir / "text.png").string()));
+  EXPECT_FALSE(ImageHeaderSize((dir / "absent.png").string()));
+  EXPECT_NO_THROW(CheckPixelCount(3840, 2160, "uhd.mp4", "a video with frames"));
+  EXPECT_NO_THROW(CheckPixelCount(8688, 5792, "photo.jpg", "an image"));
+  EXPECT_THROW(CheckPixelCount(8000, 8000, "big.avi", "a video with frames"), InputError);
+  EXPECT_THROW(CheckPixelCount(20000, 20000, "huge.png", "an image"), InputError);
+  EXPECT_THROW(CheckPixelCount(std::int64_t{1} << 40, std::int64_t{1} << 40, "overflow.png", "an image"), InputError);
+  fs::remove_all(dir);
+}
+
+// Guards: `calibrate camera` decoded a PNG declaring 20,000 × 20,000 pixels (13 such views took
+// 5.2 GB). Truth: the limit of docs/calibrate.md, checked on the header: exit 2, the file named.
+TEST(CalibrateCommandLimits, AnImageOverThePixelLimitExitsTwoBeforeDecoding) {
+  const fs::path dir = CliDir();
+  const fs::path huge = dir / "huge.png";
+  { std::ofstream(huge, std::ios::binary) << PngDeclaring(20000, 20000); }
+  const auto r = RunUphill("calibrate camera " + huge.string() + " --cols 9 --rows 6 --square 20mm -o " +
+                           (dir / "cam.json").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("huge.png: an image of 20000 × 20000 pixels is more than uphill decodes: at most 60 million "
+                       "pixels"),
+            std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "cam.json"));
+  fs::remove_all(dir);
+}
+
+// Guards: `calibrate camera --square 1e50mm` (and 1e308, 1e-50, 1e-300 mm) and `calibrate scene`
+// with the points' coordinates times 1e80 ended in OpenCV assertions (exit 1). Truth: the ranges of
+// docs/calibrate.md (a square 0.1 mm to 1 m, a coordinate within ±100 m of O): exit 2, one line
+// naming the flag or the point, the value with its unit and the range (docs/exit-codes.md).
+TEST_F(CameraCalibrationTest, OutOfRangeSquaresAndPointsExitTwoNamingTheRange) {
+  const fs::path dir = CliDir();
+  std::string images;  // views in which the board is found: the square reaches calibrateCamera
+  for (const auto& view : Named()) {
+    cv::imwrite((dir / view.name).string(), view.image);
+    images += " " + (dir / view.name).string();
+  }
+  for (const std::string square : {"1e50mm", "1e308mm", "1e-50mm", "1e-300mm"}) {
+    const auto r = RunUphill("calibrate camera" + images + " --cols 9 --rows 6 --square " + square + " -o " +
+                             (dir / "cam.json").string());
+    EXPECT_EQ(r.status, 2) << square << ": " << r.err;
+    EXPECT_NE(r.err.find("--square: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(" mm is outside the allowed range 0.1 mm to 1000 mm"), std::string::npos) << r.err;
+  }
+  const std::string cam = (dir / "cam.json").string();
+  WriteCameraFile(cam, TrueCamera(), CalibrationSummary{});
+  const auto positions = ApparatusPoints();
+  const auto pixels = ProjectApparatusPoints(TrueCamera(), LabPose(), positions);
+  std::ostringstream csv;
+  csv << "name,u,v,x_mm,y_mm,z_mm\n";
+  for (size_t i = 0; i < positions.size(); ++i)
+    csv << "P" << i << "," << pixels[i].x() << "," << pixels[i].y() << "," << positions[i].x() * 1e83 << ","
+        << positions[i].y() * 1e83 << "," << positions[i].z() * 1e83 << "\n";
+  { std::ofstream(dir / "far.csv") << csv.str(); }
+  const auto r = RunUphill("calibrate scene --camera " + cam + " --points " + (dir / "far.csv").string() + " -o " +
+                           (dir / "scene.json").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find(" mm is outside the allowed range -100000 mm to 100000 mm"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "scene.json"));
   fs::remove_all(dir);
 }
 

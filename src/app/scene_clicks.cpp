@@ -1,5 +1,7 @@
 #include "app/scene_clicks.hpp"
 
+#include <sstream>
+
 #include "model/input_error.hpp"
 
 namespace uphill {
@@ -10,6 +12,16 @@ std::vector<ApparatusPoint> SettingCalibrationPoints(const Configuration& settin
   const std::optional<double> crossbar = setting.CrossbarDistance();
   if (!crossbar)
     throw InputError("L", "the rails are given by their angles: the points at the crossbar need L, H and D");
+  const auto mm = [](double metres) {
+    std::ostringstream out;
+    out << metres * 1000;
+    return out.str() + " mm";
+  };
+  for (std::size_t i = 0; i < marks_x.size(); ++i)
+    if (!(marks_x[i] > 0 && marks_x[i] < *crossbar))
+      throw InputError("marks", "mark " + std::to_string(i + 1) + " at " + mm(marks_x[i]) +
+                                    " is not on the rails between O and the crossbar (more than 0 mm and less than " +
+                                    mm(*crossbar) + ")");
   return ApparatusCalibrationPoints(rails, *crossbar, table_z, marks_x);
 }
 

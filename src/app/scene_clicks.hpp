@@ -19,7 +19,8 @@ namespace uphill {
 
 // The points of a setting (vision/apparatus_points.hpp) from its rails and crossbar distance.
 // Throws InputError("L") when the setting gives the rails by angles only (no crossbar distance:
-// then only O and typed points can be clicked), or the configuration's own InputError.
+// then only O and typed points can be clicked), InputError("marks") naming a mark that is not
+// strictly between O and the crossbar (0 < x < L), or the configuration's own InputError.
 std::vector<ApparatusPoint> SettingCalibrationPoints(const Configuration& setting, double table_z,
                                                      const std::vector<double>& marks_x);
 

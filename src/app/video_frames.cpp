@@ -1,5 +1,7 @@
 #include "app/video_frames.hpp"
 
+#include <optional>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -9,15 +11,31 @@
 namespace uphill {
 namespace {
 
-cv::VideoCapture Open(const std::string& path, const std::string& label) {
+cv::VideoCapture OpenCapture(const std::string& path) {
   QuietVideoLibraryLogs();
   cv::VideoCapture capture;
   try {
     capture.open(path, cv::CAP_FFMPEG);
   } catch (const cv::Exception&) {
   }
-  if (!capture.isOpened() || capture.get(cv::CAP_PROP_FRAME_WIDTH) <= 0)
+  return capture;
+}
+
+bool Readable(cv::VideoCapture& capture) {
+  return capture.isOpened() && capture.get(cv::CAP_PROP_FRAME_WIDTH) > 0;
+}
+
+// The frame size the container declares, before a frame is decoded.
+void CheckFrameSize(cv::VideoCapture& capture, const std::string& label) {
+  CheckPixelCount(static_cast<std::int64_t>(capture.get(cv::CAP_PROP_FRAME_WIDTH)),
+                  static_cast<std::int64_t>(capture.get(cv::CAP_PROP_FRAME_HEIGHT)), label, "a video with frames");
+}
+
+cv::VideoCapture Open(const std::string& path, const std::string& label) {
+  cv::VideoCapture capture = OpenCapture(path);
+  if (!Readable(capture))
     throw InputError(label, "is not a video that OpenCV/FFmpeg can read (an image, another file, or a cut-off copy?)");
+  CheckFrameSize(capture, label);
   return capture;
 }
 
@@ -39,7 +57,17 @@ VideoProbe ProbeVideo(const std::string& path, const std::string& label) {
   return ProbeOf(capture);
 }
 
-EncodedFrame ReadVideoFrame(const std::string& path, const std::string& label, int index, bool jpeg) {
+void CheckVideoPixels(const std::string& path, const std::string& label) {
+  cv::VideoCapture capture = OpenCapture(path);
+  if (Readable(capture)) CheckFrameSize(capture, label);
+}
+
+std::size_t FrameDecodeBytes(const VideoProbe& video) {
+  return static_cast<std::size_t>(video.width) * static_cast<std::size_t>(video.height) * 6;
+}
+
+EncodedFrame ReadVideoFrame(const std::string& path, const std::string& label, int index, bool jpeg,
+                            DecodeBudget* budget, std::chrono::milliseconds wait) {
   if (index < 0) throw InputError("frame", "must be >= 0");
   cv::VideoCapture capture = Open(path, label);
   EncodedFrame out;
@@ -47,6 +75,8 @@ EncodedFrame ReadVideoFrame(const std::string& path, const std::string& label, i
   if (out.video.frames > 0 && index >= out.video.frames)
     throw InputError("frame", "the video has " + std::to_string(out.video.frames) + " frames (0 to " +
                                   std::to_string(out.video.frames - 1) + "): no frame " + std::to_string(index));
+  std::optional<DecodeBudget::Lease> lease;
+  if (budget) lease.emplace(budget->Acquire(FrameDecodeBytes(out.video), wait, label));
   // Seeking in FFmpeg's H.264 lands on a key frame and decodes forward to the frame asked for.
   if (index > 0) capture.set(cv::CAP_PROP_POS_FRAMES, index);
   cv::Mat frame;

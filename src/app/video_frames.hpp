@@ -2,7 +2,11 @@
 // calibration points on, the strip of tracked frames), and a video's size and length.
 #pragma once
 
+#include <chrono>
+#include <cstddef>
 #include <string>
+
+#include "vision/decode_limits.hpp"
 
 namespace uphill {
 
@@ -13,8 +17,14 @@ struct VideoProbe {
 };
 
 // Opens the video with OpenCV's FFmpeg backend. Throws InputError(label, "is not a video ...")
-// for a file OpenCV cannot decode (an image, a text file, a cut-off upload).
+// for a file OpenCV cannot decode (an image, a text file, a cut-off upload), and InputError(label)
+// for frames of more pixels than uphill decodes (vision/decode_limits.hpp), read from the
+// container before any frame is decoded.
 VideoProbe ProbeVideo(const std::string& path, const std::string& label);
+
+// Only the pixel limit of ProbeVideo: throws InputError(label) when the video opens and its frames
+// are larger than the limit; a file that does not open is left to its reader to refuse.
+void CheckVideoPixels(const std::string& path, const std::string& label);
 
 struct EncodedFrame {
   std::string bytes;         // the image file
@@ -26,7 +36,14 @@ struct EncodedFrame {
 
 // Decodes frame `index` (0 = first; seeks, then reads) and encodes it losslessly as PNG (`jpeg`:
 // JPEG at quality 92, ~10x smaller, for the strip). Throws InputError as ProbeVideo, and
-// InputError("frame") when the video has no frame `index`.
-EncodedFrame ReadVideoFrame(const std::string& path, const std::string& label, int index, bool jpeg = false);
+// InputError("frame") when the video has no frame `index`. With a `budget`, the decode first
+// leases FrameDecodeBytes of it, waiting at most `wait` (DecodeBusy when it does not fit).
+EncodedFrame ReadVideoFrame(const std::string& path, const std::string& label, int index, bool jpeg = false,
+                            DecodeBudget* budget = nullptr,
+                            std::chrono::milliseconds wait = std::chrono::milliseconds(0));
+
+// The bytes a frame of `video` holds while it is read and encoded: the decoded BGR frame and its
+// encoded copy, each counted at 3 bytes a pixel.
+std::size_t FrameDecodeBytes(const VideoProbe& video);
 
 }  // namespace uphill

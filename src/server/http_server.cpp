@@ -4,9 +4,11 @@
 #include <atomic>
 #include <cctype>
 #include <filesystem>
+#include <cstring>
 #include <optional>
 #include <regex>
 #include <sstream>
+#include <tuple>
 #include <type_traits>
 
 #include "io/contained_directory.hpp"
@@ -21,6 +23,7 @@
 #include "internal/calibration_api.hpp"
 #include "internal/folder_claim.hpp"
 #include "internal/page_assets.hpp"
+#include "internal/request_values.hpp"
 #include "internal/track_api.hpp"
 #include "internal/video_upload.hpp"
 #include "server/row_check.hpp"
@@ -122,19 +125,53 @@ std::int64_t VersionOf(const json& body) {
   return body.at("version").get<std::int64_t>();
 }
 
-// The routes whose body is not JSON: uploads, streamed to disk (internal/video_upload.hpp).
+// The routes whose body is not JSON: uploads, streamed to disk (internal/video_upload.hpp). The
+// pre-routing handler sends every PUT under these prefixes through the upload's checks (its name
+// first), so a name the route's pattern does not match is refused by the name's rule.
+constexpr const char* kVideoUploadPrefix = "/api/videos/";
+constexpr const char* kViewUploadPrefix = "/api/views/";
 constexpr const char* kVideoUploadPattern = R"(/api/videos/([^/]{1,120}))";
 constexpr const char* kViewUploadPattern = R"(/api/views/([^/]{1,120}))";
-const std::regex kVideoUploadRoute(kVideoUploadPattern);
-const std::regex kViewUploadRoute(kViewUploadPattern);
 
-// The size limit of an upload request, or 0 when the request is not an upload.
-std::size_t UploadLimit(const httplib::Request& req, const ServerOptions& options) {
-  if (req.method != "PUT") return 0;
-  if (std::regex_match(req.path, kVideoUploadRoute)) return options.max_upload_bytes;
-  if (std::regex_match(req.path, kViewUploadRoute)) return options.max_view_upload_bytes;
-  return 0;
+struct UploadRoute {
+  const internal::UploadKind* kind = nullptr;
+  std::size_t limit = 0;
+  std::string name;  // as decoded from the path
+};
+
+// The upload a request is, or nullopt when it is none.
+std::optional<UploadRoute> UploadRouteOf(const httplib::Request& req, const ServerOptions& options) {
+  if (req.method != "PUT") return std::nullopt;
+  for (const auto& [prefix, kind, limit] :
+       {std::tuple{kVideoUploadPrefix, &internal::VideoUpload(), options.max_upload_bytes},
+        std::tuple{kViewUploadPrefix, &internal::ImageUpload(), options.max_view_upload_bytes}})
+    if (req.path.rfind(prefix, 0) == 0) return UploadRoute{kind, limit, req.path.substr(std::strlen(prefix))};
+  return std::nullopt;
 }
+
+std::string Seconds(std::chrono::milliseconds t) {
+  std::ostringstream out;
+  out << t.count() / 1000.0 << " s";
+  return out.str();
+}
+
+// At most `max` uploads at once: a slot is held from the upload's start to its end.
+class UploadSlot {
+ public:
+  UploadSlot(std::atomic<std::size_t>& count, std::size_t max) : count_(count), held_(++count_ <= max) {
+    if (!held_) --count_;
+  }
+  ~UploadSlot() {
+    if (held_) --count_;
+  }
+  UploadSlot(const UploadSlot&) = delete;
+  UploadSlot& operator=(const UploadSlot&) = delete;
+  bool held() const { return held_; }
+
+ private:
+  std::atomic<std::size_t>& count_;
+  const bool held_;
+};
 
 bool ValidReportName(const std::string& name) {
   static const std::regex ok("[A-Za-z0-9][A-Za-z0-9._-]{0,127}");
@@ -176,8 +213,9 @@ internal::ConnectionLimits Limits(const ServerOptions& options) {
 
 // Refuses a request before its body is read, and closes the connection (the unread body must not
 // be taken for the next request).
-httplib::Server::HandlerResponse Refuse(httplib::Response& res, int status, const std::string& message) {
-  SendError(res, status, message);
+httplib::Server::HandlerResponse Refuse(httplib::Response& res, int status, const std::string& message,
+                                        const std::string& field = "") {
+  SendError(res, status, message, field);
   SecurityHeaders(res);
   res.set_header("Connection", "close");
   internal::BoundedHttpServer::CloseAfterResponse();
@@ -195,6 +233,8 @@ struct Server::Impl {
   std::atomic<bool> stopped{false};  // Stop() was called: Run() no longer listens
   std::mutex claim_mutex;
   std::optional<internal::FolderClaim> claim;  // once the folder exists (internal/folder_claim.hpp)
+  std::atomic<std::size_t> uploads{0};         // being received (UploadSlot)
+  DecodeBudget frame_budget{options.frame_decode_budget_bytes};  // frame requests' decoded bytes
 
   explicit Impl(ServerOptions o) : options(std::move(o)), store(options.directory), http(Limits(options)) {
     ClaimFolder();
@@ -300,13 +340,19 @@ struct Server::Impl {
         const std::string origin = req.get_header_value("Origin");
         if (!origin.empty() && origin != "http://" + req.get_header_value("Host"))
           return Refuse(res, 403, "cross-origin change refused");
-        if (const std::size_t limit = UploadLimit(req, options)) {
+        if (const std::optional<UploadRoute> upload = UploadRouteOf(req, options)) {
+          try {
+            internal::CheckUploadName(upload->name, *upload->kind);
+          } catch (const InputError& e) {
+            return Refuse(res, 422, e.what(), e.quantity());
+          }
           if (req.get_header_value("Content-Type") != "application/octet-stream")
             return Refuse(res, 415, "an upload must be sent as application/octet-stream");
           const std::size_t length = req.get_header_value<std::uint64_t>("Content-Length");
-          if (length > limit)
-            return Refuse(res, 413, "the file is larger than the upload limit (" + std::to_string(limit >> 20) + " MiB)");
-          internal::BoundedHttpServer::AllowLargeRequest(length + 32 * 1024, options.upload_deadline);
+          if (length > upload->limit)
+            return Refuse(res, 413, "the file is larger than the upload limit (" + std::to_string(upload->limit >> 20) + " MiB)");
+          internal::BoundedHttpServer::AllowLargeRequest(length + 32 * 1024, options.upload_deadline,
+                                                         options.upload_idle_timeout);
           return httplib::Server::HandlerResponse::Unhandled;
         }
         if (!IsJsonContentType(req.get_header_value("Content-Type")))
@@ -321,9 +367,8 @@ struct Server::Impl {
       if (internal::BoundedHttpServer::RequestOverBudget()) {
         res.status = 413;
         res.body.clear();
-      } else if (internal::BoundedHttpServer::RequestTimedOut()) {
-        res.status = 408;
-        res.body.clear();
+      } else if (internal::BoundedHttpServer::RequestTimedOut() && res.body.empty()) {
+        res.status = 408;  // an upload that stalled has said so itself
       }
       if (res.body.empty()) {
         const std::string message =
@@ -479,21 +524,21 @@ struct Server::Impl {
     });
     http.Get("/api/video/frame", [this](const httplib::Request& req, httplib::Response& res) {
       try {
-        int frame = 0;
-        if (req.has_param("frame")) {
-          const std::string f = req.get_param_value("frame");
-          if (f.empty() || f.size() > 9 || f.find_first_not_of("0123456789") != std::string::npos)
-            throw InputError("frame", "must be a frame number (0 = the first)");
-          frame = std::stoi(f);
-        }
+        const int frame = req.has_param("frame")
+                              ? static_cast<int>(internal::WholeNumberText(req.get_param_value("frame"), "frame", 0,
+                                                                           999'999'999, "a frame number (0 = the first)"))
+                              : 0;
         const EncodedFrame image = internal::VideoFrame(store, req.get_param_value("video"), frame,
-                                                        req.get_param_value("format") == "jpeg");
+                                                        req.get_param_value("format") == "jpeg", frame_budget,
+                                                        options.frame_decode_wait);
         res.set_header("X-Frame-Index", std::to_string(image.index));
         res.set_header("X-Video-Size", std::to_string(image.video.width) + "x" + std::to_string(image.video.height));
         res.set_header("X-Video-Frames", std::to_string(image.video.frames));
         res.set_content(image.bytes, image.content_type);
       } catch (const InputError& e) {
         SendError(res, 422, e.what(), e.quantity());
+      } catch (const DecodeBusy& e) {
+        SendError(res, 503, e.what(), "frame");
       } catch (const std::exception& e) {
         SendError(res, 500, e.what());
       }
@@ -501,22 +546,14 @@ struct Server::Impl {
     http.Get("/api/scene/points", [this](const httplib::Request& req, httplib::Response& res) {
       Respond(req, res, [this, &req](const json&) {
         json query = json::object();
-        const auto number = [](const std::string& text, const std::string& field) {
-          try {
-            std::size_t used = 0;
-            const double v = std::stod(text, &used);
-            if (used == text.size()) return v;
-          } catch (const std::exception&) {
-          }
-          throw InputError(field, "must be a number (got \"" + text.substr(0, 32) + "\")");
-        };
-        if (req.has_param("row")) query["row"] = static_cast<std::int64_t>(number(req.get_param_value("row"), "row"));
-        if (req.has_param("table_z")) query["table_z"] = number(req.get_param_value("table_z"), "table_z");
+        if (req.has_param("row"))
+          query["row"] = internal::WholeNumberText(req.get_param_value("row"), "row", 1, 999'999'999'999, "a row id");
+        if (req.has_param("table_z")) query["table_z"] = internal::NumberText(req.get_param_value("table_z"), "table_z");
         if (req.has_param("marks")) {
           query["marks"] = json::array();
           std::stringstream in(req.get_param_value("marks"));
           for (std::string item; std::getline(in, item, ',');)
-            if (!item.empty()) query["marks"].push_back(number(item, "marks"));
+            if (!item.empty()) query["marks"].push_back(internal::NumberText(item, "marks"));
         }
         return internal::ScenePoints(store.Get(), query);
       });
@@ -613,6 +650,15 @@ struct Server::Impl {
   void Upload(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader,
               const std::string& directory, const internal::UploadKind& kind, std::size_t max_bytes,
               const std::function<ordered_json(const std::string& path, const std::string& name)>& probe) {
+    const auto close = [] { internal::BoundedHttpServer::CloseAfterResponse(); };
+    const UploadSlot slot(uploads, options.max_concurrent_uploads);
+    if (!slot.held()) {
+      SendError(res, 503, std::to_string(options.max_concurrent_uploads) +
+                              " uploads are being received already (the most at once): send this file when one of "
+                              "them has ended");
+      res.set_header("Connection", "close");  // its body is not read
+      return close();
+    }
     try {
       const ContainedDirectory* folder = store.folder();
       if (!folder) throw InputError("experiment", "does not exist yet: create it first");
@@ -627,13 +673,20 @@ struct Server::Impl {
       answer.update(described);
       SendJson(res, 200, answer);
     } catch (const InputError& e) {
-      SendError(res, 422, e.what(), e.quantity());
+      if (internal::BoundedHttpServer::RequestStalled())
+        SendError(res, 408, req.matches[1].str() + ": no byte arrived for " + Seconds(options.upload_idle_timeout) +
+                                ": the upload stalled and was closed; nothing was kept", "upload");
+      else if (internal::BoundedHttpServer::RequestTimedOut())
+        SendError(res, 408, req.matches[1].str() + ": not received within the upload's deadline; nothing was kept",
+                  "upload");
+      else
+        SendError(res, 422, e.what(), e.quantity());
       res.set_header("Connection", "close");  // the rest of the body, if any, is not read
-      internal::BoundedHttpServer::CloseAfterResponse();
+      close();
     } catch (const std::exception& e) {
-      SendError(res, 500, e.what());
+      SendError(res, 500, e.what());  // the server's disk or folder (full, failing), not the request
       res.set_header("Connection", "close");
-      internal::BoundedHttpServer::CloseAfterResponse();
+      close();
     }
   }
 
@@ -732,5 +785,7 @@ void Server::Stop() {
 }
 
 ExperimentStore& Server::store() { return impl_->store; }
+
+std::size_t Server::largest_request_bytes() const { return impl_->http.LargestRequestBytes(); }
 
 }  // namespace uphill

@@ -34,10 +34,12 @@
 // Errors: {error, field?}: 400 malformed JSON, a missing version, a header given twice or a
 // request that cannot be parsed; 403 a request from another origin or host, a refused report
 // name, or a link or non-regular file where the report lives; 404; 408 a request that did not
-// arrive within the deadline; 409 a stale version ({error, state}: the current state); 411 a body
-// without Content-Length (chunked); 413 a request over max_request_bytes; 415 a body that is not
-// exactly application/json; 422 content that breaks a rule (text that is not UTF-8 included),
-// naming the field; 500 the server's own folder or disk failed.
+// arrive within the deadline or an upload that stalled; 409 a stale version ({error, state}: the
+// current state); 411 a body without Content-Length (chunked); 413 a request over
+// max_request_bytes; 415 a body that is not exactly application/json; 422 content that breaks a
+// rule (text that is not UTF-8 included, a file larger than the pixel limit), naming the field;
+// 500 the server's own folder or disk failed (full included); 503 too many uploads at once, or
+// frames to decode beyond the decode budget (try again).
 //
 // Security (docs/serve.md, "What the server promises", says what is promised and what is not): by default bound to
 // 127.0.0.1; the Host header must name the loopback address (no DNS rebinding); changes need
@@ -66,6 +68,16 @@ struct ServerOptions {
   std::size_t max_upload_bytes = std::size_t{2} << 30;  // an uploaded video
   std::size_t max_view_upload_bytes = std::size_t{64} << 20;  // an uploaded chessboard view
   std::chrono::milliseconds upload_deadline{30 * 60 * 1000};  // for the whole upload
+  // An upload that sends no byte for upload_idle_timeout is closed and its partial file removed
+  // (408); at most max_concurrent_uploads are received at once (more: 503, body unread), so
+  // stalled uploads hold up neither other uploads for long nor any other request.
+  std::chrono::milliseconds upload_idle_timeout{30 * 1000};
+  std::size_t max_concurrent_uploads = 8;
+  // Frame requests lease their decoded bytes (app/video_frames.hpp FrameDecodeBytes) of this
+  // budget, waiting at most frame_decode_wait for it (503 after that, or at once for a frame
+  // larger than the whole budget); the pixel limit itself: vision/decode_limits.hpp.
+  std::size_t frame_decode_budget_bytes = std::size_t{512} << 20;
+  std::chrono::milliseconds frame_decode_wait{10 * 1000};
   std::uint64_t report_mc_trials = 10000;  // per row, for u(X) by Monte Carlo in the report
   // A request must arrive whole within request_deadline; a connection idle for idle_timeout is
   // closed; at most max_connections are served at once (one thread each).
@@ -94,6 +106,10 @@ class Server {
   void Stop();
 
   ExperimentStore& store();
+
+  // The most bytes read for one request so far (request line, headers and body): what the
+  // per-request byte budget bounds (internal/bounded_http_server.hpp).
+  std::size_t largest_request_bytes() const;
 
  private:
   struct Impl;

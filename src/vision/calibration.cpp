@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "model/input_error.hpp"
+#include "vision/decode_limits.hpp"
 #include "vision/library_logs.hpp"
 
 namespace uphill {
@@ -79,7 +80,23 @@ std::optional<CameraPose> FitPose(const CameraIntrinsics& camera, const std::vec
   return pose;
 }
 
+// Throws InputError(quantity) unless lo ≤ value ≤ hi (metres), naming the value and the range in mm.
+void RequireLengthIn(const std::string& quantity, double value, double lo, double hi, const std::string& why) {
+  if (value >= lo && value <= hi) return;
+  const auto mm = [](double v) {
+    std::ostringstream out;
+    out << v * 1000;
+    return out.str() + " mm";
+  };
+  throw InputError(quantity, mm(value) + " is outside the allowed range " + mm(lo) + " to " + mm(hi) + " (" + why + ")");
+}
+
 }  // namespace
+
+void ValidateCalibrationTarget(const ChessboardTarget& target, const std::string& square_name) {
+  ValidateTarget(target);
+  RequireLengthIn(square_name, target.square, kMinSquare, kMaxSquare, "the side of one printed square");
+}
 
 // ---- corners ----
 
@@ -140,7 +157,7 @@ std::vector<Eigen::Vector2d> FindChessboardCorners(const cv::Mat& image, const C
 
 CameraCalibration CalibrateCamera(const std::vector<NamedImage>& images, const ChessboardTarget& target,
                                   const CameraCalibrationOptions& options) {
-  ValidateTarget(target);
+  ValidateCalibrationTarget(target);
   if (images.empty()) throw InputError("images", "none given: give 10 to 20 views of the chessboard");
   const cv::Size size = images.front().image.size();
   for (const auto& view : images) {
@@ -254,6 +271,8 @@ CameraCalibration CalibrateCamera(const std::vector<NamedImage>& images, const C
 
 CameraCalibration CalibrateCameraFromFiles(const std::vector<std::string>& paths, const ChessboardTarget& target,
                                            const CameraCalibrationOptions& options) {
+  ValidateCalibrationTarget(target);
+  for (const auto& path : paths) CheckImagePixels(path, path);
   std::vector<NamedImage> images;
   QuietVideoLibraryLogs();
   for (const auto& path : paths) {
@@ -292,6 +311,9 @@ SceneCalibrationResult CalibrateScene(const CameraIntrinsics& camera, const std:
   for (size_t i = 0; i < points.size(); ++i) {
     const ScenePoint& p = points[i];
     if (!p.pixel.allFinite() || !p.position.allFinite()) throw InputError(p.label, "must be finite");
+    for (int k = 0; k < 3; ++k)
+      RequireLengthIn(p.label + ": " + "xyz"[k], p.position[k], -kMaxPointDistance, kMaxPointDistance,
+                      "an apparatus point's coordinate, from O");
     if (p.pixel.x() < -0.5 || p.pixel.y() < -0.5 || p.pixel.x() > camera.width - 0.5 ||
         p.pixel.y() > camera.height - 0.5)
       throw InputError(p.label, "pixel (" + Fixed(p.pixel.x(), 1) + ", " + Fixed(p.pixel.y(), 1) +
@@ -391,7 +413,7 @@ CalibrationSummary SceneCalibrationResult::Summary() const {
 SceneCalibrationResult CalibrateSceneFromChessboard(const CameraIntrinsics& camera, const NamedImage& image,
                                                     const ChessboardTarget& target, const Eigen::Vector3d& origin,
                                                     const Eigen::Vector3d& x_axis, const Eigen::Vector3d& y_axis) {
-  ValidateTarget(target);
+  ValidateCalibrationTarget(target);
   if ((target.cols + target.rows) % 2 == 0)
     throw InputError("--cols/--rows", "a board with cols + rows even looks the same turned by 180°, so its origin "
                                       "is ambiguous: use e.g. 9×6 inner corners");

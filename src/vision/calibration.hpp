@@ -18,7 +18,8 @@
 // the rotation about that line undetermined and are refused; coplanar points are fine.
 //
 // Hard cases, all refused with InputError naming the file (and row) and the rule: an image that
-// cannot be read, images of different sizes, no usable view, fewer than 4 scene points, scene
+// cannot be read or declares more pixels than uphill decodes, images of different sizes, a square
+// or a point's coordinate out of range (below, "ranges"), no usable view, fewer than 4 scene points, scene
 // points on a line (in space or in the image), a pixel outside the camera's image, a frame
 // whose size is not the camera's.
 #pragma once
@@ -32,6 +33,20 @@
 #include "vision/chessboard_render.hpp"
 
 namespace uphill {
+
+// ---- ranges ----
+//
+// What OpenCV's calibration is given is checked against these ranges first: far outside them its
+// solvers fail on assertions (a square of 1e50 mm, points 1e80 mm from O) instead of saying what
+// is wrong. The ranges hold any apparatus on a lab table and any printed chessboard with room to
+// spare (docs/calibrate.md).
+inline constexpr double kMinSquare = 0.1e-3;        // m: a chessboard square, 0.1 mm ...
+inline constexpr double kMaxSquare = 1.0;           // m: ... to 1 m
+inline constexpr double kMaxPointDistance = 100.0;  // m: each coordinate of a scene point, ±100 m
+
+// ValidateTarget, and the square within [kMinSquare, kMaxSquare]. Throws InputError(square_name)
+// naming the value in mm and the range.
+void ValidateCalibrationTarget(const ChessboardTarget& target, const std::string& square_name = "--square");
 
 // ---- camera ----
 
@@ -75,7 +90,9 @@ struct CameraCalibration {
 // not found are rejected and listed, the others used.
 CameraCalibration CalibrateCamera(const std::vector<NamedImage>& images, const ChessboardTarget& target,
                                   const CameraCalibrationOptions& options = {});
-// The same from image files (cv::imread; an unreadable file is an InputError naming it).
+// The same from image files (cv::imread; an unreadable file is an InputError naming it). The target
+// is validated and each file's header checked against the pixel limit (vision/decode_limits.hpp)
+// before any image is decoded.
 CameraCalibration CalibrateCameraFromFiles(const std::vector<std::string>& paths,
                                            const ChessboardTarget& target,
                                            const CameraCalibrationOptions& options = {});
@@ -103,7 +120,8 @@ struct SceneCalibrationResult {
   CalibrationSummary Summary() const;
 };
 
-// Throws InputError (see the header comment). `frame_width`/`frame_height` > 0: the size of the
+// Throws InputError (see the header comment; also a coordinate of a point beyond ±kMaxPointDistance,
+// named with its value in mm). `frame_width`/`frame_height` > 0: the size of the
 // frame the pixels were read from, which must be the camera's; 0: not checked.
 SceneCalibrationResult CalibrateScene(const CameraIntrinsics& camera, const std::vector<ScenePoint>& points,
                                       int frame_width = 0, int frame_height = 0);

@@ -29,6 +29,7 @@
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "vision/calibration.hpp"
+#include "vision/decode_limits.hpp"
 #include "vision/library_logs.hpp"
 #endif
 
@@ -80,7 +81,7 @@ void Row(const std::string& name, const std::string& value) {
 ChessboardTarget Target(const TargetFlags& f) {
   if (f.square.empty()) throw InputError("--square", "is required (the side of one square, with unit, e.g. 20mm)");
   ChessboardTarget t{f.cols, f.rows, ParseQuantity(f.square, Dimension::kLength, "--square")};
-  ValidateTarget(t);
+  ValidateCalibrationTarget(t);
   return t;
 }
 
@@ -163,6 +164,7 @@ Eigen::Vector3d Point(const std::string& text, const std::string& flag) {
 }
 
 cv::Mat ReadImage(const std::string& path, const std::string& flag) {
+  CheckImagePixels(path, flag + " " + path);
   QuietVideoLibraryLogs();
   const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
   if (image.empty()) throw InputError(flag + " " + path, "cannot be read as an image");

@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "app/tracking_inputs.hpp"
+#include "app/video_frames.hpp"
 #include "progress_bars.hpp"
 #include "io/configuration.hpp"
 #include "io/output_paths.hpp"
@@ -100,6 +101,7 @@ void Run(const TrackFlags& f) {
       std::fprintf(stderr, "\r%s ", FrameProgressText(done, total, elapsed).c_str());
       std::fflush(stderr);
     };
+  CheckVideoPixels(f.video, f.video);
   const TrackResult result = TrackVideo(f.video, scene, calibration, options);
   if (bar) std::fprintf(stderr, "\n");
   WriteTrack(f.out, result, {f.video, f.camera, f.scene_file, scene.body().Name()});

@@ -59,16 +59,20 @@ class BoundedStream : public httplib::Stream {
     used_ = end_ - begin_;
     budget_ = limits_.request_budget_bytes;
     deadline_ = Clock::now() + limits_.request_deadline;
-    over_budget_ = timed_out_ = close_ = false;
+    idle_ = std::chrono::milliseconds(0);
+    over_budget_ = timed_out_ = stalled_ = close_ = false;
   }
   bool has_buffered() const { return begin_ < end_; }
   bool over_budget() const { return over_budget_; }
   bool timed_out() const { return timed_out_; }
+  bool stalled() const { return stalled_; }
+  std::size_t used() const { return used_ - (end_ - begin_); }  // bytes of this request read
   bool close_requested() const { return close_ || over_budget_ || timed_out_; }
   void RequestClose() { close_ = true; }
-  void AllowLarge(std::size_t bytes, std::chrono::milliseconds deadline) {
+  void AllowLarge(std::size_t bytes, std::chrono::milliseconds deadline, std::chrono::milliseconds idle) {
     budget_ = std::max(budget_, bytes);
     deadline_ = std::max(deadline_, Clock::now() + deadline);
+    idle_ = idle;
   }
 
   bool is_readable() const override { return has_buffered() || WaitFor(sock_, POLLIN, deadline_); }
@@ -82,8 +86,10 @@ class BoundedStream : public httplib::Stream {
         over_budget_ = true;
         return -1;
       }
-      if (!WaitFor(sock_, POLLIN, deadline_)) {
+      const Clock::time_point idle_until = idle_.count() > 0 ? Clock::now() + idle_ : deadline_;
+      if (!WaitFor(sock_, POLLIN, std::min(deadline_, idle_until))) {
         timed_out_ = true;
+        stalled_ = idle_until < deadline_;
         return -1;
       }
       const std::size_t room = std::min(sizeof buffer_, budget_ - used_);
@@ -131,7 +137,8 @@ class BoundedStream : public httplib::Stream {
   std::size_t used_ = 0;
   std::size_t budget_ = 0;
   Clock::time_point deadline_;
-  bool over_budget_ = false, timed_out_ = false, close_ = false;
+  std::chrono::milliseconds idle_{0};  // 0: no limit between bytes (only the deadline)
+  bool over_budget_ = false, timed_out_ = false, stalled_ = false, close_ = false;
 };
 
 thread_local BoundedStream* current_stream = nullptr;
@@ -218,12 +225,14 @@ void BoundedHttpServer::CloseAfterResponse() {
   if (current_stream) current_stream->RequestClose();
 }
 
-void BoundedHttpServer::AllowLargeRequest(std::size_t bytes, std::chrono::milliseconds deadline) {
-  if (current_stream) current_stream->AllowLarge(bytes, deadline);
+void BoundedHttpServer::AllowLargeRequest(std::size_t bytes, std::chrono::milliseconds deadline,
+                                          std::chrono::milliseconds idle) {
+  if (current_stream) current_stream->AllowLarge(bytes, deadline, idle);
 }
 
 bool BoundedHttpServer::RequestOverBudget() { return current_stream && current_stream->over_budget(); }
 bool BoundedHttpServer::RequestTimedOut() { return current_stream && current_stream->timed_out(); }
+bool BoundedHttpServer::RequestStalled() { return current_stream && current_stream->stalled(); }
 
 bool BoundedHttpServer::process_and_close_socket(socket_t sock) {
   BoundedStream stream(sock, limits_);
@@ -236,6 +245,8 @@ bool BoundedHttpServer::process_and_close_socket(socket_t sock) {
     bool connection_closed = false;
     const bool last = served + 1 == limits_.max_requests_per_connection;
     ok = process_request(stream, last, connection_closed, nullptr);
+    for (std::size_t seen = largest_request_; stream.used() > seen;)
+      if (largest_request_.compare_exchange_weak(seen, stream.used())) break;
     if (!ok || connection_closed || stream.close_requested()) break;
   }
   current_stream = nullptr;

@@ -22,6 +22,7 @@
 // Stopping: StopListening, which works even before listening has started (httplib's stop() does not).
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstddef>
 
@@ -56,16 +57,23 @@ class BoundedHttpServer : public httplib::Server {
   // For handlers (the thread serving the request): close the connection after this answer.
   static void CloseAfterResponse();
   // For the pre-routing handler of an upload: this request may hold `bytes` (its headers
-  // included) and take until `deadline` from now.
-  static void AllowLargeRequest(std::size_t bytes, std::chrono::milliseconds deadline);
-  // For the error handler: whether the current request ran out of its byte budget or deadline.
+  // included) and take until `deadline` from now, but no byte may take longer than `idle` to
+  // come (a stalled upload is closed then, and its reader fails).
+  static void AllowLargeRequest(std::size_t bytes, std::chrono::milliseconds deadline, std::chrono::milliseconds idle);
+  // For the handlers: whether the current request ran out of its byte budget or deadline, or
+  // stalled (no byte within the idle limit of AllowLargeRequest; it counts as timed out too).
   static bool RequestOverBudget();
   static bool RequestTimedOut();
+  static bool RequestStalled();
+
+  // The most bytes read for one request so far, on any connection.
+  std::size_t LargestRequestBytes() const { return largest_request_; }
 
  private:
   bool process_and_close_socket(socket_t sock) override;
 
   ConnectionLimits limits_;
+  std::atomic<std::size_t> largest_request_{0};
 };
 
 }  // namespace uphill::internal

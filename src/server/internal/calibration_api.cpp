@@ -8,9 +8,12 @@
 #include "app/scene_clicks.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
+#include "request_values.hpp"
 #include "server/row_check.hpp"
+#include "video_upload.hpp"
 #include "vision/calibration.hpp"
 #include "vision/camera.hpp"
+#include "vision/decode_limits.hpp"
 #include "vision/library_logs.hpp"
 
 namespace uphill::internal {
@@ -73,7 +76,7 @@ bool IsImageName(const std::string& name) {
 std::string FolderFile(const ExperimentStore& store, const std::string& relative, const std::string& field) {
   CheckRelativePath(relative, field);
   const ContainedDirectory& folder = FolderOf(store);
-  const ContainedDirectory::Kind kind = folder.KindOf(relative);
+  const ContainedDirectory::Kind kind = KindInFolder(folder, relative, field);
   if (kind == ContainedDirectory::Kind::kAbsent)
     throw InputError(field, relative + " is not in the experiment folder");
   if (kind != ContainedDirectory::Kind::kFile)
@@ -81,8 +84,9 @@ std::string FolderFile(const ExperimentStore& store, const std::string& relative
   return (fs::path(folder.path()) / relative).string();
 }
 
-EncodedFrame VideoFrame(const ExperimentStore& store, const std::string& video, int frame, bool jpeg) {
-  return ReadVideoFrame(FolderFile(store, video, "video"), video, frame, jpeg);
+EncodedFrame VideoFrame(const ExperimentStore& store, const std::string& video, int frame, bool jpeg,
+                        DecodeBudget& budget, std::chrono::milliseconds wait) {
+  return ReadVideoFrame(FolderFile(store, video, "video"), video, frame, jpeg, &budget, wait);
 }
 
 ordered_json ListVideos(const ExperimentStore& store) {
@@ -125,6 +129,7 @@ ordered_json ScenePoints(const StoreSnapshot& snapshot, const json& query) {
     try {
       points = SettingCalibrationPoints(RowConfiguration(snapshot.state, *row), table_z, marks);
     } catch (const InputError& e) {
+      if (e.quantity() == "marks") throw;  // the request's own marks: refused, not left out
       note = std::string("only O: ") + e.what();
     }
   } else {
@@ -209,11 +214,15 @@ ordered_json SolveScene(const ExperimentStore& store, const StoreSnapshot& snaps
 }
 
 ImageSize ProbeImage(const std::string& path, const std::string& name) {
+  const std::string not_image =
+      "not an image OpenCV can decode (a chessboard view must be a PNG, JPEG, BMP or TIFF photo or frame); nothing "
+      "was kept";
+  const std::optional<PixelSize> size = ImageHeaderSize(path);  // its size, before decoding it
+  if (!size) throw InputError(name, not_image);
+  CheckPixelCount(size->width, size->height, name, "an image");
   QuietVideoLibraryLogs();  // a refused file is said once, in the answer
   const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (image.empty())
-    throw InputError(name, "not an image OpenCV can decode (a chessboard view must be a PNG, JPEG, BMP or TIFF "
-                           "photo or frame); nothing was kept");
+  if (image.empty()) throw InputError(name, not_image);
   return {image.cols, image.rows};
 }
 
@@ -230,7 +239,7 @@ ordered_json CalibrateCameraViews(const ExperimentStore& store, const StoreSnaps
   const std::string folder_name = body.at("folder").get<std::string>();
   CheckRelativePath(folder_name, "folder");
   const ContainedDirectory& folder = FolderOf(store);
-  if (folder.KindOf(folder_name) != ContainedDirectory::Kind::kDirectory)
+  if (KindInFolder(folder, folder_name, "folder") != ContainedDirectory::Kind::kDirectory)
     throw InputError("folder", folder_name + " is not a folder of the experiment");
   const ContainedDirectory views = folder.Subdirectory(folder_name, false);
   std::vector<std::string> paths;
@@ -240,12 +249,11 @@ ordered_json CalibrateCameraViews(const ExperimentStore& store, const StoreSnaps
   if (paths.size() > 60) throw InputError("folder", folder_name + " holds more than 60 images: keep 10 to 20 views");
   ChessboardTarget target;
   for (const char* k : {"cols", "rows"})
-    if (body.contains(k)) {
-      if (!body.at(k).is_number_integer()) throw InputError(k, "must be a whole number of inner corners");
-      (std::string(k) == "cols" ? target.cols : target.rows) = body.at(k).get<int>();
-    }
+    if (body.contains(k))
+      (std::string(k) == "cols" ? target.cols : target.rows) =
+          static_cast<int>(WholeNumberJson(body.at(k), k, 2, 100, "the count of inner corners"));
   if (body.contains("square")) target.square = LengthIn(body.at("square"), "square", unit);
-  ValidateTarget(target);
+  ValidateCalibrationTarget(target, "square");
   CameraCalibration c;
   try {
     c = CalibrateCameraFromFiles(paths, target);

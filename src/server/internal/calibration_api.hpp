@@ -7,6 +7,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <chrono>
 #include <string>
 
 #include "app/video_frames.hpp"
@@ -18,8 +19,10 @@ namespace uphill::internal {
 // libraries that open paths). Throws InputError(field) when it is not there or not a file.
 std::string FolderFile(const ExperimentStore& store, const std::string& relative, const std::string& field);
 
-// GET /api/video/frame?video=P&frame=N&format=png|jpeg
-EncodedFrame VideoFrame(const ExperimentStore& store, const std::string& video, int frame, bool jpeg);
+// GET /api/video/frame?video=P&frame=N&format=png|jpeg: the decode leases its bytes of `budget`,
+// waiting at most `wait` (DecodeBusy: 503).
+EncodedFrame VideoFrame(const ExperimentStore& store, const std::string& video, int frame, bool jpeg,
+                        DecodeBudget& budget, std::chrono::milliseconds wait);
 
 // GET /api/videos: {videos:[{path, bytes}]} the video files in the folder (by extension, at most
 // 3 folders deep, links not followed), sorted.
@@ -41,7 +44,8 @@ nlohmann::ordered_json SolveScene(const ExperimentStore& store, const StoreSnaps
 std::string SceneFilePath(const std::string& name);
 
 // A chessboard view uploaded (PUT /api/views/NAME): its size when OpenCV decodes it. Throws
-// InputError(name) naming the rule when it does not decode as an image.
+// InputError(name) naming the rule when its header declares more pixels than uphill decodes
+// (vision/decode_limits.hpp; checked before decoding) or it does not decode as an image.
 struct ImageSize {
   int width = 0, height = 0;
 };

@@ -40,29 +40,58 @@ std::string Listed(const std::vector<std::string>& items) {
   return out;
 }
 
+// The name with the bytes a path cannot hold in a name, and other control bytes, as %XX.
+std::string Shown(const std::string& name) {
+  static const char* kHex = "0123456789ABCDEF";
+  std::string out;
+  for (const char c : name.substr(0, 140)) {
+    const auto b = static_cast<unsigned char>(c);
+    if (b < 0x20 || b == 0x7F || c == '/' || c == '%') out.append({'%', kHex[b >> 4], kHex[b & 15]});
+    else out += c;
+  }
+  return name.size() > 140 ? out + "…" : out;
+}
+
 }  // namespace
+
+void CheckUploadName(const std::string& name, const UploadKind& kind) {
+  static const std::regex ok("[A-Za-z0-9_-][A-Za-z0-9._-]{0,99}");
+  if (!std::regex_match(name, ok) || name.find("..") != std::string::npos)
+    throw InputError("name", "a file name of 1 to 100 letters, digits, '.', '-' or '_', not starting with '.' (got \"" +
+                                 Shown(name) + "\", " + std::to_string(name.size()) + " characters: rename the file)");
+  if (!HasExtension(name, kind))
+    throw InputError("name", name + ": not " + (kind.what == "image" ? "an " : "a ") + kind.what + " file name (" +
+                                 Listed(kind.extensions) + ")");
+}
+
+ContainedDirectory::Kind KindInFolder(const ContainedDirectory& folder, const std::string& relative,
+                                      const std::string& field) {
+  try {
+    return folder.KindOf(relative);
+  } catch (const EnvironmentError& e) {
+    std::string message = e.what();
+    const std::string root = folder.path() + "/";
+    if (message.rfind(root, 0) == 0) message.erase(0, root.size());
+    throw InputError(field, relative + ": refused: " + message);
+  }
+}
 
 std::string ReceiveUpload(const ContainedDirectory& folder, const std::string& directory, const std::string& name,
                           const UploadKind& kind, std::size_t declared_bytes, std::size_t max_bytes,
                           const BodyReader& read, const std::function<void(const std::string& staged_path)>& check) {
-  static const std::regex ok("[A-Za-z0-9_-][A-Za-z0-9._-]{0,99}");
-  if (!std::regex_match(name, ok) || name.find("..") != std::string::npos)
-    throw InputError("name", "a file name of 1 to 100 letters, digits, '.', '-' or '_' (rename the file)");
-  if (!HasExtension(name, kind))
-    throw InputError("name", name + ": not " + (kind.what == "image" ? "an " : "a ") + kind.what + " file name (" +
-                                 Listed(kind.extensions) + ")");
+  CheckUploadName(name, kind);
   if (declared_bytes > max_bytes)
     throw InputError("upload", name + " is " + std::to_string(declared_bytes >> 20) + " MiB: larger than the limit of " +
                                    std::to_string(max_bytes >> 20) + " MiB");
   const std::string target = directory + "/" + name;
-  if (folder.KindOf(target) != ContainedDirectory::Kind::kAbsent)
+  if (KindInFolder(folder, target, "name") != ContainedDirectory::Kind::kAbsent)
     throw InputError("name", target + " exists already in the experiment folder: pick it from the list, or rename the file");
   const ContainedDirectory into = folder.Subdirectory(directory, true);
   ContainedDirectory staging = into.MakeStagingDirectory(kUploadStagingPrefix);
   try {
     const int fd = staging.OpenForAppend("upload");
     std::size_t received = 0;
-    std::string failure;
+    std::string failure, disk_failure;
     const bool whole = read([&](const char* data, std::size_t n) {
       received += n;
       if (received > max_bytes) {
@@ -73,7 +102,7 @@ std::string ReceiveUpload(const ContainedDirectory& folder, const std::string& d
         const ssize_t w = ::write(fd, data + done, n - done);
         if (w < 0 && errno == EINTR) continue;
         if (w <= 0) {
-          failure = std::string("cannot be written: ") + std::strerror(errno);
+          disk_failure = w < 0 ? std::strerror(errno) : "nothing written";
           return false;
         }
         done += static_cast<std::size_t>(w);
@@ -82,6 +111,9 @@ std::string ReceiveUpload(const ContainedDirectory& folder, const std::string& d
     });
     const bool synced = ::fsync(fd) == 0;
     ::close(fd);
+    if (!disk_failure.empty())
+      throw EnvironmentError(target + ": cannot be written to the experiment folder's disk (" + disk_failure +
+                             "): nothing was kept");
     if (!failure.empty()) throw InputError("upload", name + ": " + failure + "; nothing was kept");
     if (!whole || received != declared_bytes)
       throw InputError("upload", name + ": the upload was cut off (" + std::to_string(received) + " of " +

@@ -31,11 +31,21 @@ struct UploadKind {
 const UploadKind& VideoUpload();
 const UploadKind& ImageUpload();  // .png .jpg .jpeg .bmp .tif .tiff: what OpenCV calibrates from
 
-// Stores the body as `directory`/`name` (directory created) and returns that relative path.
 // Throws InputError("name") for a name that is not 1-100 letters, digits, '.', '-', '_' (not
-// starting with '.') or has none of the kind's extensions, InputError("upload") for a body beyond
-// `max_bytes` or cut off, whatever `check` throws when it refuses the staged file, and
-// InputError("name") when the name is taken; EnvironmentError for the disk.
+// starting with '.') or has none of the kind's extensions, showing the name as sent (a '/' or a
+// NUL it holds as %2F, %00).
+void CheckUploadName(const std::string& name, const UploadKind& kind);
+
+// folder.KindOf(relative), with a link or a file where a folder of the path should be refused
+// as InputError(field) naming the path (relative to the folder) and the rule.
+ContainedDirectory::Kind KindInFolder(const ContainedDirectory& folder, const std::string& relative,
+                                      const std::string& field);
+
+// Stores the body as `directory`/`name` (directory created) and returns that relative path.
+// Throws InputError("name") for a name CheckUploadName refuses, InputError("upload") for a body
+// beyond `max_bytes` or cut off, whatever `check` throws when it refuses the staged file,
+// InputError("name") when the name is taken or a folder of its path is a link; EnvironmentError
+// when the disk fails (full, or failing to write).
 std::string ReceiveUpload(const ContainedDirectory& folder, const std::string& directory, const std::string& name,
                           const UploadKind& kind, std::size_t declared_bytes, std::size_t max_bytes,
                           const BodyReader& read, const std::function<void(const std::string& staged_path)>& check);
