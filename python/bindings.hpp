@@ -44,6 +44,18 @@ class RowInputError : public InputError {
   std::size_t row_;
 };
 
+// f(), with an InputError it throws made element i's (RowInputError) — unless `whole`: the
+// argument is a scalar, and the error is about it as a whole.
+template <typename F>
+auto ForElement(std::size_t i, F&& f, bool whole = false) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    if (whole) throw;
+    throw RowInputError(e, i);
+  }
+}
+
 // An argument of the wrong Python type or NumPy dtype (never cast): uphill.InputTypeError.
 class ArgumentTypeError : public InputError {
  public:

@@ -30,11 +30,9 @@ constexpr std::size_t kBlock = 8192;  // 3 inputs + 3 outputs: 384 KB, within L2
 // Element i's outputs, each (name, value), finite (model/input_ranges.hpp's last guard), else
 // RowInputError naming the first that is not.
 void RequireFiniteElement(std::size_t i, std::initializer_list<std::pair<const char*, double>> outputs) {
-  try {
+  ForElement(i, [&] {
     for (const auto& [name, value] : outputs) RequireFiniteResult(name, value);
-  } catch (const InputError& e) {
-    throw RowInputError(e, i);
-  }
+  });
 }
 
 // The scalar model's verdict on element i (throws its InputError as RowInputError); used only

@@ -225,6 +225,12 @@ when given, else a robust scale (1.4826·MAD). loss_scale in units of sigma (0: 
         d.y = Column(y, "Y");
         d.u_y = Column(u_y, "u(Y)");
         d.u_model = Column(u_model, "u_model");
+        // Positions and their uncertainties in the lengths' ranges (model/input_ranges.hpp), as
+        // the experiment reader holds Y and u(Y) for `uphill fit`.
+        for (std::size_t i = 0; i < d.y.size(); ++i) ForElement(i, [&] { RequireModelLength("Y", d.y[i]); });
+        for (std::size_t i = 0; i < d.u_y.size(); ++i) ForElement(i, [&] { RequireLengthUncertainty("u(Y)", d.u_y[i]); });
+        for (std::size_t i = 0; i < d.u_model.size(); ++i)
+          ForElement(i, [&] { RequireLengthUncertainty("u_model", d.u_model[i]); });
         FrictionOptions o;
         o.fit_scale = fit_scale;
         o.fit = Options(outlier_threshold);

@@ -11,31 +11,13 @@ namespace {
 
 double Angle(const py::handle& v, const char* name) { return Quantity(v, Dimension::kAngle, name); }
 
-// A scene whose numbers are all finite (model/input_ranges.hpp's last guard): the ranges of the
-// lengths keep the known cases so, an extreme combination is refused.
+// A scene whose positions lie in the lengths' range (model/input_ranges.hpp), as the program's.
 Scene CheckedScene(const Body& body, const Rails& rails, double rod_radius) {
   Scene scene(body, rails, rod_radius);
-  const auto x_eq = scene.x_eq(), z_eq = scene.z_eq();
-  RequireFiniteResult("theta", rails.theta);
-  RequireFiniteResult("alpha", rails.alpha);
-  RequireFiniteResult("X", x_eq.value_or(0.0));
-  RequireFiniteResult("z at X", z_eq.value_or(0.0));
-  RequireFiniteResult("x_max", scene.x_max());
-  RequireFiniteResult("x_low", scene.x_low());
+  RequireSceneInRange(scene);
   return scene;
 }
 
-// Element i's InputError as the row's (the argument named, the element's index) when the
-// argument is an array.
-template <typename F>
-auto PerElement(const Float64Argument& argument, std::size_t i, F&& f) {
-  try {
-    return f();
-  } catch (const InputError& e) {
-    if (argument.is_scalar()) throw;
-    throw RowInputError(e, i);
-  }
-}
 
 // Scene.at over an array of x: one library call per element.
 py::dict PathAt(const Scene& scene, const py::handle& x_value) {
@@ -44,14 +26,14 @@ py::dict PathAt(const Scene& scene, const py::handle& x_value) {
   py::array_t<double> z = NewArray(shape), dzdx = NewArray(shape), r_star = NewArray(shape), x_contact = NewArray(shape);
   double *pz = MutableData(z), *pd = MutableData(dzdx), *pr = MutableData(r_star), *pc = MutableData(x_contact);
   for (std::size_t i = 0; i < x.size(); ++i) {
-    const PathPoint p = PerElement(x, i, [&] {
+    const PathPoint p = ForElement(i, [&] {
       const PathPoint point = scene.At(x[i]);
       RequireFiniteResult("z at x", point.z);
       RequireFiniteResult("dz/dx at x", point.dzdx);  // infinite where the path turns vertical
       RequireFiniteResult("R* at x", point.r_star);
       RequireFiniteResult("the contact at x", point.x_contact);
       return point;
-    });
+    }, x.is_scalar());
     pz[i] = p.z, pd[i] = p.dzdx, pr[i] = p.r_star, pc[i] = p.x_contact;
   }
   py::dict out;
@@ -67,12 +49,12 @@ py::object RestBandAt(const Scene& scene, const py::handle& mu_value) {
   py::array_t<double> low = NewArray(shape), high = NewArray(shape);
   double *pl = MutableData(low), *ph = MutableData(high);
   for (std::size_t i = 0; i < mu.size(); ++i) {
-    const std::optional<RestBand> band = PerElement(mu, i, [&] {
+    const std::optional<RestBand> band = ForElement(i, [&] {
       RequireRollingResistance("mu", mu[i]);
       std::optional<RestBand> rest = scene.Rest(mu[i]);
       if (rest) RequireFiniteResult("x_rest", rest->high), RequireFiniteResult("x_rest(-mu)", rest->low);
       return rest;
-    });
+    }, mu.is_scalar());
     if (!band) return py::none();  // the double cone: see rests_everywhere
     pl[i] = band->low, ph[i] = band->high;
   }

@@ -118,7 +118,11 @@ Rails Configuration::MakeRails() const {
   return Rails::FromAngles(theta.value, alpha.value);
 }
 
-Scene Configuration::MakeScene() const { return Scene(MakeBody(), MakeRails(), rod_radius.value); }
+Scene Configuration::MakeScene() const {
+  Scene scene(MakeBody(), MakeRails(), rod_radius.value);
+  RequireSceneInRange(scene);
+  return scene;
+}
 
 UncertainRails Configuration::MakeUncertainRails() const {
   if (from_apparatus) return UncertainRails::Apparatus(L, H, D, convention);

@@ -44,7 +44,7 @@ struct Configuration {
   bool HasUncertainty() const;
   Body MakeBody() const;    // throws InputError
   Rails MakeRails() const;  // throws InputError
-  Scene MakeScene() const;  // throws InputError
+  Scene MakeScene() const;  // throws InputError, also for positions beyond model/input_ranges.hpp
   // The inputs with their uncertainties, for Propagate (model/propagation.hpp).
   UncertainRails MakeUncertainRails() const;
   UncertainBody MakeUncertainBody() const;

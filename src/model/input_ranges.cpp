@@ -5,6 +5,7 @@
 
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
+#include "model/scene.hpp"
 
 namespace uphill {
 namespace {
@@ -62,6 +63,21 @@ void RequireRollingResistance(const std::string& quantity, double mu) {
 
 void RequireMonteCarloTrials(const std::string& quantity, double trials) {
   if (!(trials >= kFewestTrials && trials <= kMostTrials)) Refuse(quantity, "lie between 100 and 100000000", trials, "");
+}
+
+void RequireSceneInRange(const Scene& scene) {
+  RequireFiniteResult("theta", scene.rails().theta);
+  RequireFiniteResult("alpha", scene.rails().alpha);
+  RequireFiniteResult("x_low", scene.x_low());
+  const auto position = [](const char* name, double x) {
+    RequireFiniteResult(name, x);
+    if (std::abs(x) > kLongestModelLength)
+      throw InputError("the setting", std::string(name) + " = " + Shown(x) +
+                                          " m lies beyond 1000 km from O: an angle or a ratio of lengths is too extreme");
+  };
+  if (const auto x_eq = scene.x_eq()) position("X", *x_eq);
+  if (const auto z_eq = scene.z_eq()) RequireFiniteResult("z at X", *z_eq);
+  position(scene.cone() ? "x_fall" : "x_max", scene.x_max());
 }
 
 void RequireFiniteResult(const std::string& what, double value) {

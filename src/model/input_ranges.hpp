@@ -48,6 +48,14 @@ inline constexpr double kFewestTrials = 100, kMostTrials = 1e8;
 // `trials` as given (a double holds any integer a caller may pass, negative or huge).
 void RequireMonteCarloTrials(const std::string& quantity, double trials);
 
+class Scene;
+
+// A scene whose positions lie in the lengths' range: X and x_max (x_fall for the double cone)
+// finite and at most 1000 km from O, x_low finite, θ and α finite. Lengths in range can still
+// give a divergence angle of a few ulp, which puts X at 1e300 m, where the motion's integrator
+// never finishes. Throws InputError("the setting", …) naming the position.
+void RequireSceneInRange(const Scene& scene);
+
 // The last guard before a result leaves the library: the ranges above keep the known cases
 // finite, and a combination they miss (an extreme ratio of two lengths, a divergence angle of a
 // few ulp) is refused rather than shown as inf or NaN. Throws InputError("the setting", …)

@@ -25,6 +25,7 @@ EXTREMES = [0.0, -0.0, 5e-324, -5e-324, 2.2250738585072014e-308, -1e-310, 1e-300
 class Draw:
     def __init__(self, seed):
         self.rng = random.Random(seed)
+        self.last = ""  # the call being made, for a failure's message
 
     def chance(self, p):
         return self.rng.random() < p
@@ -39,7 +40,9 @@ class Draw:
     def real(self, lo, hi, p_extreme=0.2):
         """value() as a float, for arithmetic in the test itself (an int too large is ±inf)."""
         v = self.value(lo, hi, p_extreme)
-        return math.copysign(math.inf, v) if isinstance(v, int) and abs(v) >= 2**1024 else float(v)
+        if isinstance(v, int) and abs(v) >= 2**1024:
+            return math.inf if v > 0 else -math.inf
+        return float(v)
 
     def array(self, lo, hi, n):
         """A float64 array of n plausible values, sometimes with an extreme element."""
@@ -74,7 +77,7 @@ class Draw:
 def path_x(d, scene):
     """A position on the path mostly, or anywhere."""
     lo, hi = scene.x_low, scene.x_max
-    return d.value(lo + 1e-3 * (hi - lo), hi - 1e-3 * (hi - lo), 0.15)
+    return d.real(lo + 1e-3 * (hi - lo), hi - 1e-3 * (hi - lo), 0.15)
 
 
 # ---- the calls: each returns (a description, the result) --------------------------------------
@@ -92,7 +95,7 @@ def call_scene_path(d):
     mu = d.value(0, 0.2)
     out = [scene.at(xs)]
     out.append(scene.rest(mu) if scene.x_eq is not None else scene.rests_everywhere(mu))
-    out.append(scene.kinetic_factor(path_x(d, scene)))
+    out.append(scene.kinetic_factor(d.value(scene.x_low, scene.x_max)))
     return "Scene.at/rest/kinetic_factor", out
 
 
@@ -144,6 +147,7 @@ def call_motion(d):
     options = dict(v0=d.value(-1, 1, 0.2) if method == "ode" else 0.0, g=d.value(1, 20),
                    mu=d.value(0, 0.1) if method == "ode" else 0.0, method=method)
     x0 = path_x(d, scene)
+    d.last = f"Motion({scene_text(scene)}, x0={x0!r}, {options})"
     motion = uphill.Motion(scene, x0, **options)
     end = motion.end_time
     assert end == math.inf or math.isfinite(end), f"end_time {end}"
@@ -181,7 +185,9 @@ def call_fit_friction(d):
             continue
         scenes.append(scene)
         y.append(scene.x_eq + (scene.x_max - scene.x_eq) * d.real(0.01, 0.9, 0.1))
-    fit = uphill.fit_friction(scenes, np.array(y, dtype=float), np.full(len(y), d.value(1e-4, 1e-3)))
+    u_y = d.value(1e-4, 1e-3)
+    d.last = f"fit_friction([{', '.join(scene_text(s) for s in scenes)}], y={y!r}, u_y={u_y!r})"
+    fit = uphill.fit_friction(scenes, np.array(y, dtype=float), np.full(len(y), u_y))
     return "fit_friction", fit_numbers(fit)
 
 
@@ -195,6 +201,12 @@ def call_units(d):
 
 CALLS = [call_body_rails_scene, call_scene_path, call_convert, call_convert_apparatus, call_propagate, call_motion,
          call_release_times, call_fits, call_fit_friction, call_units]
+
+
+def scene_text(scene):
+    """A scene as the arguments that rebuild it, for a failure's message."""
+    return (f"Scene(Body({scene.body.kind!r}, {scene.body.across!r}, {scene.body.along!r}), "
+            f"Rails.from_angles({scene.rails.theta!r}, {scene.rails.alpha!r}), rod_radius={scene.rod_radius!r})")
 
 
 def fit_numbers(fit):
@@ -234,13 +246,14 @@ def test_every_call_returns_finite_numbers_or_raises_input_error():
     with np.errstate(all="ignore"):
         for i in range(draws):
             call = d.rng.choice(CALLS)
+            d.last = ""
             try:
                 what, result = call(d)
             except uphill.InputError:
                 refused += 1
                 continue
             except Exception as e:  # noqa: BLE001 - the property: nothing else may escape
-                failures.append(f"draw {i} ({call.__name__}): {type(e).__name__}: {e}")
+                failures.append(f"draw {i} ({call.__name__}): {type(e).__name__}: {e} {d.last}")
                 continue
             bad = non_finite(result)
             if bad:
