@@ -154,3 +154,21 @@ def test_the_command_line_refuses_the_same_values(flags, name):
 def test_huge_ints_and_overflowing_values_are_input_errors(call):
     with pytest.raises(uphill.InputError):
         call()
+
+
+# Guards: a divergence of 1e-300 rad put x_max at 1e297 m, where Motion's ODE never finished (an
+# internal RuntimeError); found by test_property.py.
+def test_a_scene_whose_positions_lie_beyond_1000_km_is_refused():
+    with pytest.raises(uphill.InputError) as e:
+        uphill.Scene(uphill.Body.spheroid(0.018, 0.015), uphill.Rails.from_angles(0.355, 1e-300))
+    assert e.value.quantity == "the setting" and "1000 km" in e.value.rule, str(e.value)
+
+
+# Guards: fit_friction with u(Y) = 5e-324 or Y = 1e306 raised Ceres' internal RuntimeError; found
+# by test_property.py. Y and u(Y) are held to the lengths' ranges, as `uphill fit` holds them.
+@pytest.mark.parametrize("y, u_y, name", [(0.2664, 5e-324, "u(Y)"), (1.165e306, 6e-4, "Y")])
+def test_fit_friction_refuses_positions_and_uncertainties_outside_the_ranges(y, u_y, name):
+    scene = uphill.Scene(uphill.Body.spheroid(0.0198, 0.0197), uphill.Rails.from_angles(0.2045, 0.1429))
+    with pytest.raises(uphill.InputError) as e:
+        uphill.fit_friction([scene], np.array([y]), np.array([u_y]))
+    assert (e.value.quantity, e.value.row) == (name, 0), str(e.value)
