@@ -26,6 +26,7 @@ constexpr FieldSpec kUncertainFields[] = {
 // an angle (model/input_ranges.hpp).
 void RequireFieldRange(const std::string& name, double si, bool length, bool uncertainty) {
   if (uncertainty) {
+    if (si < 0.0) throw InputError(name, "must be >= 0");  // the sign is the rule a negative one breaks
     if (length) RequireLengthUncertainty(name, si);
     else RequireAngleUncertainty(name, si);
   } else if (length) {
