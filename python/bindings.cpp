@@ -48,6 +48,29 @@ py::object& InputTypeErrorType() {
   return type;
 }
 
+// A Python value for a message: its str, cut short (an int may have thousands of digits).
+std::string Shown(const py::handle& value) {
+  std::string text = py::str(value);
+  return text.size() > 24 ? text.substr(0, 20) + "..." : text;
+}
+
+// A Python int or float as a double: InputError for an int too large for one (Python raises
+// OverflowError) and for NaN and the infinities.
+double ToDouble(const py::handle& value, const std::string& name) {
+  const double v = PyFloat_AsDouble(value.ptr());
+  if (v == -1.0 && PyErr_Occurred()) {
+    PyErr_Clear();
+    throw InputError(name, "must be a finite number (got " + Shown(value) + ", too large for a double)");
+  }
+  return v;
+}
+
+double Finite(const py::handle& value, const std::string& name) {
+  const double v = ToDouble(value, name);
+  if (!std::isfinite(v)) throw InputError(name, "must be a finite number (got " + Shown(value) + ")");
+  return v;
+}
+
 void Raise(const py::object& type, const InputError& e, const py::object& row) {
   py::object error = type(e.quantity(), e.rule(), row);
   PyErr_SetObject(type.ptr(), error.ptr());
@@ -80,7 +103,7 @@ Float64Argument::Float64Argument(const py::handle& value, std::string name) : na
   if (py::isinstance<py::bool_>(value))
     throw ArgumentTypeError(name_, "expected a number or a float64 array, got a bool");
   if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) {
-    scalar_ = value.cast<double>();
+    scalar_ = ToDouble(value, name_);
     return;
   }
   py::array array;
@@ -153,9 +176,37 @@ double Quantity(const py::handle& value, Dimension dimension, const std::string&
   if (py::isinstance<py::str>(value)) return ParseQuantity(value.cast<std::string>(), dimension, name);
   if (py::isinstance<py::bool_>(value) || !(py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)))
     throw ArgumentTypeError(name, "expected a number in SI units or a text with its unit (e.g. \"45 mm\")");
-  const double v = value.cast<double>();
-  if (!std::isfinite(v)) throw InputError(name, "must be a finite number (got " + std::string(py::str(value)) + ")");
+  return Finite(value, name);
+}
+
+double Length(const py::handle& value, const std::string& name) {
+  const double v = Quantity(value, Dimension::kLength, name);
+  RequireModelLength(name, v);
   return v;
+}
+
+double Number(const py::handle& value, const std::string& name) {
+  if (py::isinstance<py::bool_>(value) || !(py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)))
+    throw ArgumentTypeError(name, "expected a number, got " + std::string(py::str(py::type::of(value).attr("__name__"))));
+  return Finite(value, name);
+}
+
+std::uint64_t Count(const py::handle& value, const std::string& name) {
+  if (py::isinstance<py::bool_>(value) || !py::isinstance<py::int_>(value))
+    throw ArgumentTypeError(name, "expected a whole number (int), got " +
+                                      std::string(py::str(py::type::of(value).attr("__name__"))));
+  const unsigned long long n = PyLong_AsUnsignedLongLong(value.ptr());
+  if (n == static_cast<unsigned long long>(-1) && PyErr_Occurred()) {
+    PyErr_Clear();
+    throw InputError(name, "must be a whole number >= 0 and < 2^64 (got " + Shown(value) + ")");
+  }
+  return n;
+}
+
+std::uint64_t Trials(const py::handle& value, const std::string& name) {
+  const std::uint64_t n = Count(value, name);
+  if (n != 0) RequireMonteCarloTrials(name, static_cast<double>(n));
+  return n;
 }
 
 std::optional<double> OptionalQuantity(const py::object& value, Dimension dimension, const std::string& name) {

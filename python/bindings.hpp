@@ -20,6 +20,7 @@
 #include <pybind11/pybind11.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -27,6 +28,7 @@
 
 #include "io/units.hpp"
 #include "model/input_error.hpp"
+#include "model/input_ranges.hpp"
 
 namespace uphill::python {
 
@@ -41,6 +43,18 @@ class RowInputError : public InputError {
  private:
   std::size_t row_;
 };
+
+// f(), with an InputError it throws made element i's (RowInputError) — unless `whole`: the
+// argument is a scalar, and the error is about it as a whole.
+template <typename F>
+auto ForElement(std::size_t i, F&& f, bool whole = false) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    if (whole) throw;
+    throw RowInputError(e, i);
+  }
+}
 
 // An argument of the wrong Python type or NumPy dtype (never cast): uphill.InputTypeError.
 class ArgumentTypeError : public InputError {
@@ -86,9 +100,18 @@ py::array_t<double> OutputArray(const py::object& out, const std::string& name, 
 double* MutableData(py::array_t<double>& array);
 
 // A quantity given as a number (SI) or as text with its unit, as on the command line ("45 mm",
-// "10 deg"): uphill's own unit parser (io/units.hpp) reads the text.
+// "10 deg"): uphill's own unit parser (io/units.hpp) reads the text. Finite, else InputError.
 double Quantity(const py::handle& value, Dimension dimension, const std::string& name);
 std::optional<double> OptionalQuantity(const py::object& value, Dimension dimension, const std::string& name);
+// A length (a number in m, or text with its unit) in the model's range (model/input_ranges.hpp).
+double Length(const py::handle& value, const std::string& name);
+// A plain real number (a Python int or float): ArgumentTypeError for another type, InputError for
+// NaN, the infinities, or an int too large for a double.
+double Number(const py::handle& value, const std::string& name);
+// A whole number in [0, 2^64) (a seed): ArgumentTypeError for another type, InputError outside.
+std::uint64_t Count(const py::handle& value, const std::string& name);
+// Monte Carlo trials: 0 (none) or within model/input_ranges.hpp's range.
+std::uint64_t Trials(const py::handle& value, const std::string& name);
 
 // nlohmann JSON (the CLI's own JSON of a result) to Python dicts, lists and numbers.
 py::object ToPython(const nlohmann::ordered_json& value);

@@ -14,6 +14,7 @@
 #include <cfloat>
 #include <cmath>
 #include <functional>
+#include <initializer_list>
 #include <map>
 
 #include "bindings.hpp"
@@ -25,6 +26,14 @@ namespace uphill::python {
 namespace {
 
 constexpr std::size_t kBlock = 8192;  // 3 inputs + 3 outputs: 384 KB, within L2
+
+// Element i's outputs, each (name, value), finite (model/input_ranges.hpp's last guard), else
+// RowInputError naming the first that is not.
+void RequireFiniteElement(std::size_t i, std::initializer_list<std::pair<const char*, double>> outputs) {
+  ForElement(i, [&] {
+    for (const auto& [name, value] : outputs) RequireFiniteResult(name, value);
+  });
+}
 
 // The scalar model's verdict on element i (throws its InputError as RowInputError); used only
 // for an element the bulk check has found outside the domain.
@@ -49,29 +58,30 @@ std::size_t FirstInvalid(std::size_t m, Ok ok) {
   return m;
 }
 
-inline bool PositiveFinite(double v) { return (v > 0.0) & (v <= DBL_MAX); }
-inline bool NonNegativeFinite(double v) { return (v >= 0.0) & (v <= DBL_MAX); }
+// The lengths' ranges of model/input_ranges.hpp, branch-free: a length in [1 nm, 1000 km] (false
+// for NaN and the infinities), and H, which may also be 0. The scalar checks name the element.
+inline bool InLengthRange(double v) { return (v >= kShortestModelLength) & (v <= kLongestModelLength); }
+inline bool HeightInRange(double v) { return (v == 0.0) | InLengthRange(v); }
+inline bool ApparatusInRange(double l, double h, double d) { return InLengthRange(l) & HeightInRange(h) & InLengthRange(d); }
 
-// Whether a block of crossbar measurements lies in the domain (L, D > 0, H >= 0, all finite), in
-// AVX2 where the CPU has it: three minima and one NaN/inf detector (l + h + d)·0, 7 vector
-// operations per 4 elements, a few percent of the kernel's work. It can say false for valid
-// values near the largest double (l + h + d overflowing): callers then look element by element.
+__attribute__((target("avx2,fma"))) inline __m256d InLengthRangeAvx2(__m256d v) {
+  return _mm256_and_pd(_mm256_cmp_pd(v, _mm256_set1_pd(kShortestModelLength), _CMP_GE_OQ),
+                       _mm256_cmp_pd(v, _mm256_set1_pd(kLongestModelLength), _CMP_LE_OQ));
+}
+
+// Whether a block of crossbar measurements lies in the ranges, in AVX2 where the CPU has it: the
+// ordered comparisons are false for NaN, so a mask of all four lanes means every element is in.
 __attribute__((target("avx2,fma"))) bool ApparatusBlockValidAvx2(std::size_t m, const double* L, const double* H,
                                                                    const double* D) {
-  const __m256d zero = _mm256_setzero_pd();
-  __m256d lo_ld = _mm256_set1_pd(1.0), lo_h = lo_ld, poison = zero;
+  __m256d ok = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
   std::size_t j = 0;
   for (; j + 4 <= m; j += 4) {
     const __m256d l = _mm256_loadu_pd(L + j), h = _mm256_loadu_pd(H + j), d = _mm256_loadu_pd(D + j);
-    lo_ld = _mm256_min_pd(lo_ld, _mm256_min_pd(l, d));
-    lo_h = _mm256_min_pd(lo_h, h);
-    poison = _mm256_or_pd(poison, _mm256_mul_pd(_mm256_add_pd(_mm256_add_pd(l, h), d), zero));  // NaN if any is
+    const __m256d h_ok = _mm256_or_pd(_mm256_cmp_pd(h, _mm256_setzero_pd(), _CMP_EQ_OQ), InLengthRangeAvx2(h));
+    ok = _mm256_and_pd(ok, _mm256_and_pd(_mm256_and_pd(InLengthRangeAvx2(l), InLengthRangeAvx2(d)), h_ok));
   }
-  const __m256d ok = _mm256_and_pd(
-      _mm256_and_pd(_mm256_cmp_pd(lo_ld, zero, _CMP_GT_OQ), _mm256_cmp_pd(lo_h, zero, _CMP_GE_OQ)),
-      _mm256_cmp_pd(poison, zero, _CMP_EQ_OQ));
   bool all = _mm256_movemask_pd(ok) == 0xF;
-  for (; j < m; ++j) all &= PositiveFinite(L[j]) & NonNegativeFinite(H[j]) & PositiveFinite(D[j]);
+  for (; j < m; ++j) all &= ApparatusInRange(L[j], H[j], D[j]);
   return all;
 }
 
@@ -79,8 +89,18 @@ bool ApparatusBlockValid(std::size_t m, const double* L, const double* H, const 
   static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   if (avx2) return ApparatusBlockValidAvx2(m, L, H, D);
   bool all = true;
-  for (std::size_t j = 0; j < m; ++j) all &= PositiveFinite(L[j]) & NonNegativeFinite(H[j]) & PositiveFinite(D[j]);
+  for (std::size_t j = 0; j < m; ++j) all &= ApparatusInRange(L[j], H[j], D[j]);
   return all;
+}
+
+// The first element of [0, m) whose output is not finite (model/input_ranges.hpp's last guard),
+// or m; several outputs are checked at once.
+std::size_t FirstNonFinite(std::size_t m, std::initializer_list<const double*> outputs) {
+  return FirstInvalid(m, [&](std::size_t j) {
+    bool ok = true;
+    for (const double* out : outputs) ok &= std::abs(out[j]) <= DBL_MAX;
+    return ok;
+  });
 }
 
 // A block of an argument: a pointer into its array, or a block filled with its scalar.
@@ -115,7 +135,10 @@ Rails ElementRails(const ConvertArguments& a, std::size_t i) {
                        : Rails::FromAngles((*a.theta)[i], (*a.alpha)[i]);
 }
 
+// Element i's lengths in their ranges (model/input_ranges.hpp), then the model's own rules.
 void ElementScene(const ConvertArguments& a, std::size_t i) {
+  for (const std::optional<Float64Argument>* length : {&a.L, &a.H, &a.D, &a.across, &a.along, &a.rod_radius})
+    if (length->has_value()) RequireModelLength((*length)->name(), (**length)[i]);
   Scene(ElementBody(a, i), ElementRails(a, i), a.rod_radius ? (*a.rod_radius)[i] : 0.0);
 }
 
@@ -140,13 +163,14 @@ py::dict Convert(const ConvertArguments& a, const std::vector<py::ssize_t>& shap
       const double *x0 = in[0].At(start, m), *x1 = in[1].At(start, m), *x2 = in[2].At(start, m);
       const double *across = in[3].At(start, m), *along = in[4].At(start, m);
       const double* rods = a.rod_radius ? in[5].At(start, m) : nullptr;
-      // The domain (model/batch_convert.hpp's contract): lengths finite and > 0, H finite and
-      // >= 0, along a rail L > hypot(H, D/2); 0 <= theta < pi/2, 0 < alpha < pi; rods > 0.
+      // The domain (model/batch_convert.hpp's contract) within the lengths' ranges
+      // (model/input_ranges.hpp): lengths in [1 nm, 1000 km], H also 0, along a rail
+      // L > hypot(H, D/2); 0 <= theta < pi/2, 0 < alpha < pi; rods > 0.
       const std::size_t bad = FirstInvalid(m, [&](std::size_t j) {
-        bool ok = PositiveFinite(across[j]) & PositiveFinite(along[j]);
-        if (rods) ok &= PositiveFinite(rods[j]);
+        bool ok = InLengthRange(across[j]) & InLengthRange(along[j]);
+        if (rods) ok &= InLengthRange(rods[j]);
         if (a.apparatus()) {
-          ok &= PositiveFinite(x0[j]) & NonNegativeFinite(x1[j]) & PositiveFinite(x2[j]);
+          ok &= ApparatusInRange(x0[j], x1[j], x2[j]);
           if (a.convention == LConvention::kAlongRail) ok &= x0[j] > std::hypot(x1[j], x2[j] / 2);
         } else {
           ok &= (x0[j] >= 0.0) & (x0[j] < M_PI / 2) & (x1[j] > 0.0) & (x1[j] < M_PI);
@@ -177,6 +201,14 @@ py::dict Convert(const ConvertArguments& a, const std::vector<py::ssize_t>& shap
         SpheroidBatch(m, across, along, rods, tan_theta.data(), tan_half_alpha.data(), p_first + start,
                       p_second + start);
       }
+      const std::size_t overflow = FirstNonFinite(m, {p_theta + start, p_alpha + start, p_phi + start, p_first + start,
+                                                      p_second + start});
+      if (overflow < m) {
+        py::gil_scoped_acquire acquire;
+        const std::size_t i = start + overflow;
+        RequireFiniteElement(i, {{"theta", p_theta[i]}, {"alpha", p_alpha[i]}, {"phi", p_phi[i]},
+                                 {cone ? "x_fall" : "X", p_first[i]}, {cone ? "theta0" : "x_max", p_second[i]}});
+      }
     }
   }
   py::dict out;
@@ -193,9 +225,14 @@ py::dict Convert(const ConvertArguments& a, const std::vector<py::ssize_t>& shap
 void AddUncertainties(const ConvertArguments& a, const std::map<std::string, std::optional<Float64Argument>>& u,
                       std::uint64_t mc_trials, std::uint64_t seed, const std::vector<py::ssize_t>& shape,
                       std::size_t n, py::dict& out) {
+  // An uncertainty of element i in its range (model/input_ranges.hpp), named as given.
   auto get = [&](const std::string& name, std::size_t i) {
     const auto& arg = u.at(name);
-    return arg ? (*arg)[i] : 0.0;
+    if (!arg) return 0.0;
+    const double v = (*arg)[i];
+    if (name == "u_theta" || name == "u_alpha") RequireAngleUncertainty(arg->name(), v);
+    else RequireLengthUncertainty(arg->name(), v);
+    return v;
   };
   std::map<std::string, py::array_t<double>> first_order, monte_carlo;
   PropagationOptions options;
@@ -220,6 +257,8 @@ void AddUncertainties(const ConvertArguments& a, const std::map<std::string, std
     } catch (const InputError& e) {
       throw RowInputError(e, i);
     }
+    for (const PropagatedValue* v : r.Outputs())
+      RequireFiniteElement(i, {{v->name, v->u_first_order}, {v->name, mc_trials > 0 ? v->u_monte_carlo : 0.0}});
     for (const PropagatedValue* v : r.Outputs()) {
       const std::string name = v->name;
       if (!first_order.count(name)) {
@@ -242,7 +281,8 @@ void BindConvert(py::module_& m) {
       [](const std::string& body, const py::object& L, const py::object& H, const py::object& D,
          const py::object& theta, const py::object& alpha, const py::object& R, const py::object& a,
          const py::object& b, const py::object& h, const py::object& rod_radius, bool along_rail,
-         std::uint64_t mc_trials, std::uint64_t seed, const py::kwargs& uncertainties) {
+         const py::object& mc_trials_value, const py::object& seed_value, const py::kwargs& uncertainties) {
+        const std::uint64_t mc_trials = Trials(mc_trials_value, "mc_trials"), seed = Count(seed_value, "seed");
         ConvertArguments args;
         args.body = ParseBodyKind(body);
         args.convention = along_rail ? LConvention::kAlongRail : LConvention::kHorizontal;
@@ -312,8 +352,9 @@ u_rod_radius (standard uncertainties, same units, scalars or arrays) add u_<outp
 exact derivatives) and, with mc_trials > 0, u_mc_<output> (Monte Carlo, seeded) per element
 (model/propagation.hpp; one call per element, microseconds each at first order).
 Accuracy: the batch kernel's, within a few ulp of the scalar model (Scene); see uphill.Scene.
-Errors: InputError naming the argument and the element (row) outside the model's domain, with the
-scalar model's own message; mismatched shapes; TypeError for a dtype other than float64.)");
+Errors: InputError naming the argument and the element (row) outside the model's domain (lengths
+and uncertainties in the ranges of model/input_ranges.hpp; mc_trials 0 or in [100, 10^8]), with
+the scalar model's own message; mismatched shapes; InputTypeError for a dtype other than float64.)");
 
   m.def(
       "convert_apparatus",
@@ -321,8 +362,8 @@ scalar model's own message; mismatched shapes; TypeError for a dtype other than 
          const py::object& b_value, const py::object& theta_out, const py::object& alpha_out,
          const py::object& x_eq_out) {
         const Float64Argument L(L_value, "L"), H(H_value, "H"), D(D_value, "D");
-        const double a = Quantity(a_value, Dimension::kLength, "a"), b = Quantity(b_value, Dimension::kLength, "b");
-        Body::Spheroid(a, b);  // the body's own checks (finite, > 0)
+        const double a = Length(a_value, "a"), b = Length(b_value, "b");
+        Body::Spheroid(a, b);  // the body's own checks (> 0)
         const auto shape = CommonShape({&L, &H, &D});
         const std::size_t n = ElementCount(shape);
         py::array_t<double> theta = OutputArray(theta_out, "theta", shape), alpha = OutputArray(alpha_out, "alpha", shape),
@@ -338,13 +379,21 @@ scalar model's own message; mismatched shapes; TypeError for a dtype other than 
             // The kernel first (it never traps, whatever the input), then the check of the block
             // it has just brought into the cache; outside the domain the call raises.
             ConvertApparatusBatch(m, l, h, d, a, b, p_theta + start, p_alpha + start, p_x_eq + start);
-            if (ApparatusBlockValid(m, l, h, d)) continue;
-            const std::size_t bad = FirstInvalid(
-                m, [&](std::size_t j) { return PositiveFinite(l[j]) & NonNegativeFinite(h[j]) & PositiveFinite(d[j]); });
-            if (bad < m) {
+            if (!ApparatusBlockValid(m, l, h, d)) {
+              const std::size_t bad = FirstInvalid(m, [&](std::size_t j) { return ApparatusInRange(l[j], h[j], d[j]); });
+              if (bad < m) {
+                py::gil_scoped_acquire acquire;
+                const std::size_t i = start + bad;
+                ExplainElement(i, [&] {
+                  for (const Float64Argument* length : {&L, &H, &D}) RequireModelLength(length->name(), (*length)[i]);
+                  Rails::FromApparatus(L[i], H[i], D[i], LConvention::kHorizontal);
+                });
+              }
+            }
+            const std::size_t overflow = FirstNonFinite(m, {p_x_eq + start});
+            if (overflow < m) {
               py::gil_scoped_acquire acquire;
-              const std::size_t i = start + bad;
-              ExplainElement(i, [&] { Rails::FromApparatus(L[i], H[i], D[i], LConvention::kHorizontal); });
+              RequireFiniteElement(start + overflow, {{"X", p_x_eq[start + overflow]}});
             }
           }
         }
@@ -359,8 +408,8 @@ line rails. theta, alpha in rad, x_eq (X) in m.
 The kernel `uphill bench convert` times (ConvertApparatusBatch): libmvec's AVX2 atan where the CPU
 has it, within a few ulp of the scalar model. Pass theta=, alpha=, x_eq= (float64, C-contiguous,
 the inputs' shape) to write into your own arrays and allocate nothing.
-Errors: InputError naming the argument and the element outside the domain (L, D > 0, H >= 0, all
-finite), with the model's own message.)");
+Errors: InputError naming the argument and the element outside the domain (L, D and H in
+[1 nm, 1000 km], H also 0: model/input_ranges.hpp), with the model's own message.)");
 }
 
 }  // namespace uphill::python

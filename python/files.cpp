@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -14,6 +15,7 @@
 #include "io/configuration.hpp"
 #include "io/experiment.hpp"
 #include "io/xy_table.hpp"
+#include "model/number_text.hpp"
 #include "report/analysis.hpp"
 #include "report/fit_json.hpp"
 
@@ -47,7 +49,7 @@ FieldSource KeywordSource(const py::kwargs& fields) {
       continue;
     } else if (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)) {
       char text[32];
-      std::snprintf(text, sizeof text, "%.17g", value.cast<double>());
+      std::snprintf(text, sizeof text, "%.17g", Number(value, name));
       field.text = text;
       const std::string base = name.rfind("u_", 0) == 0 ? name.substr(2) : name;
       field.default_unit = base == "theta" || base == "alpha" ? "rad" : "m";
@@ -112,15 +114,18 @@ py::array_t<double> RowArray(const ExperimentAnalysis& a, F&& value) {
   return out;
 }
 
-// The options `uphill convert` takes besides the setting: mu, --at-x, --mc-trials, --seed.
-ConversionOptions ConversionOptionsOf(const py::object& mu, const py::object& at_x, std::uint64_t mc_trials,
-                                      std::uint64_t seed) {
+// The options `uphill convert` takes besides the setting: mu, --at-x, --mc-trials, --seed, in the
+// command's ranges (model/input_ranges.hpp).
+ConversionOptions ConversionOptionsOf(const py::object& mu, const py::object& at_x, const py::object& mc_trials,
+                                      const py::object& seed) {
   ConversionOptions options;
   options.mu = OptionalQuantity(mu, Dimension::kDimensionless, "mu");
+  if (options.mu) RequireRollingResistance("mu", *options.mu);
   if (!at_x.is_none())
     for (const auto& x : at_x) options.at_x.push_back(Quantity(x, Dimension::kLength, "at_x"));
-  options.propagation.trials = mc_trials;
-  options.propagation.seed = seed;
+  options.propagation.trials = Count(mc_trials, "mc_trials");
+  RequireMonteCarloTrials("mc_trials", static_cast<double>(options.propagation.trials));
+  options.propagation.seed = Count(seed, "seed");
   return options;
 }
 
@@ -139,10 +144,13 @@ velocity, acceleration or dimensionless. A number without a unit is refused (Inp
 command line: a guessed unit is a silent 25.4x error.)");
   m.def(
       "to_unit",
-      [](double value, const std::string& dimension, const std::string& unit) {
+      [](const py::object& value, const std::string& dimension, const std::string& unit) {
         const Dimension d = ParseDimension(dimension);
         if (UnitFactor(d, unit) == 0.0) throw InputError("unit", "must be one of " + AcceptedUnits(d));
-        return ToUnit(value, d, unit);
+        const double converted = ToUnit(Number(value, "value"), d, unit);
+        if (!std::isfinite(converted))  // 1e308 m in um
+          throw InputError("value", "is too large to express in " + unit + " (got " + ExactText(Number(value, "value")) + ")");
+        return converted;
       },
       py::arg("value"), py::arg("dimension"), py::arg("unit"),
       "A value in SI expressed in `unit` of `dimension` (e.g. to_unit(0.0254, \"length\", \"in\") == 1).");
@@ -153,7 +161,7 @@ command line: a guessed unit is a silent 25.4x error.)");
 void BindFiles(py::module_& m) {
   m.def(
       "convert_setting",
-      [](const py::object& mu, const py::object& at_x, std::uint64_t mc_trials, std::uint64_t seed,
+      [](const py::object& mu, const py::object& at_x, const py::object& mc_trials, const py::object& seed,
          const std::string& length_unit, const py::kwargs& fields) {
         ConversionOptions options = ConversionOptionsOf(mu, at_x, mc_trials, seed);
         options.length_unit = length_unit;
@@ -179,8 +187,8 @@ default) as for the command.)");
 
   m.def(
       "convert_batch_file",
-      [](const std::string& path, const py::object& mu, const py::object& at_x, std::uint64_t mc_trials,
-         std::uint64_t seed, const py::kwargs& defaults) {
+      [](const std::string& path, const py::object& mu, const py::object& at_x, const py::object& mc_trials,
+         const py::object& seed, const py::kwargs& defaults) {
         const ConversionOptions options = ConversionOptionsOf(mu, at_x, mc_trials, seed);
         const FieldSource source = KeywordSource(defaults);
         std::vector<nlohmann::ordered_json> rows;
@@ -319,7 +327,8 @@ and u_x_eq_mc (Monte Carlo), x_max, y and u_y (m). fits: dict method -> FitRepor
 
   m.def(
       "analyse_experiment",
-      [](const py::object& experiment, std::uint64_t mc_trials, std::uint64_t seed, double outlier_threshold) {
+      [](const py::object& experiment, const py::object& mc_trials, const py::object& seed,
+         const py::object& outlier_threshold) {
         std::shared_ptr<LoadedExperiment> loaded;
         if (py::isinstance<LoadedExperiment>(experiment)) {
           loaded = experiment.cast<std::shared_ptr<LoadedExperiment>>();
@@ -328,9 +337,10 @@ and u_x_eq_mc (Monte Carlo), x_max, y and u_y (m). fits: dict method -> FitRepor
           loaded->experiment = LoadExperiment(py::str(experiment).cast<std::string>());
         }
         AnalysisOptions options;
-        options.mc_trials = mc_trials;
-        options.seed = seed;
-        options.outlier_threshold = outlier_threshold;
+        options.mc_trials = Count(mc_trials, "mc_trials");
+        RequireMonteCarloTrials("mc_trials", static_cast<double>(options.mc_trials));
+        options.seed = Count(seed, "seed");
+        options.outlier_threshold = Number(outlier_threshold, "outlier_threshold");
         auto result = std::make_unique<Analysis>();
         result->loaded = loaded;
         {

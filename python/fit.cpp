@@ -41,9 +41,10 @@ LineData MakeLineData(const py::object& x, const py::object& y, const py::object
   return d;
 }
 
-FitOptions Options(double outlier_threshold) {
+// Reads a Python object: called with the GIL, before Run releases it.
+FitOptions Options(const py::object& outlier_threshold) {
   FitOptions o;
-  o.outlier_threshold = outlier_threshold;
+  o.outlier_threshold = Number(outlier_threshold, "outlier_threshold");
   return o;
 }
 
@@ -161,9 +162,10 @@ void BindFit(py::module_& m) {
   m.def(
       "fit_ols",
       [](const py::object& x, const py::object& y, const py::object& u_x, const py::object& u_y,
-         double outlier_threshold) {
+         const py::object& outlier_threshold) {
         const LineData d = MakeLineData(x, y, u_x, u_y);
-        return Run([&] { return FitOrdinaryLeastSquares(d, Options(outlier_threshold)); });
+        const FitOptions options = Options(outlier_threshold);
+        return Run([&] { return FitOrdinaryLeastSquares(d, options); });
       },
       py::arg("x"), py::arg("y"), py::arg("u_x") = py::none(), py::arg("u_y") = py::none(), py::kw_only(),
       py::arg("outlier_threshold") = 3.0,
@@ -174,9 +176,10 @@ note says so). Standard errors: the usual, scaled by sqrt(chi2/dof). Accuracy: N
   m.def(
       "fit_wls",
       [](const py::object& x, const py::object& y, const py::object& u_y, const py::object& u_x,
-         double outlier_threshold) {
+         const py::object& outlier_threshold) {
         const LineData d = MakeLineData(x, y, u_x, u_y);
-        return Run([&] { return FitWeightedLeastSquares(d, Options(outlier_threshold)); });
+        const FitOptions options = Options(outlier_threshold);
+        return Run([&] { return FitWeightedLeastSquares(d, options); });
       },
       py::arg("x"), py::arg("y"), py::arg("u_y"), py::kw_only(), py::arg("u_x") = py::none(),
       py::arg("outlier_threshold") = 3.0,
@@ -185,9 +188,10 @@ unscaled (the stated uncertainties propagated), scaled also given. u_x, if given
 note says so). Returns a FitReport.)");
   m.def(
       "fit_york",
-      [](const py::object& x, const py::object& y, const py::object& u_x, const py::object& u_y, double outlier_threshold) {
+      [](const py::object& x, const py::object& y, const py::object& u_x, const py::object& u_y, const py::object& outlier_threshold) {
         const LineData d = MakeLineData(x, y, u_x, u_y);
-        return Run([&] { return FitErrorsInVariables(d, Options(outlier_threshold)); });
+        const FitOptions options = Options(outlier_threshold);
+        return Run([&] { return FitErrorsInVariables(d, options); });
       },
       py::arg("x"), py::arg("y"), py::arg("u_x"), py::arg("u_y"), py::kw_only(), py::arg("outlier_threshold") = 3.0,
       R"(Errors in both variables: the maximum-likelihood line of York et al. (2004)
@@ -196,13 +200,13 @@ Standard errors unscaled (York's), scaled also given. Returns a FitReport.)");
   m.def(
       "fit_robust",
       [](const py::object& x, const py::object& y, const py::object& u_y, const py::object& u_x, const std::string& loss,
-         double loss_scale, double outlier_threshold) {
+         const py::object& loss_scale, const py::object& outlier_threshold) {
         const LineData d = MakeLineData(x, y, u_x, u_y);
         RobustOptions o;
         if (loss == "huber") o.loss = RobustLoss::kHuber;
         else if (loss == "cauchy") o.loss = RobustLoss::kCauchy;
         else throw InputError("loss", "must be \"huber\" or \"cauchy\" (got \"" + loss + "\")");
-        o.loss_scale = loss_scale;
+        o.loss_scale = Number(loss_scale, "loss_scale");
         o.fit = Options(outlier_threshold);
         return Run([&] { return FitRobust(d, o); });
       },
@@ -215,12 +219,18 @@ when given, else a robust scale (1.4826·MAD). loss_scale in units of sigma (0: 
   m.def(
       "fit_friction",
       [](const std::vector<Scene>& scenes, const py::object& y, const py::object& u_y, const py::object& u_model,
-         bool fit_scale, double outlier_threshold) {
+         bool fit_scale, const py::object& outlier_threshold) {
         FrictionData d;
         d.scenes = scenes;
         d.y = Column(y, "Y");
         d.u_y = Column(u_y, "u(Y)");
         d.u_model = Column(u_model, "u_model");
+        // Positions and their uncertainties in the lengths' ranges (model/input_ranges.hpp), as
+        // the experiment reader holds Y and u(Y) for `uphill fit`.
+        for (std::size_t i = 0; i < d.y.size(); ++i) ForElement(i, [&] { RequireModelLength("Y", d.y[i]); });
+        for (std::size_t i = 0; i < d.u_y.size(); ++i) ForElement(i, [&] { RequireLengthUncertainty("u(Y)", d.u_y[i]); });
+        for (std::size_t i = 0; i < d.u_model.size(); ++i)
+          ForElement(i, [&] { RequireLengthUncertainty("u_model", d.u_model[i]); });
         FrictionOptions o;
         o.fit_scale = fit_scale;
         o.fit = Options(outlier_threshold);

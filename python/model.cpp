@@ -9,8 +9,15 @@
 namespace uphill::python {
 namespace {
 
-double Length(const py::handle& v, const char* name) { return Quantity(v, Dimension::kLength, name); }
 double Angle(const py::handle& v, const char* name) { return Quantity(v, Dimension::kAngle, name); }
+
+// A scene whose positions lie in the lengths' range (model/input_ranges.hpp), as the program's.
+Scene CheckedScene(const Body& body, const Rails& rails, double rod_radius) {
+  Scene scene(body, rails, rod_radius);
+  RequireSceneInRange(scene);
+  return scene;
+}
+
 
 // Scene.at over an array of x: one library call per element.
 py::dict PathAt(const Scene& scene, const py::handle& x_value) {
@@ -19,13 +26,14 @@ py::dict PathAt(const Scene& scene, const py::handle& x_value) {
   py::array_t<double> z = NewArray(shape), dzdx = NewArray(shape), r_star = NewArray(shape), x_contact = NewArray(shape);
   double *pz = MutableData(z), *pd = MutableData(dzdx), *pr = MutableData(r_star), *pc = MutableData(x_contact);
   for (std::size_t i = 0; i < x.size(); ++i) {
-    PathPoint p;
-    try {
-      p = scene.At(x[i]);
-    } catch (const InputError& e) {
-      if (x.is_scalar()) throw;
-      throw RowInputError(e, i);
-    }
+    const PathPoint p = ForElement(i, [&] {
+      const PathPoint point = scene.At(x[i]);
+      RequireFiniteResult("z at x", point.z);
+      RequireFiniteResult("dz/dx at x", point.dzdx);  // infinite where the path turns vertical
+      RequireFiniteResult("R* at x", point.r_star);
+      RequireFiniteResult("the contact at x", point.x_contact);
+      return point;
+    }, x.is_scalar());
     pz[i] = p.z, pd[i] = p.dzdx, pr[i] = p.r_star, pc[i] = p.x_contact;
   }
   py::dict out;
@@ -41,13 +49,12 @@ py::object RestBandAt(const Scene& scene, const py::handle& mu_value) {
   py::array_t<double> low = NewArray(shape), high = NewArray(shape);
   double *pl = MutableData(low), *ph = MutableData(high);
   for (std::size_t i = 0; i < mu.size(); ++i) {
-    std::optional<RestBand> band;
-    try {
-      band = scene.Rest(mu[i]);
-    } catch (const InputError& e) {
-      if (mu.is_scalar()) throw;
-      throw RowInputError(e, i);
-    }
+    const std::optional<RestBand> band = ForElement(i, [&] {
+      RequireRollingResistance("mu", mu[i]);
+      std::optional<RestBand> rest = scene.Rest(mu[i]);
+      if (rest) RequireFiniteResult("x_rest", rest->high), RequireFiniteResult("x_rest(-mu)", rest->low);
+      return rest;
+    }, mu.is_scalar());
     if (!band) return py::none();  // the double cone: see rests_everywhere
     pl[i] = band->low, ph[i] = band->high;
   }
@@ -55,27 +62,45 @@ py::object RestBandAt(const Scene& scene, const py::handle& mu_value) {
   return py::make_tuple(low, high);
 }
 
-py::dict PropagatedToDict(const PropagatedValue& v, BodyKind body) {
+py::dict PropagatedToDict(const PropagatedValue& v, BodyKind body, bool monte_carlo) {
   py::dict d;
   d["value"] = v.value;
   d["unit"] = v.unit;
   d["u_first_order"] = v.u_first_order;
-  d["u_monte_carlo"] = v.u_monte_carlo;
-  d["mc_mean"] = v.mc_mean;
-  d["coverage_interval"] = py::make_tuple(v.coverage_low, v.coverage_high);
+  RequireFiniteResult(v.name, v.value);
+  RequireFiniteResult(v.name, v.u_first_order);
+  if (monte_carlo) {
+    for (double mc : {v.u_monte_carlo, v.mc_mean, v.coverage_low, v.coverage_high}) RequireFiniteResult(v.name, mc);
+    d["u_monte_carlo"] = v.u_monte_carlo;
+    d["mc_mean"] = v.mc_mean;
+    d["coverage_interval"] = py::make_tuple(v.coverage_low, v.coverage_high);
+  } else {  // trials = 0: first order only
+    for (const char* key : {"u_monte_carlo", "mc_mean", "coverage_interval"}) d[key] = py::none();
+  }
   d["disagrees"] = v.disagrees;
   py::dict sensitivity;
-  for (int q = 0; q < kInputQuantityCount; ++q)
+  for (int q = 0; q < kInputQuantityCount; ++q) {
+    RequireFiniteResult(v.name, v.sensitivity[q]);
     if (v.sensitivity[q] != 0.0) sensitivity[InputName(static_cast<InputQuantity>(q), body)] = v.sensitivity[q];
+  }
   d["sensitivity"] = sensitivity;
   return d;
 }
 
-// An input with its standard uncertainty: a number or text, or a (value, u) pair.
+// A standard uncertainty (a number or text) in its range (model/input_ranges.hpp); 0 when None.
+double Uncertainty(const py::object& u, Dimension dimension, const std::string& name) {
+  if (u.is_none()) return 0.0;
+  const double v = Quantity(u, dimension, name);
+  if (dimension == Dimension::kLength) RequireLengthUncertainty(name, v);
+  else RequireAngleUncertainty(name, v);
+  return v;
+}
+
+// An input with its standard uncertainty, each a number or text, in their ranges.
 Uncertain UncertainInput(const py::object& value, const py::object& u, Dimension dimension, const std::string& name) {
   Uncertain out;
-  out.value = Quantity(value, dimension, name);
-  if (!u.is_none()) out.u = Quantity(u, dimension, "u(" + name + ")");
+  out.value = dimension == Dimension::kLength ? Length(value, name) : Quantity(value, dimension, name);
+  out.u = Uncertainty(u, dimension, "u(" + name + ")");
   return out;
 }
 
@@ -131,7 +156,7 @@ Build with Rails.from_angles(theta, alpha) or Rails.from_apparatus(L, H, D, alon
 All lengths in metres, angles in radians. Raises InputError when the body cannot rest on both
 rails or the scene is not modelled (a double cone on rods).)")
       .def(py::init([](const Body& body, const Rails& rails, const py::object& rod_radius) {
-             return Scene(body, rails, rod_radius.is_none() ? 0.0 : Length(rod_radius, "rod_radius"));
+             return CheckedScene(body, rails, rod_radius.is_none() ? 0.0 : Length(rod_radius, "rod_radius"));
            }),
            py::arg("body"), py::arg("rails"), py::arg("rod_radius") = py::none(),
            "Scene(body, rails, rod_radius=None): rod_radius in m (or text); None = line rails.")
@@ -152,17 +177,30 @@ rails or the scene is not modelled (a double cone on rods).)")
       .def("rest", &RestBandAt, py::arg("mu"),
            "Rest band (x_rest(-mu), x_rest(mu)) in m for a rolling-resistance coefficient mu >= 0 (a number or a "
            "float64 array: a tuple of arrays); x_rest(mu) is the paper's measured Y. None for the double cone.")
-      .def("rests_everywhere", &Scene::RestsEverywhere, py::arg("mu"),
-           "Double cone: its constant slope satisfies |dz/dx| <= mu.")
-      .def("kinetic_factor", &Scene::KineticFactor, py::arg("x"), "1 + I/(m·R*²) at x (m): dimensionless.");
+      .def(
+          "rests_everywhere",
+          [](const Scene& scene, const py::object& mu_value) {
+            const double mu = Number(mu_value, "mu");
+            RequireRollingResistance("mu", mu);
+            return scene.RestsEverywhere(mu);
+          },
+          py::arg("mu"), "Double cone: its constant slope satisfies |dz/dx| <= mu (0 <= mu <= 10).")
+      .def(
+          "kinetic_factor",
+          [](const Scene& scene, const py::object& x) {
+            const double k = scene.KineticFactor(Number(x, "x"));
+            RequireFiniteResult("the kinetic factor", k);
+            return k;
+          },
+          py::arg("x"), "1 + I/(m·R*²) at x (m): dimensionless.");
 
   m.def(
       "propagate",
       [](const Body& body, const py::object& L, const py::object& H, const py::object& D, const py::object& theta,
          const py::object& alpha, const py::object& u_L, const py::object& u_H, const py::object& u_D,
          const py::object& u_theta, const py::object& u_alpha, const py::object& u_across, const py::object& u_along,
-         const py::object& rod_radius, const py::object& u_rod_radius, bool along_rail, std::uint64_t trials,
-         std::uint64_t seed) {
+         const py::object& rod_radius, const py::object& u_rod_radius, bool along_rail, const py::object& trials,
+         const py::object& seed) {
         const bool apparatus = !L.is_none() || !H.is_none() || !D.is_none();
         if (apparatus == (!theta.is_none() || !alpha.is_none()))
           throw InputError("rails", "give either L, H, D or theta, alpha");
@@ -174,8 +212,8 @@ rails or the scene is not modelled (a double cone on rods).)")
                       : UncertainRails::Angles(UncertainInput(theta, u_theta, Dimension::kAngle, "theta"),
                                                UncertainInput(alpha, u_alpha, Dimension::kAngle, "alpha"));
         UncertainBody ubody;
-        const Uncertain across{body.across, u_across.is_none() ? 0.0 : Quantity(u_across, Dimension::kLength, "u_across")};
-        const Uncertain along{body.along, u_along.is_none() ? 0.0 : Quantity(u_along, Dimension::kLength, "u_along")};
+        const Uncertain across{body.across, Uncertainty(u_across, Dimension::kLength, "u_across")};
+        const Uncertain along{body.along, Uncertainty(u_along, Dimension::kLength, "u_along")};
         switch (body.kind) {
           case BodyKind::kSphere: ubody = UncertainBody::Sphere(across); break;
           case BodyKind::kSpheroid: ubody = UncertainBody::Spheroid(across, along); break;
@@ -184,15 +222,15 @@ rails or the scene is not modelled (a double cone on rods).)")
         Uncertain rods;
         if (!rod_radius.is_none()) rods = UncertainInput(rod_radius, u_rod_radius, Dimension::kLength, "rod_radius");
         PropagationOptions options;
-        options.trials = trials;
-        options.seed = seed;
+        options.trials = Trials(trials, "trials");
+        options.seed = Count(seed, "seed");
         PropagationResult result;
         {
           py::gil_scoped_release release;
           result = Propagate(rails, ubody, rods, options);
         }
         py::dict out;
-        for (const PropagatedValue* v : result.Outputs()) out[v->name] = PropagatedToDict(*v, body.kind);
+        for (const PropagatedValue* v : result.Outputs()) out[v->name] = PropagatedToDict(*v, body.kind, options.trials > 0);
         out["trials"] = result.trials;
         out["valid_trials"] = result.valid_trials;
         out["rejected_trials"] = result.rejected.total();
@@ -215,7 +253,9 @@ text with a unit, u_<name> its standard uncertainty in the same dimension; rod_r
 Returns a dict keyed by output ("theta", "alpha", "phi" in rad; "x_eq", "x_max" in m; "theta0" in
 rad for the cone), each a dict of value, unit, u_first_order, u_monte_carlo, mc_mean,
 coverage_interval (95 %), disagrees (first order and Monte Carlo differ by > 5 %) and the
-sensitivities (output unit per input unit); plus trials, valid_trials, rejected_trials.)");
+sensitivities (output unit per input unit); plus trials, valid_trials, rejected_trials. With
+trials=0 the Monte Carlo entries (u_monte_carlo, mc_mean, coverage_interval) are None; otherwise
+trials lies in [100, 10^8]. Lengths and uncertainties in the ranges of model/input_ranges.hpp.)");
 }
 
 }  // namespace uphill::python

@@ -34,6 +34,7 @@ py::dict StatesAt(const Motion& motion, const py::handle& t_value) {
     try {
       py::gil_scoped_release release;
       s = motion.At(t[i]);
+      for (double v : {s.t, s.x, s.z, s.v, s.vx, s.vz, s.angle}) RequireFiniteResult("the state at t", v);
     } catch (const InputError& e) {
       if (t.is_scalar()) throw;
       throw RowInputError(e, i);
@@ -62,17 +63,18 @@ void BindMotion(py::module_& m) {
 
 Motion(scene, x0, v0=0, g=9.80665, mu=0, method="quadrature", tolerance=1e-13): x0 in m (or text
 "100 mm"), v0 in m/s (signed, + away from O), g in m/s², mu the rolling-resistance slope threshold
-(needs method="ode"), tolerance the relative accuracy target of t and x. Released at rest beyond X
+(needs method="ode"), tolerance the relative accuracy target of t and x, in [1e-15, 1e-2]. Ranges
+(model/input_ranges.hpp): |v0| <= 1000 m/s, 1e-3 <= g <= 1e3 m/s², 0 <= mu <= 10. Released at rest beyond X
 the body rolls away from O until it falls off at x_max; nearer to O it rolls back.
 Accuracy: t(x) and x(t) within max(1e-10, 16·cond·1.1e-16) of 25-digit references.)")
-      .def(py::init([](const Scene& scene, const py::object& x0, const py::object& v0, const py::object& g, double mu,
-                       const std::string& method, double tolerance) {
-             MotionOptions o;
+      .def(py::init([](const Scene& scene, const py::object& x0, const py::object& v0, const py::object& g,
+                       const py::object& mu, const std::string& method, const py::object& tolerance) {
+             MotionOptions o;  // v0, g and mu in the ranges of model/input_ranges.hpp (Motion checks them)
              o.v0 = Quantity(v0, Dimension::kVelocity, "v0");
              o.g = Quantity(g, Dimension::kAcceleration, "g");
-             o.mu = mu;
+             o.mu = Number(mu, "mu");
              o.method = ParseMethod(method);
-             o.tolerance = tolerance;
+             o.tolerance = Number(tolerance, "tolerance");
              const double start = Quantity(x0, Dimension::kLength, "x0");
              py::gil_scoped_release release;
              return Motion(scene, start, o);
@@ -97,18 +99,18 @@ Accuracy: t(x) and x(t) within max(1e-10, 16·cond·1.1e-16) of 25-digit referen
            "v, vx, vz (m/s; v the speed of the centre), angle (rad, rotation since release).")
       .def("time_at", &TimesAt, py::arg("x"),
            "First time (s) the centre is at x (m; a number or a float64 array); inf where it never gets there.")
-      .def("position_event", [](const Motion& motion, double x) { return EventTuple(motion.PositionEvent(x)); },
+      .def("position_event", [](const Motion& motion, const py::object& x) { return EventTuple(motion.PositionEvent(Number(x, "x"))); },
            py::arg("x"), "(\"position\", t, x): when the centre first reaches x (m); t = inf if never.");
 
   m.def(
       "release_times",
-      [](const Scene& scene, const py::object& x0, const py::object& xs_value, const py::object& g, double tolerance,
-         const py::object& out) {
+      [](const Scene& scene, const py::object& x0, const py::object& xs_value, const py::object& g,
+         const py::object& tolerance, const py::object& out) {
         const Float64Argument xs(xs_value, "xs");
         if (xs.is_scalar() || xs.shape().size() != 1) throw InputError("xs", "must be a one-dimensional float64 array");
         ReleaseTimesOptions o;
         o.g = Quantity(g, Dimension::kAcceleration, "g");
-        o.tolerance = tolerance;
+        o.tolerance = Number(tolerance, "tolerance");
         const double start = Quantity(x0, Dimension::kLength, "x0");
         py::array_t<double> t = OutputArray(out, "out", xs.shape());
         double* pt = MutableData(t);

@@ -8,9 +8,16 @@
 //      flags or files given; no line of FFmpeg or OpenCV comes before it.
 // Truth: the program's own contract (docs/exit-codes.md), not its answers.
 //
-// Reproducible: UPHILL_PROPERTY_SEED=<n> picks the draws (default fixed); a failure prints the
-// seed and the command line. UPHILL_PROPERTY_SCALE multiplies the number of runs (the sanitizer
-// build defaults to a quarter).
+// Draws: each command's flags are drawn per process run (about 270 runs), and the model's inputs
+// are also drawn at the level of the library the program calls, many per process: each row of a
+// `convert --batch` CSV is one drawn setting (body, lengths, angles, rod, uncertainties, every
+// cell sometimes extreme) that goes through the same configuration reader, range checks
+// (model/input_ranges.hpp), converter and printer as one setting given by flags — 10,000 rows in
+// 10 runs (ConvertBatchRows). A process per draw would take minutes.
+//
+// Reproducible: UPHILL_PROPERTY_SEED=<n> picks the draws (default fixed, printed by each test);
+// a failure prints the seed and the command line. UPHILL_PROPERTY_SCALE multiplies the number of
+// runs (the sanitizer build defaults to a quarter).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -23,6 +30,8 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
@@ -44,7 +53,10 @@ using nlohmann::json;
 
 std::uint64_t Seed() {
   const char* s = std::getenv("UPHILL_PROPERTY_SEED");
-  return s ? std::strtoull(s, nullptr, 10) : 20261123;
+  static const std::uint64_t seed = s ? std::strtoull(s, nullptr, 10) : 20261123;
+  static const bool printed = (std::cout << "UPHILL_PROPERTY_SEED=" << seed << " (set it to draw other values)\n", true);
+  (void)printed;
+  return seed;
 }
 
 int Runs(int release_runs) {
@@ -177,13 +189,16 @@ class Draw {
   }
   // A quantity: usually a plausible value in [lo, hi] `unit`; otherwise extreme.
   std::string Quantity(double lo, double hi, const std::string& unit, const std::vector<std::string>& units) {
-    if (Chance(0.7)) return Num(Uniform(lo, hi)) + unit;
+    if (Chance(plain_)) return Num(Uniform(lo, hi)) + unit;
     if (Chance(0.2)) return ExtremeNumber();  // without a unit
     return ExtremeNumber() + Pick(units);
   }
   std::string Length(double lo_mm, double hi_mm) { return Quantity(lo_mm, hi_mm, "mm", {"mm", "m", "km", "um", "in"}); }
   std::string Angle(double lo_deg, double hi_deg) { return Quantity(lo_deg, hi_deg, "deg", {"deg", "rad"}); }
-  std::string Plain(double lo, double hi) { return Chance(0.7) ? Num(Uniform(lo, hi)) : ExtremeNumber(); }
+  std::string Plain(double lo, double hi) { return Chance(plain_) ? Num(Uniform(lo, hi)) : ExtremeNumber(); }
+  // How often a quantity is plausible (else extreme): 0.7, more for a setting whose many cells
+  // should mostly reach the converter.
+  void SetPlain(double p) { plain_ = p; }
   std::string Count(int lo, int hi) {
     if (Chance(0.75)) return std::to_string(Int(lo, hi));
     return Pick(std::vector<std::string>{"0", "-1", "-100", "18446744073709551616", "99999999999", "1e6", "3.5", "",
@@ -235,6 +250,7 @@ class Draw {
 
  private:
   std::mt19937_64 rng_;
+  double plain_ = 0.7;
 };
 
 // A fresh working folder per run (outputs, inputs).
@@ -305,6 +321,45 @@ TEST(CliProperty, ConvertBatch) {
     Check(o, a, {}, {});
     Done(work);
   }
+}
+
+// The library-level draws (see the top): 1000 settings per batch, every column drawn. The rows'
+// cells carry their units (column "L", not "L_mm"), so a cell may also lack one.
+TEST(CliProperty, ConvertBatchRows) {
+  Draw d(11);
+  const std::vector<std::string> columns = {"body", "R", "a", "b", "h", "L", "H", "D", "theta", "alpha",
+                                            "rod_diameter", "u_L", "u_H", "u_D", "u_R", "u_a", "u_theta", "u_alpha"};
+  int rows_drawn = 0, converted = 0;
+  for (int i = 0, n = Runs(10); i < n; ++i) {
+    const fs::path work = Work("convert-rows");
+    std::ofstream csv(work / "batch.csv");
+    for (std::size_t c = 0; c < columns.size(); ++c) csv << (c ? "," : "") << columns[c];
+    csv << "\n";
+    for (int r = 0; r < 1000; ++r, ++rows_drawn) {
+      d.SetPlain(d.Chance(0.5) ? 0.97 : 0.7);
+      std::map<std::string, std::string> cell;
+      for (const Arg& a : d.Scene()) cell[a.flag.substr(2) == "rod-diameter" ? "rod_diameter" : a.flag.substr(2)] = a.value;
+      for (const Arg& a : d.Uncertainties()) cell[a.flag.substr(2).replace(1, 1, "_")] = a.value;
+      for (std::size_t c = 0; c < columns.size(); ++c) {
+        const std::string& v = cell[columns[c]];
+        csv << (c ? "," : "") << (v.find_first_of(",\"") == std::string::npos ? v : "\"" + v + "\"");
+      }
+      csv << "\n";
+    }
+    csv.close();
+    std::vector<Arg> a = {{"--batch", "batch.csv"}, {"--mc-trials", "100"}, {"--json", "", true}};
+    if (d.Chance(0.5)) a.push_back({"--mu", d.Plain(0, 0.2)});
+    const Outcome o = RunProgram({"convert"}, a, work);
+    Check(o, a, {}, {});
+    if (json::accept(o.out)) {
+      for (const json& row : json::parse(o.out)) converted += !row.contains("error");
+    } else {
+      EXPECT_TRUE(o.out.empty()) << "not JSON: " << o.out.substr(0, 300) << "\n  " << o.command;
+    }
+    Done(work);
+  }
+  std::cout << "convert --batch rows drawn: " << rows_drawn << ", converted: " << converted << "\n";
+  EXPECT_GT(converted, rows_drawn / 10);  // the draws reach the converter, not only the reader's refusals
 }
 
 TEST(CliProperty, FitXy) {
@@ -421,26 +476,30 @@ TEST(CliProperty, Simulate) {
   }
 }
 
+// A track CSV of `frames` frames: at rest at x0, then accelerating away; with probability `odd`
+// (and a few lost frames) a cell is extreme. odd = 0: a plain, noise-free release.
+void WriteTrack(Draw& d, const fs::path& file, int frames, double odd) {
+  std::ofstream csv(file);
+  csv << "frame,t,u,v,radius_px,x,z,quality\n";
+  const double x0 = odd > 0 ? d.Uniform(5, 50) : 30.0;
+  for (int f = 0; f < frames; ++f) {
+    const double t = f / 120.0;
+    const double x = t < 0.2 ? x0 : x0 + 0.5 * 9.81 * 0.05 * (t - 0.2) * (t - 0.2) * 1000;
+    if (odd > 0 && d.Chance(odd)) {
+      csv << f << "," << d.Num(t) << ",,,,,,0\n";
+      continue;
+    }
+    const auto cell = [&](const std::string& plain, double p) { return odd > 0 && d.Chance(p * odd) ? d.ExtremeNumber() : plain; };
+    csv << f << "," << cell(d.Num(t), 0.6) << ",400,300,20," << cell(d.Num(x + (odd > 0 ? d.Uniform(-0.3, 0.3) : 0.0)), 1.0)
+        << ",10," << cell("0.7", 0.6) << "\n";
+  }
+}
+
 TEST(CliProperty, AnalyseTrack) {
   Draw d(7);
   for (int i = 0, n = Runs(25); i < n; ++i) {
     const fs::path work = Work("analyse-track");
-    std::ofstream csv(work / "track.csv");
-    csv << "frame,t,u,v,radius_px,x,z,quality\n";
-    const int frames = d.Int(0, 60);
-    const double x0 = d.Uniform(5, 50);
-    for (int f = 0; f < frames; ++f) {
-      const double t = f / 120.0;
-      const double x = t < 0.2 ? x0 : x0 + 0.5 * 9.81 * 0.05 * (t - 0.2) * (t - 0.2) * 1000;
-      if (d.Chance(0.05)) {
-        csv << f << "," << d.Num(t) << ",,,,,,0\n";
-        continue;
-      }
-      csv << f << "," << (d.Chance(0.97) ? d.Num(t) : d.ExtremeNumber()) << ",400,300,20,"
-          << (d.Chance(0.95) ? d.Num(x + d.Uniform(-0.3, 0.3)) : d.ExtremeNumber()) << ",10,"
-          << (d.Chance(0.97) ? "0.7" : d.ExtremeNumber()) << "\n";
-    }
-    csv.close();
+    WriteTrack(d, work / "track.csv", d.Int(0, 60), 0.05);
     std::vector<Arg> a = d.Scene();
     a.insert(a.begin(), {"", "track.csv"});
     if (d.Chance(0.3)) a.push_back({"--g", d.Quantity(1, 20, "m/s2", {"m/s2"})});
@@ -454,6 +513,52 @@ TEST(CliProperty, AnalyseTrack) {
                         : std::vector<fs::path>{});
     Done(work);
   }
+}
+
+// Regression: a position uncertainty or g outside model/input_ranges.hpp, on the command line
+// and in an experiment's experiment.json, is refused naming it (exit 2) — it printed "inf mm" and
+// wrote it into track_analysis.json. Truth: docs/exit-codes.md and the ranges' contract.
+TEST(CliRanges, AnalyseTrackRefusesAnExtremeUncertaintyOrG) {
+  Draw d(12);
+  const fs::path work = Work("analyse-track-ranges");
+  WriteTrack(d, work / "track.csv", 60, 0.0);
+  const std::vector<Arg> scene = {{"", "track.csv"}, {"--body", "sphere"}, {"--R", "12.7mm"},
+                                  {"--theta", "3deg"}, {"--alpha", "40deg"}};
+  for (const auto& [flag, value] : std::vector<std::pair<std::string, std::string>>{
+           {"--u-x", "1e308mm"}, {"--u-x", "1e-320mm"}, {"--g", "1e-308m/s2"}, {"--g", "1e308m/s2"}}) {
+    std::vector<Arg> a = scene;
+    a.push_back({flag, value});
+    a.push_back({"-o", "out"});
+    const Outcome o = RunProgram({"analyse-track"}, a, work);
+    Check(o, a, {}, {work / "out/track_analysis.json"});
+    EXPECT_EQ(o.status, 2) << o.command << "\n" << o.out;
+    EXPECT_NE(o.err.find(flag + ": must be > 0, between"), std::string::npos) << o.err;
+  }
+  std::vector<Arg> plain = scene;
+  plain.push_back({"--u-x", "0.3mm"});
+  const Outcome ok = RunProgram({"analyse-track"}, plain, work);
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  Done(work);
+}
+
+TEST(CliRanges, ExperimentJsonRefusesAnExtremeVideoUncertaintyOrG) {
+  const fs::path work = Work("experiment-ranges");
+  for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
+           {"u_x", "1e308 mm"}, {"u_x", "1e-320 mm"}, {"g", "1e-308 m/s2"}}) {
+    fs::remove_all(work / "exp");
+    fs::create_directories(work / "exp");
+    json e = json::parse(testing::ReadBytes(fs::path(UPHILL_SOURCE_DIR) / "data/series1-fixed-D/experiment.json"));
+    e["format"] = "uphill-experiment/2";
+    e["video_analysis"] = {{key, value}};
+    std::ofstream(work / "exp/experiment.json") << e.dump(2);
+    fs::copy_file(fs::path(UPHILL_SOURCE_DIR) / "data/series1-fixed-D/measurements.csv", work / "exp/measurements.csv");
+    const std::vector<Arg> a = {{"", "./exp"}, {"--mc-trials", "100"}};
+    const Outcome o = RunProgram({"fit"}, a, work);
+    Check(o, a, {}, {});
+    EXPECT_EQ(o.status, 2) << o.command;
+    EXPECT_NE(o.err.find("video_analysis." + key + ": must be > 0, between"), std::string::npos) << o.err;
+  }
+  Done(work);
 }
 
 TEST(CliProperty, CalibrateTargetAndScene) {

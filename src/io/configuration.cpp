@@ -5,7 +5,7 @@
 
 #include "io/units.hpp"
 #include "model/input_error.hpp"
-#include "model/length_range.hpp"
+#include "model/input_ranges.hpp"
 
 namespace uphill {
 namespace {
@@ -21,6 +21,18 @@ constexpr FieldSpec kUncertainFields[] = {
     {"D", Dimension::kLength},     {"theta", Dimension::kAngle},  {"alpha", Dimension::kAngle},
     {"rod_diameter", Dimension::kLength},
 };
+
+// The range of a numeric field: a length of the model, or a standard uncertainty of a length or
+// an angle (model/input_ranges.hpp).
+void RequireFieldRange(const std::string& name, double si, bool length, bool uncertainty) {
+  if (uncertainty) {
+    if (si < 0.0) throw InputError(name, "must be >= 0");  // the sign is the rule a negative one breaks
+    if (length) RequireLengthUncertainty(name, si);
+    else RequireAngleUncertainty(name, si);
+  } else if (length) {
+    RequireModelLength(name, si);
+  }
+}
 
 class Reader {
  public:
@@ -38,11 +50,8 @@ class Reader {
     if (!field) return std::nullopt;
     used_.push_back(name);
     Uncertain m;
-    m.value = Parse(name, *field, dimension);
-    if (const auto uf = source_.lookup("u_" + name)) {
-      m.u = Parse("u_" + name, *uf, dimension);
-      if (m.u < 0.0) throw InputError(source_.context("u_" + name), "must be >= 0");
-    }
+    m.value = Parse(name, *field, dimension, false);
+    if (const auto uf = source_.lookup("u_" + name)) m.u = Parse("u_" + name, *uf, dimension, true);
     return m;
   }
 
@@ -72,10 +81,12 @@ class Reader {
   }
 
  private:
-  double Parse(const std::string& name, const FieldSource::Field& field, Dimension dimension) const {
+  // The value of a field, in its range (model/input_ranges.hpp); an uncertainty's range when
+  // `uncertainty`. Angles' own range is the model's (Rails::FromAngles).
+  double Parse(const std::string& name, const FieldSource::Field& field, Dimension dimension, bool uncertainty) const {
     try {
       const double value = ParseQuantity(field.text, dimension, name, field.default_unit);
-      if (dimension == Dimension::kLength) RequireModelLength(name, value);
+      RequireFieldRange(name, value, dimension == Dimension::kLength, uncertainty);
       return value;
     } catch (const InputError& e) {
       throw InputError(source_.context(name), e.rule());
@@ -108,7 +119,11 @@ Rails Configuration::MakeRails() const {
   return Rails::FromAngles(theta.value, alpha.value);
 }
 
-Scene Configuration::MakeScene() const { return Scene(MakeBody(), MakeRails(), rod_radius.value); }
+Scene Configuration::MakeScene() const {
+  Scene scene(MakeBody(), MakeRails(), rod_radius.value);
+  RequireSceneInRange(scene);
+  return scene;
+}
 
 UncertainRails Configuration::MakeUncertainRails() const {
   if (from_apparatus) return UncertainRails::Apparatus(L, H, D, convention);
@@ -230,10 +245,12 @@ std::optional<NumericField> FindNumericField(std::string_view name) {
 }
 
 bool SetNumericField(Configuration& c, const NumericField& field, double si) {
-  // A length outside the model's range (model/length_range.hpp): the full parse names it.
-  if (field.length && si != 0.0 && !(std::abs(si) >= kShortestModelLength && std::abs(si) <= kLongestModelLength))
+  // A value outside its range (model/input_ranges.hpp): the full parse names the cell.
+  try {
+    RequireFieldRange("", si, field.length, field.uncertainty);
+  } catch (const InputError&) {
     return false;
-  if (field.uncertainty && si < 0.0) return false;  // Reader::Get refuses it, naming the cell
+  }
   const auto set = [&](Uncertain& m, double v) { (field.uncertainty ? m.u : m.value) = v; };
   using T = NumericField::Target;
   switch (field.target) {

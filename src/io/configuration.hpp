@@ -44,7 +44,7 @@ struct Configuration {
   bool HasUncertainty() const;
   Body MakeBody() const;    // throws InputError
   Rails MakeRails() const;  // throws InputError
-  Scene MakeScene() const;  // throws InputError
+  Scene MakeScene() const;  // throws InputError, also for positions beyond model/input_ranges.hpp
   // The inputs with their uncertainties, for Propagate (model/propagation.hpp).
   UncertainRails MakeUncertainRails() const;
   UncertainBody MakeUncertainBody() const;
@@ -84,8 +84,8 @@ std::optional<Dimension> NumericFieldDimension(std::string_view name);
 // Sets numeric field `name` of a configuration that ParseConfiguration returned to the value
 // `si` (SI units), exactly as ParseConfiguration would have read it from a row that differs only
 // there. False when the field has no place in this configuration or the value is one that
-// ParseConfiguration refuses on reading (a negative uncertainty, a length outside
-// model/length_range.hpp): parse that row instead. The geometry is not checked here
+// ParseConfiguration refuses on reading (a value outside its range in model/input_ranges.hpp):
+// parse that row instead. The geometry is not checked here
 // (Configuration::MakeScene does it).
 bool SetNumericField(Configuration& configuration, std::string_view name, double si);
 

@@ -9,7 +9,7 @@
 #include "io/csv_table.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
-#include "model/length_range.hpp"
+#include "model/input_ranges.hpp"
 
 namespace uphill {
 namespace {
@@ -96,13 +96,12 @@ void ReadVideoKeys(const json& meta, const std::string& json_path, Experiment* e
     if (options.contains("u_x")) {
       const std::string where = json_path + ": video_analysis.u_x";
       v.u_x = ParseQuantity(Text(options.at("u_x"), where), Dimension::kLength, where);
-      if (!(v.u_x > 0.0) || !std::isfinite(v.u_x))
-        throw InputError(where, "must be > 0 (the standard uncertainty of a tracked position)");
+      RequirePositiveLength(where, v.u_x);
     }
     if (options.contains("g")) {
       const std::string where = json_path + ": video_analysis.g";
       v.g = ParseQuantity(Text(options.at("g"), where), Dimension::kAcceleration, where);
-      if (!(v.g > 0.0) || !std::isfinite(v.g)) throw InputError(where, "must be > 0");
+      RequireGravity(where, v.g);
     }
   }
 }

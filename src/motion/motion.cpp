@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "model/input_error.hpp"
+#include "model/input_ranges.hpp"
 #include "internal/motion_engine.hpp"
 #include "model/number_text.hpp"
 
@@ -46,10 +47,9 @@ Motion::Motion(const Scene& scene, double x0, const MotionOptions& o) {
   if (!std::isfinite(x0) || x0 < lo || x0 > hi || (cone && x0 >= hi))
     throw InputError("x0", "must lie on the path, in [" + ExactText(lo) + ", " + ExactText(hi) + (cone ? ")" : "]") +
                                " m (got " + ExactText(x0) + " m)");
-  if (!std::isfinite(o.v0)) throw InputError("v0", "must be a finite speed");
-  if (!(o.g > 0.0) || !std::isfinite(o.g)) throw InputError("g", "must be a finite number > 0 (got " + ExactText(o.g) + ")");
-  if (!(o.mu >= 0.0) || !std::isfinite(o.mu))
-    throw InputError("mu", "must be a finite number >= 0 (got " + ExactText(o.mu) + ")");
+  RequireSpeed("v0", o.v0);
+  RequireGravity("g", o.g);
+  RequireRollingResistance("mu", o.mu);
   if (!(o.tolerance >= 1e-15 && o.tolerance <= 1e-2))
     throw InputError("tolerance", "must lie in [1e-15, 1e-2] (got " + ExactText(o.tolerance) + ")");
   if (o.method == MotionMethod::kQuadrature && o.mu > 0.0)

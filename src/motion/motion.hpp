@@ -72,10 +72,10 @@ enum class MotionMethod { kQuadrature, kOde };
 
 struct MotionOptions {
   // Initial velocity of the centre, m/s: its speed, signed by the direction of x (> 0 away
-  // from O). 0: released from rest.
+  // from O). 0: released from rest. At most 1000 m/s in size (model/input_ranges.hpp).
   double v0 = 0.0;
-  double g = 9.80665;  // m/s², > 0
-  double mu = 0.0;     // rolling resistance (slope threshold), ≥ 0; > 0 needs kOde
+  double g = 9.80665;  // m/s², in [1e-3, 1e3] (model/input_ranges.hpp)
+  double mu = 0.0;     // rolling resistance (slope threshold), in [0, 10]; > 0 needs kOde
   MotionMethod method = MotionMethod::kQuadrature;
   // Relative accuracy target of t and x, in [1e-15, 1e-2]. 1e-13 by default.
   double tolerance = 1e-13;
@@ -105,8 +105,9 @@ struct MotionEvent {
 class Motion {
  public:
   // Throws InputError (naming x0, v0, g, mu, tolerance or method) for input outside the domain:
-  // x0 outside [x_low, x_max] (x_fall excluded for the cone), g ≤ 0, μ < 0, μ > 0 with
-  // kQuadrature, v0 ≠ 0 with kQuadrature for a spheroid on rods.
+  // x0 outside [x_low, x_max] (x_fall excluded for the cone), v0, g or μ outside their ranges
+  // (model/input_ranges.hpp), μ > 0 with kQuadrature, v0 ≠ 0 with kQuadrature for a spheroid on
+  // rods.
   Motion(const Scene& scene, double x0, const MotionOptions& options = {});
   ~Motion();
   Motion(Motion&&) noexcept;
@@ -155,7 +156,7 @@ class Motion {
 // InputError (naming x0, xs, g, nodes, tolerance, kernel or scene) for other scenes, x0 ≤ X,
 // positions not increasing in (x0, x_max].
 struct ReleaseTimesOptions {
-  double g = 9.80665;        // m/s², > 0
+  double g = 9.80665;        // m/s², in [1e-3, 1e3] (model/input_ranges.hpp)
   double tolerance = 1e-13;  // relative, in [1e-15, 1e-2]; used when nodes = 0
   int nodes = 0;             // 0: from the tolerance; 2 … 12: fixed
   VectorKernel kernel = VectorKernel::kAuto;  // vector_kernel.hpp

@@ -33,6 +33,7 @@
 #include <numbers>
 
 #include "model/input_error.hpp"
+#include "model/input_ranges.hpp"
 #include "model/libmvec_avx2.hpp"
 #include "internal/motion_engine.hpp"
 #include "model/number_text.hpp"
@@ -359,7 +360,7 @@ void ReleaseTimes(const Scene& scene, double x0, std::span<const double> xs, std
   if (!(x0 > *scene.x_eq() && x0 < scene.x_max()))
     throw InputError("x0", "must lie in (X, x_max) = (" + ExactText(*scene.x_eq()) + ", " + ExactText(scene.x_max()) +
                                ") m (got " + ExactText(x0) + " m)");
-  if (!(o.g > 0.0) || !std::isfinite(o.g)) throw InputError("g", "must be a finite number > 0 (got " + ExactText(o.g) + ")");
+  RequireGravity("g", o.g);
   if (o.nodes != 0 && (o.nodes < kMinNodes || o.nodes > kMaxNodes))
     throw InputError("nodes", "must be 0 (chosen from the tolerance) or 2 ... 12 (got " + std::to_string(o.nodes) + ")");
   if (!(o.tolerance >= 1e-15 && o.tolerance <= 1e-2))

@@ -7,6 +7,7 @@
 #include "internal/track_model_fit.hpp"
 #include "internal/track_series.hpp"
 #include "model/input_error.hpp"
+#include "model/input_ranges.hpp"
 #include "model/number_text.hpp"
 
 namespace uphill {
@@ -15,8 +16,8 @@ namespace {
 using namespace internal;
 
 void RequireOptions(const TrackAnalysisOptions& o) {
-  if (!(o.u_x > 0.0 && std::isfinite(o.u_x))) throw InputError("u_x", "must be > 0 (the stated position uncertainty)");
-  if (!(o.g > 0.0 && std::isfinite(o.g))) throw InputError("g", "must be > 0");
+  RequirePositiveLength("u_x", o.u_x);
+  RequireGravity("g", o.g);
   if (!(o.band_sigmas > 0.0 && std::isfinite(o.band_sigmas))) throw InputError("band_sigmas", "must be > 0");
   if (!(o.huber_sigmas > 0.0 && std::isfinite(o.huber_sigmas))) throw InputError("huber_sigmas", "must be > 0");
   if (o.confirm_frames < 1) throw InputError("confirm_frames", "must be >= 1");

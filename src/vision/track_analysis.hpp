@@ -106,7 +106,7 @@
 // Cost: a Ceres fit whose residuals each integrate the motion (quadrature for g, the ODE for μ).
 //
 // Errors: InputError for an empty track, a track with no frame found, fewer than 2 frames found,
-// or options out of range (u_x ≤ 0, g ≤ 0, k ≤ 0 …). A track that cannot be fitted (the ball
+// or options out of range (u_x and g outside model/input_ranges.hpp, k ≤ 0 …). A track that cannot be fitted (the ball
 // never moves, too few frames in the window, a scene the chosen model does not cover) is not an
 // error: fit.available is false and fit.unavailable says why.
 #pragma once
@@ -124,9 +124,9 @@ namespace uphill {
 enum class TrackFitParameter { kEffectiveG, kMu };
 
 struct TrackAnalysisOptions {
-  double g = 9.80665;                                // m/s², the reference g (kMu: the g used)
+  double g = 9.80665;                                // m/s², the reference g (kMu: the g used), in [1e-3, 1e3]
   TrackFitParameter fit = TrackFitParameter::kEffectiveG;
-  double u_x = 0.5e-3;                               // stated position uncertainty σ, m, > 0
+  double u_x = 0.5e-3;                               // stated position uncertainty σ, m, in [1 nm, 1000 km]
   double band_sigmas = 5.0;                          // k of the k·σ bands
   int confirm_frames = 3;                            // consecutive frames that confirm a change
   int reference_frames = 25;                         // frames of the release band's median

@@ -14,6 +14,7 @@
 #include "io/output_paths.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
+#include "model/input_ranges.hpp"
 #include "vision/track_analysis.hpp"
 #include "vision/track_analysis_output.hpp"
 #include "vision/track_table.hpp"
@@ -39,9 +40,9 @@ void Run(const AnalyseTrackFlags& f) {
   const Scene scene = ParseConfiguration(FlagSource(f.scene)).MakeScene();
   TrackAnalysisOptions o;
   o.g = ParseQuantity(f.g, Dimension::kAcceleration, "--g");
-  if (!(o.g > 0.0)) throw InputError("--g", "must be > 0");
+  RequireGravity("--g", o.g);
   o.u_x = ParseQuantity(f.u_x, Dimension::kLength, "--u-x");
-  if (!(o.u_x > 0.0)) throw InputError("--u-x", "must be > 0 (the standard uncertainty of a tracked position)");
+  RequirePositiveLength("--u-x", o.u_x);
   if (!(f.tracker_floor_px >= 0.0 && std::isfinite(f.tracker_floor_px)))
     throw InputError("--tracker-floor-px", "must be >= 0 (pixels)");
   if (!(f.tracker_blur >= 0.0 && std::isfinite(f.tracker_blur)))
