@@ -55,17 +55,30 @@ CsvRecords::CsvRecords(const std::string& path, Options options) : source_(path 
     close_fd_ = true;
     posix_fadvise(fd_, 0, 0, POSIX_FADV_SEQUENTIAL);
   }
-  ReadHeader();
+  ReadHeaderOrRelease();
 }
 
 CsvRecords::CsvRecords(std::istream& in, const std::string& source, Options options)
     : source_(source), options_(options), stream_(&in) {
-  ReadHeader();
+  ReadHeaderOrRelease();
 }
 
-CsvRecords::~CsvRecords() {
+CsvRecords::~CsvRecords() { Release(); }
+
+void CsvRecords::Release() {
   if (parser_ready_) csv_free(&parser_);
+  parser_ready_ = false;
   if (close_fd_) close(fd_);
+  close_fd_ = false;
+}
+
+void CsvRecords::ReadHeaderOrRelease() {
+  try {
+    ReadHeader();
+  } catch (...) {
+    Release();
+    throw;
+  }
 }
 
 int CsvRecords::Column(const std::string& name) const {

@@ -79,7 +79,11 @@ class CsvRecords {
 
  private:
   enum class Got { kRecord, kBlank, kEnd };
+  // The header, read by the constructors; when it is refused the constructor throws, so no
+  // destructor runs: what was acquired (the file, libcsv's buffer) is released first.
+  void ReadHeaderOrRelease();
   void ReadHeader();
+  void Release();
   bool Fill();  // reads another block; false at the end of the input
   Got NextRaw(Record* record);
   Got Quoted(std::size_t line_begin, Record* record);
