@@ -1,0 +1,262 @@
+// BallTracker::Impl: the tracker's state between frames and its stages, private to the tracker.
+// The stages live in their own files:
+//   ball_tracker.cpp          set-up, the public interface, and Track: one frame through the stages
+//   tracker_motion.cpp        predict: the motion through the last centres, the exposure, the row
+//                             delay, the body's region, and the scene-change watch
+//   tracker_measure.cpp       measure and acquire: the outline fits (two passes, or one near a
+//                             good prediction), their observations, and the candidates along the path
+//   tracker_refit.cpp         assess and revise: frames kept for a refit once the background and
+//                             the motion are known, the readout settled at the end, a body withdrawn
+// Thresholds: tracker_thresholds.hpp.
+#pragma once
+
+#include <Eigen/Core>
+#include <deque>
+#include <map>
+#include <memory>
+#include <optional>
+#include <opencv2/core.hpp>
+#include <utility>
+#include <vector>
+
+#include "background_model.hpp"
+#include "body_shading.hpp"
+#include "edge_fit.hpp"
+#include "motion_prediction.hpp"
+#include "outline_fit.hpp"
+#include "rejected_windows.hpp"
+#include "row_delay_settle.hpp"
+#include "tracker_thresholds.hpp"
+#include "vision/ball_tracker.hpp"
+
+namespace uphill {
+
+// The tracker's files share these names (this header is private to them).
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+using internal::FitOutcome;
+using internal::FitRequest;
+
+struct BallTracker::Impl : internal::TrackerThresholds {
+  struct Sample {
+    double t, x, z;  // s (clip time of the reported centre), m
+    // The frame's time and the centre's row: under a rolling shutter t is frame_t + row·δ, δ the
+    // rows' delay as known now (the samples are re-timed whenever it changes).
+    double frame_t = 0, row = 0;
+  };
+
+  // Whether a search follows the body (a prediction or a frame's own fit to start from) or
+  // looks for it anew.
+  enum class Search { kTracking, kAcquiring };
+
+  Scene scene;
+  TrackerOptions options;
+  internal::OutlineGeometry geometry;
+  cv::Mat occluder;                                 // CV_8U: the near rail's band
+  std::unique_ptr<internal::BackgroundModel> background;
+  std::unique_ptr<internal::BodyShading> shading;   // learnt from the first frames at rest
+  double light_inverse_distance = 0;                // 1/m: its lamp's, in the last model fit
+  std::deque<std::pair<long, Sample>> history;      // last found (frame, sample)
+  long frame_index = -1;
+  double x_lo = 0, x_hi = 0;                        // searchable part of the path
+  double lens_reach = 0;                            // LensModelReach of the camera
+  double noise = 0.01;                              // residual RMS of a sample, linear units
+  std::deque<double> noises;                        // of the last accepted frames
+  double row_delay = 0;                             // s per row
+  std::vector<double> exposures;                    // per-frame measurements |D|/|V|
+  std::vector<double> row_delays;                   // per-frame measurements of the row delay, s
+  // The frames that measured the row delay: a window of each, its last fit's request (made at
+  // request.row_delay) and that fit's estimate; the far ones fitted again at the end of the clip
+  // (SettleReadout).
+  struct ReadoutFrame {
+    cv::Mat window;
+    cv::Point origin;
+    double gain;
+    FitRequest request;
+    internal::FrameDelay estimate;
+  };
+  std::vector<ReadoutFrame> readout_frames;
+  std::optional<double> row_delay_u;                // s per row, once settled
+  int row_delay_frames = 0;                         // the frames it was settled on
+  std::vector<double> scene_residuals;              // recent steady levels
+  int scene_suspect = 0;
+  long scene_suspect_from = -1;
+  std::optional<long> scene_changed_at;
+  std::deque<std::pair<long, double>> gains;        // (frame, gain)
+  // Every accepted frame's centre (revised ones included), for the velocity at a past frame.
+  std::map<long, Sample> samples;
+  // Frames measured before the background under the body or its motion was known: a window of
+  // the frame each, fitted again once both are (FitAgain), their revised observations handed out
+  // by TakeRevisions.
+  struct Pending {
+    long frame;
+    double t, gain;
+    cv::Mat window;
+    cv::Point origin;
+    BallObservation observed;
+    Vector2d centre;  // fitted, at the reference time
+    bool edge_fallback = false;  // observed by the edge fit: keep it unless the background becomes known
+  };
+  std::deque<Pending> pending;
+  size_t pending_bytes = 0;
+  std::vector<std::pair<long, BallObservation>> revisions;
+  std::vector<long> exposure_changes;
+  // Fast path: the edge fit; whether this clip needs the full model on every frame (its grey
+  // contrast is low, its body patterned, or the edge fit keeps failing), and why.
+  std::unique_ptr<internal::EdgeFit> edges;
+  bool needs_model = false;
+  int distrusted = 0;
+  long confident_model_frame = -1;  // the last frame the model measured, its background known
+  long learnt_near_at = -1;         // the last frame whose background the model's path learnt
+  // A body found anew where the model could not check it against the background (rays whose
+  // background was never seen: the first frames of a clip) counts once the next frames find it
+  // again near it; found in that frame alone it was the table's texture (wood grain between the
+  // rails), not a body, and it is withdrawn (a revision that says not found).
+  struct Unconfirmed {
+    long frame;
+    bool needs_model_before;
+  };
+  std::optional<Unconfirmed> unconfirmed;
+  // The whole-path search's candidates fitted and rejected since the body was last found, with
+  // their pixels (see rejected_windows.hpp).
+  internal::RejectedWindows rejected;
+
+  Impl(const Scene& sc, const TrackerOptions& o) : scene(sc), options(o) {}
+
+  double Exposure() const;
+
+  // Whether this frame's fit measures the row delay (TrackerOptions::measure_readout): until
+  // kReadoutFrames have, where a whole frame's readout would shear the body by over a pixel.
+  bool MeasuresReadout(const Vector2d& centre, const Vector2d& velocity) const;
+
+  // A frame's measured row delay; the median of all so far is used from kReadoutMinFrames on.
+  // False for a fit that did not see the shear (a delay far outside one frame time's).
+  bool MeasuredRowDelay(double delay);
+  // A centre reported in the frame of time t, at the time of its row with the rows' delay as now
+  // known (its time_offset, unless the delay changed since it was measured).
+  Sample SampleOf(double t, const BallObservation& o) const { return Sample{t + o.v * row_delay, o.x, o.z, t, o.v}; }
+  // The rows' delay from here on, and the times of the centres measured so far with it: those
+  // measured before it was known (at a global shutter's 0, the first five) lie several pixels
+  // off the motion of those after, and the prediction from both would miss by as much.
+  void SetRowDelay(double delay);
+  bool SeesShear(double delay) const { return delay > -0.5 * FrameRowDelay() && delay < 1.5 * FrameRowDelay(); }
+  // The row delay of a readout lasting the whole frame time, s per row: the most a camera has.
+  double FrameRowDelay() const { return 1 / options.fps / geometry.cal.camera.height; }
+
+  double RadiusPx(double x, double z) const {
+    const Vector3d c(x, 0, z);
+    return geometry.a * geometry.cal.camera.fx / (c - geometry.eye).norm();
+  }
+  double MetresPerPx(double x, double z) const { return 1.0 / (geometry.cal.camera.fx / (Vector3d(x, 0, z) - geometry.eye).norm()); }
+
+  // The motion through the history (motion_prediction.hpp), while the body may still be predicted
+  // from it.
+  std::optional<internal::MotionFit> Motion(long f) const;
+
+  // The body's region (smeared silhouette, a radius around it, and its shadow below it), px.
+  cv::Rect BodyRegion(const Vector2d& centre, const Vector2d& smear) const;
+
+  // The path's direction at x (unit, (x, z)).
+  Vector2d PathTangent(double x) const {
+    const double slope = scene.At(std::clamp(x, x_lo, x_hi)).dzdx;
+    return Vector2d(1, slope).normalized();
+  }
+
+  // `acceleration` bends the smear over the exposure (smeared_outline.hpp); zero when unknown.
+  FitRequest Request(const Vector2d& centre, const Vector2d& velocity, bool moving_known, double half_width,
+                     const Vector2d& acceleration = Vector2d::Zero()) const;
+
+  // A fit is a body when enough rays agree with it, the body stands out of the background by
+  // several noise levels, and its inlier rays fit within a few noise levels. `agreement`: the
+  // share of the fitted rays that must be inliers (less near the prediction, where a painted
+  // body's band or the rails may cost rays, than for a body found anew).
+  bool Accept(const FitOutcome& f, double agreement) const {
+    return f.ok && f.inliers >= std::max(10.0, 0.25 * options.rays) && f.inliers >= agreement * f.rays_fitted &&
+           f.contrast >= options.min_contrast && f.contrast >= 6 * noise && f.misfit < 3;
+  }
+
+  // Two passes: around the guess with the given half width, then narrow around the first fit
+  // (with `narrow_iterations`; q.iterations caps the first passes).
+  FitOutcome Measure(const internal::FrameView& view, FitRequest q, Search search = Search::kTracking,
+                     int narrow_iterations = kNarrowIterations);
+
+  // One narrow pass, where the prediction is good (the model measured the previous frame, its
+  // background known): one Ceres solve instead of two or more. Measure() when the fit moves more
+  // than half a pixel from the prediction or fails. The edge shift is held as in Measure(), so
+  // that both fit the same parameters: freed here alone, it moves the centre across the motion
+  // on fast frames.
+  FitOutcome MeasureNear(const internal::FrameView& view, FitRequest q);
+
+  // Whether the lens model maps the camera-frame point where it is (LensModelReach).
+  bool WithinLens(const Vector3d& pc) const { return pc.z() > 0 && pc.head<2>().norm() < lens_reach * pc.z(); }
+
+  // Candidates along the path between x0 and x1, best first: the predicted outline's inside
+  // against its outside (against the background where it is known).
+  std::vector<Vector2d> Candidates(const cv::Mat& frame, double gain, double x0, double x1) const;
+
+  // Quality in [0, 1]: the share of the visible outline's rays that agree with the fit, lowered
+  // when those fit worse than the pixel noise allows and when the body stands out of the
+  // background by less than 20 noise levels.
+  double Quality(const FitOutcome& f) const;
+
+  // The centre (x, z), its pixel and the outline's mean radius about it.
+  void Place(const Vector2d& centre, BallObservation* o) const;
+
+  BallObservation Observe(const FitOutcome& f, const FitRequest& q);
+
+  // The fast path's fit is trusted when it saw the outline nearly all round, in grey-level
+  // contrast well above the noise, and its edge points lie on the fitted outline.
+  bool Trusted(const internal::EdgeFitOutcome& e) const {
+    return e.ok && e.inliers >= 0.35 * kEdgePoints && e.inliers >= kFastMinAgreement * e.attempted &&
+           e.contrast >= kFastMinContrast && e.rms_px <= kFastMaxRmsPx;
+  }
+
+  BallObservation ObserveEdges(const internal::EdgeFitOutcome& e) const;
+
+  // A frame where the body rests (found near a prediction that barely moves) is a sharp view of
+  // its shading.
+  void LearnShading(const cv::Mat& frame, const BallObservation& o, const Vector2d& velocity);
+
+  void Remember(long f, double t, const BallObservation& o);
+
+  // The velocity and acceleration at time t of frame f from the accepted centres of the frames
+  // around it (a parabola in time through up to four on each side); false with fewer than two on
+  // each side.
+  bool VelocityAround(long f, double t, Vector2d* velocity, Vector2d* acceleration) const;
+
+  // Whether the background is known everywhere around the body centred at `centre` (its region,
+  // on a 12 × 12 lattice of the band's pixels).
+  bool BackgroundKnownAround(const Vector2d& centre) const;
+
+  // Keeps a window of the frame for a refit when the fit lacked the background or the motion.
+  void KeepForRefit(long f, double t, const cv::Mat& frame, double gain, const FitOutcome& fit,
+                    const BallObservation& o, bool motion_known, bool edge_fallback);
+
+  // The part of a frame kept for a later fit: the body's region, 24 px more each side (a fit
+  // started there may move by that much).
+  cv::Rect KeptWindow(const Vector2d& centre, const Vector2d& smear, const cv::Mat& frame) const;
+
+  // A frame that measured the row delay, for SettleReadout: the window its smear covers, the
+  // request of a narrow pass from its fit, and its estimate. The smear's prior stays the motion's
+  // prediction: one centred on the smear fitted at this frame's delay would hold part of the
+  // shear that delay got wrong.
+  void KeepReadoutFrame(const cv::Mat& frame, double gain, const FitOutcome& fit, FitRequest q);
+
+  // The clip's row delay, settled on the frames that measured it (row_delay_settle.hpp), and its
+  // standard uncertainty; the running median of their estimates is kept when it cannot be.
+  void SettleReadout();
+
+  // Fits kept frames again whose background and motion are now known (all of them when `all`,
+  // with whatever is known by then).
+  void FitAgain(bool all);
+
+  void Withdraw();
+
+  // Scene residual and gain bookkeeping (SceneChangedAt, ExposureChanges).
+  void WatchScene(long f);
+
+  // One frame through the stages (BallTracker::Track).
+  BallObservation Track(const cv::Mat& input);
+};
+
+}  // namespace uphill

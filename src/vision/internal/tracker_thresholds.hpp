@@ -1,0 +1,78 @@
+// The ball tracker's thresholds (ball_tracker.cpp and the tracker_*.cpp files beside it), in one
+// place, each with the reason for its value. Pixels are raw image pixels; "noise" is a sample's
+// residual RMS in linear units (outline_fit.hpp). The values were chosen on rendered footage
+// (docs/track.md, "How the tracker was checked"); docs/benchmarks.md gives what they measure.
+#pragma once
+
+#include <cstddef>
+
+namespace uphill::internal {
+
+struct TrackerThresholds {
+  // The second, narrow pass of a fit, around the first one: the first pass lands within about a
+  // pixel, so ±1.5 px holds the outline and keeps the windows small.
+  static constexpr double kNarrowHalfWidthPx = 1.5;
+  // Ceres iterations of that narrow pass after a coarse search (outline_fit.hpp,
+  // FitRequest::iterations): started within a pixel, two iterations reach the minimum.
+  static constexpr int kNarrowIterations = 2;
+  // Ceres iterations of a pass started at a fit of the same frame or at a checked prediction
+  // (within half a pixel or so, where Kaufman's step leaves about a quarter of the offset): the
+  // narrow pass where the model measured the frame before (MeasureNear), both passes of a refit,
+  // and the refit of a frame at the settled row delay.
+  static constexpr int kStartedNearIterations = 1;
+  // Frames without the body after which the motion is no longer predicted: beyond a few frames
+  // the prediction's error exceeds the search window.
+  static constexpr int kHistoryGap = 5;
+  // Samples the prediction's parabola is fitted to: enough to average the centres' noise, few
+  // enough that a change of motion (release, impact) leaves the window quickly.
+  static constexpr std::size_t kHistory = 6;
+  // A scene change: the background residual jumps above this many times its usual level (plus
+  // 0.01): a bumped camera or a changed exposure, far beyond a frame's noise.
+  static constexpr double kSceneChangeFactor = 4;
+  // The usual level is never taken below this: H.264 copies static blocks exactly, so the first
+  // frames of a clip can show no residual at all, and the first key frame would look like a change.
+  static constexpr double kUsualResidualFloor = 0.005;
+  // Frames that confirm a scene or exposure change: one odd frame (a flash, a dropped frame) is not.
+  static constexpr int kConfirmFrames = 3;
+  // The fast path (edge_fit.hpp): edge searches per frame, enough to see the outline all round
+  // with a few lost to the rails.
+  static constexpr int kEdgePoints = 96;
+  // Predicted smear over the exposure, in radii, up to which the fast path is tried (its own
+  // checks deciding), with the exposure known and with it guessed (a 180° shutter): beyond it the
+  // edges' ramps are longer than the edge fit's window and bias its centre.
+  static constexpr double kFastMaxBlur = 0.375, kFastMaxBlurGuessed = 0.5;
+  // Grey levels across the outline below which an edge is too faint for the edge fit.
+  static constexpr double kFastMinContrast = 20;
+  // RMS of the edge points about the fitted outline, px: a body whose edges scatter more is
+  // patterned or occluded, and needs the model.
+  static constexpr double kFastMaxRmsPx = 0.3;
+  // Share of the searched rays that must be inliers for the edge fit to be trusted.
+  static constexpr double kFastMinAgreement = 0.85;
+  // Edge fit against the model at acquisition, px: within this the clip may take the fast path.
+  static constexpr double kFastMaxDisagreementPx = 0.5;
+  // Untrusted fast fits in a row after which the clip takes the model on every frame.
+  static constexpr int kFastDistrust = 3;
+  // Frames between background updates of the whole band: a still scene's background changes
+  // only with the gain, which each frame's normalisation follows.
+  static constexpr int kLearnEvery = 8;
+  // A model fit whose smear measures the exposure: its inlier rays fit within 1.5 noise levels
+  // and are at least this share of the rays (a ball's shadow, the rails' reflections and the
+  // highlight leave 55-75 % of the rays inliers on rendered footage; the exposure is the median
+  // over the frames).
+  static constexpr double kExposureMinAgreement = 0.5;
+  // The rolling shutter's readout, where measured: at the end of the clip the frames fitted at a
+  // delay farther than this share of a whole frame's readout from the clip's are fitted again
+  // (row_delay_settle.hpp).
+  static constexpr double kReadoutNear = 0.2;
+  // The readout's systematic uncertainty, s, added in quadrature to the frames' standard error:
+  // the smear model errs most at the smear's ends, where the shear shows, and that leaks into the
+  // delay the same way on every frame (on global-shutter footage the measured readout lies
+  // within 2.5 u of 0 with it).
+  static constexpr double kReadoutSystematic = 0.003;
+  // The readout is measured on up to kReadoutFrames frames and used from kReadoutMinFrames on:
+  // a median of five resists one bad frame, and more frames add little once the systematic
+  // part dominates.
+  static constexpr std::size_t kReadoutFrames = 15, kReadoutMinFrames = 5;
+};
+
+}  // namespace uphill::internal
