@@ -13,6 +13,7 @@
 
 #include "batch_kernels_avx2.hpp"
 #include "coverage_windows.hpp"
+#include "monte_carlo_avx2.hpp"
 #include "narrow_atan.hpp"
 #include "model/batch_convert.hpp"
 #include "model/gaussian_stream.hpp"
@@ -94,96 +95,6 @@ void AccumulateMoments(OutputStats& s, const double* y, std::size_t n) {
   Neumaier(&s.sum, &s.sum_c, a);
   Neumaier(&s.sum2, &s.sum2_c, b);
 }
-
-// φ's argument T/sqrt(1 + B²), the expression of batch_convert.cpp's AVX2 kernels
-// (batch_kernels_avx2.hpp), so that the angle is the only thing the vector path computes anew; and
-// in the same pass the bounds of B, T and the argument (NaNs skipped), for NarrowAtan::DegreeFor.
-struct Bounds {
-  double lo, hi;
-};
-#if defined(__x86_64__) && defined(__GNUC__)
-#pragma GCC push_options
-#pragma GCC target("avx2,fma")
-void PhiArgumentAvx2(std::size_t n, const double* B, const double* T, double* out, Bounds (&bounds)[3]) {
-  __m256d lo[3], hi[3];
-  for (int k = 0; k < 3; ++k) lo[k] = _mm256_set1_pd(HUGE_VAL), hi[k] = _mm256_set1_pd(-HUGE_VAL);
-  auto extend = [&](int k, __m256d v) {  // a NaN in v yields the second operand: skipped
-    lo[k] = _mm256_min_pd(v, lo[k]);
-    hi[k] = _mm256_max_pd(v, hi[k]);
-  };
-  std::size_t j = 0;
-  for (; j + 4 <= n; j += 4) {
-    const __m256d b = _mm256_loadu_pd(B + j), t = _mm256_loadu_pd(T + j);
-    const __m256d p = avx2::PhiArgument(b, t);
-    _mm256_storeu_pd(out + j, p);
-    extend(0, b);
-    extend(1, t);
-    extend(2, p);
-  }
-  for (int k = 0; k < 3; ++k) {
-    alignas(32) double l[4], h[4];
-    _mm256_store_pd(l, lo[k]);
-    _mm256_store_pd(h, hi[k]);
-    bounds[k] = {std::min(std::min(l[0], l[1]), std::min(l[2], l[3])),
-                 std::max(std::max(h[0], h[1]), std::max(h[2], h[3]))};
-  }
-  for (; j < n; ++j) {
-    out[j] = T[j] / std::sqrt(std::fma(B[j], B[j], 1.0));
-    const double v[3] = {B[j], T[j], out[j]};
-    for (int k = 0; k < 3; ++k) {
-      bounds[k].lo = v[k] < bounds[k].lo ? v[k] : bounds[k].lo;
-      bounds[k].hi = v[k] > bounds[k].hi ? v[k] : bounds[k].hi;
-    }
-  }
-}
-// The common case's model in one pass over a block (OnePass below): per group of four trials B,
-// T, the three angles (NarrowAtan, all three at degree N), x_eq and x_max by the batch kernels'
-// own expressions (batch_kernels_avx2.hpp), nothing going through memory in between. A short
-// tail is padded with the block's first trial.
-template <int N>
-void LineSpheroidOnePassAvx2(std::size_t n, const double* L, const double* H, const double* D, const double* a,
-                             const double* b, const NarrowAtan (&atan)[3], double* const (&out)[5]) {
-  const __m256d one = _mm256_set1_pd(1.0), two = _mm256_set1_pd(2.0);
-  auto group = [&](__m256d l, __m256d h, __m256d d, __m256d va, __m256d vb, __m256d (&y)[5]) {
-    const __m256d B = avx2::TanTheta(h, l), T = avx2::TanHalfAlpha(d, l);
-    y[0] = avx2::Atan<N>(atan[0], B, one);
-    y[1] = avx2::Atan<N>(atan[1], T, two);
-    y[2] = avx2::Atan<N>(atan[2], avx2::PhiArgument(B, T), one);
-    y[3] = avx2::SpheroidXEq(va, vb, B, T);
-    y[4] = avx2::SpheroidXMax(va, vb, T);
-  };
-  std::size_t j = 0;
-  for (; j + 4 <= n; j += 4) {
-    __m256d y[5];
-    group(_mm256_loadu_pd(L + j), _mm256_loadu_pd(H + j), _mm256_loadu_pd(D + j), _mm256_loadu_pd(a + j),
-          _mm256_loadu_pd(b + j), y);
-    for (int k = 0; k < 5; ++k) _mm256_storeu_pd(out[k] + j, y[k]);
-  }
-  if (j < n) {
-    alignas(32) double in[5][4];
-    const double* from[5] = {L, H, D, a, b};
-    for (int k = 0; k < 5; ++k)
-      for (std::size_t t = 0; t < 4; ++t) in[k][t] = from[k][j + t < n ? j + t : 0];
-    __m256d y[5];
-    group(_mm256_load_pd(in[0]), _mm256_load_pd(in[1]), _mm256_load_pd(in[2]), _mm256_load_pd(in[3]),
-          _mm256_load_pd(in[4]), y);
-    for (int k = 0; k < 5; ++k) {
-      alignas(32) double t[4];
-      _mm256_store_pd(t, y[k]);
-      for (std::size_t m = 0; j + m < n; ++m) out[k][j + m] = t[m];
-    }
-  }
-}
-
-// The one pass at degree `degree`, 1 … NarrowAtan::kMaxDegree.
-template <int... N>
-void LineSpheroidOnePassOf(int degree, std::integer_sequence<int, N...>, std::size_t n, const double* L,
-                           const double* H, const double* D, const double* a, const double* b,
-                           const NarrowAtan (&atan)[3], double* const (&out)[5]) {
-  ((degree == N + 1 ? LineSpheroidOnePassAvx2<N + 1>(n, L, H, D, a, b, atan, out) : void()), ...);
-}
-#pragma GCC pop_options
-#endif
 
 // Puts base[r] in place for every rank r of [r_begin, r_end) (distinct, ascending, each inside
 // [first, last)) as std::nth_element would: the middle rank first, then each side within its
@@ -512,9 +423,8 @@ class MonteCarloRun {
     const double* across = Input(Index(InputQuantity::kAcross));
     const double* along = p_.body == BodyKind::kSphere ? across : Input(Index(InputQuantity::kAlong));
     double* const out[5] = {Output(kOutTheta), Output(kOutAlpha), Output(kOutPhi), Output(kOutXEq), Output(kOutXMax)};
-    LineSpheroidOnePassOf(degree, std::make_integer_sequence<int, NarrowAtan::kMaxDegree>{}, n,
-                          Input(Index(InputQuantity::kL)), Input(Index(InputQuantity::kH)),
-                          Input(Index(InputQuantity::kD)), across, along, atan, out);
+    LineSpheroidOnePassAvx2(degree, n, Input(Index(InputQuantity::kL)), Input(Index(InputQuantity::kH)),
+                            Input(Index(InputQuantity::kD)), across, along, atan, out);
     return true;
 #else
     (void)n;
