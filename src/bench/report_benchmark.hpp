@@ -1,4 +1,4 @@
-// `uphill bench report`: the fit report of an experiment whose trials are videos (issue 13):
+// `uphill bench report`: the fit report of an experiment whose trials are videos:
 // 20 trial videos of 1080p, 10 s each (rendered once with exact ground truth into a cache folder
 // outside the repository), reported by the `uphill report` program as a user runs it, against the
 // time to decode all the videos alone, every core used; then a second report of the unchanged

@@ -1,4 +1,4 @@
-// The robustness table of `uphill bench track` (issue 10): the tracker on the ray-traced footage
+// The robustness table of `uphill bench track`: the tracker on the ray-traced footage
 // of src/vision/footage_conditions.hpp, one row per condition, against OpenCV's CSRT, KCF and
 // HoughCircles on the same clips (tools/bench/track_peers.py).
 //

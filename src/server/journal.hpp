@@ -2,7 +2,7 @@
 // journal is read back and checked before it is trusted. ExperimentStore (experiment_store.hpp)
 // decides what to do with what is found. Format: data/README.md, "Journal".
 //
-// Format uphill-journal/2 (written since the hardening of issue 11): a header line
+// Format uphill-journal/2: a header line
 //   {"format":"uphill-journal/2","journal":"<16 hex id>","seq":0,"crc32":"<8 hex>"}
 // then one entry per line, each with `seq` (1, 2, 3, … in the file: a missing or repeated line
 // is a gap) and, as its last member, `crc32`: the CRC-32 (Boost.CRC, the zlib/PNG polynomial) of

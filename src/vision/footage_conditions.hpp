@@ -1,4 +1,4 @@
-// The robustness matrix of the tracker (issue 10): named conditions of the POV-Ray footage
+// The robustness matrix of the tracker: named conditions of the POV-Ray footage
 // (footage_clip.hpp), each a short clip that differs from a baseline in one respect, plus the
 // issue's two failing clips and three clips of bad input.
 //
@@ -23,11 +23,11 @@
 //   cloth                a woven cloth table instead of wood
 //   thin-rails           1 mm wires instead of 8 mm rods
 //   spheroid-band        the paper's yellow spheroid (a = 15.875 mm, b = 25.4 mm) with a dark
-//                        painted band through its rolling axis, on 1 mm wires, 720p60 (issue 10)
+//                        painted band through its rolling axis, on 1 mm wires, 720p60
 //   flicker              mains flicker: 30 % modulation at 100 Hz
 //   ae-drift             automatic exposure drifting ±15 % over 1.5 s
 //   partly-out           the frame's left edge at x ≈ 190 mm: the ball rolls out of the picture
-//   fast-180-30 … fast-360-60   fast family at 1080p, shutter 180°/360° at 30/60 fps (360-30: issue 10)
+//   fast-180-30 … fast-360-60   fast family at 1080p, shutter 180°/360° at 30/60 fps
 //   rolling-shutter      fast 1080p30 180°, rows read over 25 ms
 //   bad-no-body          the apparatus without the body
 //   bad-camera-moved     the camera is bumped at 0.9 s (0.6° turn, 4 mm shift)

@@ -84,7 +84,7 @@
 //    small double count, on the safe side). The release event quotes max(u, se·sqrt(max(1, χ²/ν))).
 // Assumptions: the bias is smooth along the path at the scales tried and of the size the two
 // options state; the model is right (fed the true positions, the fit recovers x0, t0, g to 1e-8).
-// The defaults (0.08 px, 0.015) are calibrated on main's tracker over the 720p clips of the
+// The defaults (0.08 px, 0.015) are calibrated on the tracker over the 720p clips of the
 // robustness matrix (uphill bench track: clean, baseline, cloth, spheroid-band): along the path
 // its error is 0.03–0.07 px at rest (0.12 px on the spheroid) and grows to 0.15–0.2 px at
 // 12.5 px/frame with a 180° shutter (1/500 s: no growth). Footage with a longer shutter, or a
@@ -92,7 +92,7 @@
 // Accuracy (tests/vision_povray_analysis_test.cpp, tests/vision_analysis_test.cpp,
 // docs/analyse-track.md "Accuracy"): on 9 independent POV-Ray clips, |fitted − truth| ≤ 2.7 u for
 // x0, t0, g (pulls 0.2–0.7 on the 720p lab clips, up to 2.2 on the isoluminant ball, 1.4–2.7 on
-// the spheroid main's tracker loses half of, < 0.25 on 320 × 180 clips where the tracker beats
+// the spheroid, whose frames the tracker partly loses, < 0.25 on 320 × 180 clips where the tracker beats
 // the floor: there u is 5–20× the real error); on synthetic tracks with an injected bias of the
 // stated size the pulls' RMS is 0.4–0.7. Without the systematic part the same fits miss by up to
 // 12 se_scaled.

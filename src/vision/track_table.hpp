@@ -1,7 +1,7 @@
 // Track: the ball's measured positions, one row per video frame, as `uphill track` writes them
 // (and `uphill analyse-track` reads them).
 //
-// CSV format (the one `uphill track` writes, issue 5): the header starts exactly with
+// CSV format (the one `uphill track` writes): the header starts exactly with
 //   frame,t,u,v,radius_px,x,z,quality
 // and may have more columns after these (ignored here). frame: integer ≥ 0, strictly increasing;
 // t: seconds from the container's timestamps, finite, strictly increasing; u, v: the projected
