@@ -8,7 +8,7 @@
 #include "commands.hpp"
 #include "app/convert_batch.hpp"
 #include "flag_checks.hpp"
-#include "convert_output.hpp"
+#include "app/conversion_printer.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "model/input_ranges.hpp"

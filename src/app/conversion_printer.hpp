@@ -1,14 +1,16 @@
-// Output of `uphill convert`: a readable table (lab units, each column naming its unit), CSV
-// (the same columns) or JSON (SI, ToJson). Failed rows of a batch appear in every format,
-// with their error, so the output lines up with the input rows.
+// ConversionPrinter: the output formats of `uphill convert` (docs/convert.md): a readable table
+// (lab units, each column naming its unit), CSV (the same columns) or JSON (SI, ToJson). Failed
+// rows of a batch appear in every format, with their error, so the output lines up with the input
+// rows.
 //
 // Rows are printed as they come (a batch of any size is never held): JSON as the elements of one
 // array (from each row's ConversionResult), CSV line by line (from each row's ConversionSummary,
-// numbers written with model/decimal_text.hpp straight into the output buffer); the table holds its first kTableSample rows to size its columns, then
-// prints the rest with those widths (a wider cell shifts its line; an error after the sample, when
-// the sample had none, goes at the end of its line). The optional columns - label, the
-// uncertainties, the rest band, θ0 - are chosen before the first row: for a batch from its header
-// and the flags (ColumnsFor), for one configuration from its result.
+// numbers written with model/decimal_text.hpp straight into the output buffer); the table holds
+// its first kTableSample rows to size its columns, then prints the rest with those widths (a
+// wider cell shifts its line; an error after the sample, when the sample had none, goes at the
+// end of its line). The optional columns - label, the uncertainties, the rest band, θ0 - are
+// chosen before the first row: for a batch from its header and the flags, for one configuration
+// from its result.
 #pragma once
 
 #include <cstddef>
@@ -19,7 +21,7 @@
 
 #include "app/convert_batch.hpp"
 
-namespace uphill::cli {
+namespace uphill {
 
 enum class OutputFormat { kTable, kCsv, kJson };
 
@@ -73,4 +75,4 @@ class ConversionPrinter {
   static constexpr std::size_t kCsvBlock = std::size_t{1} << 16;
 };
 
-}  // namespace uphill::cli
+}  // namespace uphill

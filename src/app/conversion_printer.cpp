@@ -1,4 +1,4 @@
-#include "convert_output.hpp"
+#include "app/conversion_printer.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -12,7 +12,7 @@
 #include "model/decimal_text.hpp"
 #include "model/number_text.hpp"
 
-namespace uphill::cli {
+namespace uphill {
 namespace {
 
 
@@ -298,4 +298,4 @@ void ConversionPrinter::Finish() {
   }
 }
 
-}  // namespace uphill::cli
+}  // namespace uphill
