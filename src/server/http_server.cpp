@@ -27,8 +27,10 @@
 #include "internal/track_api.hpp"
 #include "internal/video_upload.hpp"
 #include "server/row_check.hpp"
-// Last: it includes <httplib.h>, which includes <resolv.h>, whose `_res` macro breaks Eigen.
+// Last: they include <httplib.h>, which includes <resolv.h>, whose `_res` macro breaks Eigen.
 #include "internal/bounded_http_server.hpp"
+#include "internal/http_replies.hpp"
+#include "internal/request_gate.hpp"
 
 namespace uphill {
 namespace {
@@ -36,118 +38,28 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 using nlohmann::ordered_json;
+using internal::ContentType;
+using internal::IsJsonContentType;
+using internal::ParseBody;
+using internal::Refuse;
+using internal::SecurityHeaders;
+using internal::SendError;
+using internal::SendJson;
+using internal::VersionOf;
 
 constexpr std::size_t kMaxReportFileBytes = 64u << 20;
 
-constexpr const char* kPagePolicy =
-    "default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self'; connect-src 'self'; "
-    "form-action 'none'; frame-ancestors 'none'; base-uri 'none'";
 // Report files are documents, not the app: no script at all, their own inline styles, sandboxed.
 constexpr const char* kReportPolicy =
     "default-src 'none'; img-src 'self' data:; style-src 'unsafe-inline'; frame-ancestors 'none'; sandbox";
 
-void SecurityHeaders(httplib::Response& res) {
-  if (!res.has_header("Content-Security-Policy")) res.set_header("Content-Security-Policy", kPagePolicy);
-  if (!res.has_header("Cache-Control")) res.set_header("Cache-Control", "no-store");
-  res.set_header("X-Content-Type-Options", "nosniff");
-  res.set_header("Referrer-Policy", "no-referrer");
-  res.set_header("X-Frame-Options", "DENY");
-}
-
-void SendJson(httplib::Response& res, int status, const ordered_json& body) {
-  res.status = status;
-  // Text that is not UTF-8 never gets this far (422 naming the field); `replace` keeps an answer
-  // an answer even if some did.
-  res.set_content(body.dump(-1, ' ', false, ordered_json::error_handler_t::replace), "application/json; charset=utf-8");
-}
-
-void SendError(httplib::Response& res, int status, const std::string& message, const std::string& field = "") {
-  ordered_json body = {{"error", message}};
-  if (!field.empty()) body["field"] = field;
-  SendJson(res, status, body);
-}
-
-// A request body as JSON. Nesting is bounded: no request of the page is deeper than 4.
-// Marks a byte that is not UTF-8 while the field holding it is looked for: U+FDD0, a
-// noncharacter that no keyboard produces.
-constexpr std::string_view kBadByteMark = "\xEF\xB7\x90";
-
-// The path of the first key or string value that contains the mark, as the API names fields
-// ("row.note", "experiment.body.a"), or "" if none.
-std::string MarkedField(const json& j, const std::string& path) {
-  const auto marked = [](const std::string& s) { return s.find(kBadByteMark) != std::string::npos; };
-  if (j.is_string()) return marked(j.get_ref<const std::string&>()) ? path : "";
-  if (j.is_object())
-    for (const auto& [key, value] : j.items()) {
-      const std::string inner = path.empty() ? key : path + "." + key;
-      if (marked(key)) return inner;
-      if (std::string found = MarkedField(value, inner); !found.empty()) return found;
-    }
-  if (j.is_array())
-    for (std::size_t i = 0; i < j.size(); ++i)
-      if (std::string found = MarkedField(j[i], path + "[" + std::to_string(i) + "]"); !found.empty()) return found;
-  return "";
-}
-
-const json::parser_callback_t kDepthLimit = [](int depth, json::parse_event_t, json&) {
-  if (depth > 16) throw InputError("request", "JSON nested too deeply");
-  return true;
-};
-
-// Text that is not UTF-8 (a Latin-1 paste, a broken client) is refused naming the field that
-// holds it, which JSON's own parser cannot do: the bad bytes are marked, the marked document is
-// parsed, and the field with the mark is named.
-[[noreturn]] void RefuseNotUtf8(const std::string& body) {
-  std::string marked;
-  std::string_view rest = body;
-  for (std::size_t bad; (bad = InvalidUtf8At(rest)) != std::string_view::npos;) {
-    marked.append(rest.substr(0, bad)).append(kBadByteMark);
-    rest.remove_prefix(bad + 1);
-  }
-  marked.append(rest);
-  const json j = json::parse(marked, nullptr, false);
-  std::string field = j.is_discarded() ? "" : MarkedField(j, "");
-  if (field.empty()) field = "request";
-  // The key itself may be the bad text: name it with the mark shown as U+FFFD.
-  for (std::size_t at; (at = field.find(kBadByteMark)) != std::string::npos;) field.replace(at, kBadByteMark.size(), "\xEF\xBF\xBD");
-  throw InputError(field.substr(0, 96), "is not valid UTF-8 text (the page sends UTF-8: retype or paste it again)");
-}
-
-json ParseBody(const httplib::Request& req) {
-  if (req.body.empty()) return json::object();
-  if (InvalidUtf8At(req.body) != std::string_view::npos) RefuseNotUtf8(req.body);
-  return json::parse(req.body, kDepthLimit);
-}
-
-std::int64_t VersionOf(const json& body) {
-  if (!body.is_object() || !body.contains("version") || !body.at("version").is_number_integer())
-    throw std::invalid_argument("version: missing (the version of the state the change was made against)");
-  return body.at("version").get<std::int64_t>();
-}
-
 // The routes whose body is not JSON: uploads, streamed to disk (internal/video_upload.hpp). The
-// pre-routing handler sends every PUT under these prefixes through the upload's checks (its name
-// first), so a name the route's pattern does not match is refused by the name's rule.
-constexpr const char* kVideoUploadPrefix = "/api/videos/";
-constexpr const char* kViewUploadPrefix = "/api/views/";
+// pre-routing handler (internal/request_gate.hpp) sends every PUT under these prefixes through
+// the upload's checks (its name first), so a name the route's pattern does not match is refused
+// by the name's rule.
 constexpr const char* kVideoUploadPattern = R"(/api/videos/([^/]{1,120}))";
 constexpr const char* kViewUploadPattern = R"(/api/views/([^/]{1,120}))";
 
-struct UploadRoute {
-  const internal::UploadKind* kind = nullptr;
-  std::size_t limit = 0;
-  std::string name;  // as decoded from the path
-};
-
-// The upload a request is, or nullopt when it is none.
-std::optional<UploadRoute> UploadRouteOf(const httplib::Request& req, const ServerOptions& options) {
-  if (req.method != "PUT") return std::nullopt;
-  for (const auto& [prefix, kind, limit] :
-       {std::tuple{kVideoUploadPrefix, &internal::VideoUpload(), options.max_upload_bytes},
-        std::tuple{kViewUploadPrefix, &internal::ImageUpload(), options.max_view_upload_bytes}})
-    if (req.path.rfind(prefix, 0) == 0) return UploadRoute{kind, limit, req.path.substr(std::strlen(prefix))};
-  return std::nullopt;
-}
 
 std::string Seconds(std::chrono::milliseconds t) {
   std::ostringstream out;
@@ -178,29 +90,8 @@ bool ValidReportName(const std::string& name) {
   return std::regex_match(name, ok) && name.find("..") == std::string::npos;
 }
 
-// "application/json", optionally with "; charset=utf-8": the only body the API reads. Anything
-// else, "application/jsonx" or "text/plain" included, is refused (a cross-site form cannot send
-// this type without a CORS preflight, which this server never grants).
-bool IsJsonContentType(const std::string& value) {
-  std::string v;
-  for (char c : value)
-    if (c != ' ' && c != '\t') v += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return v == "application/json" || v == "application/json;charset=utf-8";
-}
 
-// Headers whose meaning is lost when they are sent twice (which Host decides the origin check,
-// which length the body has): a request with two of them is refused.
-constexpr const char* kSingleHeaders[] = {"Host", "Origin", "Content-Type", "Content-Length", "Transfer-Encoding"};
 
-std::string ContentType(const std::string& name) {
-  const std::string ext = fs::path(name).extension().string();
-  if (ext == ".html") return "text/html; charset=utf-8";
-  if (ext == ".json") return "application/json; charset=utf-8";
-  if (ext == ".svg") return "image/svg+xml";
-  if (ext == ".png") return "image/png";
-  if (ext == ".jpg" || ext == ".jpeg") return "image/jpeg";
-  return "text/plain; charset=utf-8";  // .md, .gp, .dat, anything else: shown, never run
-}
 
 internal::ConnectionLimits Limits(const ServerOptions& options) {
   internal::ConnectionLimits limits;
@@ -211,16 +102,6 @@ internal::ConnectionLimits Limits(const ServerOptions& options) {
   return limits;
 }
 
-// Refuses a request before its body is read, and closes the connection (the unread body must not
-// be taken for the next request).
-httplib::Server::HandlerResponse Refuse(httplib::Response& res, int status, const std::string& message,
-                                        const std::string& field = "") {
-  SendError(res, status, message, field);
-  SecurityHeaders(res);
-  res.set_header("Connection", "close");
-  internal::BoundedHttpServer::CloseAfterResponse();
-  return httplib::Server::HandlerResponse::Handled;
-}
 
 }  // namespace
 
@@ -311,93 +192,9 @@ struct Server::Impl {
     }
   }
 
-  bool AllowedHost(const httplib::Request& req) const {
-    if (options.host != "127.0.0.1" && options.host != "localhost" && options.host != "::1") return true;
-    const std::string host = req.get_header_value("Host");
-    std::string p = std::to_string(port);
-    p.insert(p.begin(), ':');  // not ":" + ...: GCC 12 gives a false -Wrestrict there
-    if (host.size() <= p.size() || host.compare(host.size() - p.size(), p.size(), p) != 0) return false;
-    const std::string name = host.substr(0, host.size() - p.size());
-    return name == "127.0.0.1" || name == "localhost" || name == "[::1]";
-  }
 
   void Routes() {
-    // Uploads may be large; every other request is held to max_request_bytes before its body is
-    // read (pre-routing handler) and by its connection's byte budget.
-    http.set_payload_max_length(
-        std::max({options.max_request_bytes, options.max_upload_bytes, options.max_view_upload_bytes}));
-
-    // Every request, before its body is read: the headers that decide how it is read and whom it
-    // comes from must be there once, the body must have a length, and it must come from here.
-    http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-      for (const char* name : kSingleHeaders)
-        if (req.get_header_value_count(name) > 1)
-          return Refuse(res, 400, std::string("the ") + name + " header is given more than once: refused");
-      if (req.has_header("Transfer-Encoding"))
-        return Refuse(res, 411, "send the body with a Content-Length (Transfer-Encoding is refused)");
-      if (!AllowedHost(req)) return Refuse(res, 403, "Host header must be this server's loopback address");
-      if (req.method != "GET" && req.method != "HEAD") {
-        const std::string origin = req.get_header_value("Origin");
-        if (!origin.empty() && origin != "http://" + req.get_header_value("Host"))
-          return Refuse(res, 403, "cross-origin change refused");
-        if (const std::optional<UploadRoute> upload = UploadRouteOf(req, options)) {
-          try {
-            internal::CheckUploadName(upload->name, *upload->kind);
-          } catch (const InputError& e) {
-            return Refuse(res, 422, e.what(), e.quantity());
-          }
-          if (req.get_header_value("Content-Type") != "application/octet-stream")
-            return Refuse(res, 415, "an upload must be sent as application/octet-stream");
-          const std::size_t length = req.get_header_value<std::uint64_t>("Content-Length");
-          if (length > upload->limit)
-            return Refuse(res, 413, "the file is larger than the upload limit (" + std::to_string(upload->limit >> 20) + " MiB)");
-          internal::BoundedHttpServer::AllowLargeRequest(length + 32 * 1024, options.upload_deadline,
-                                                         options.upload_idle_timeout);
-          return httplib::Server::HandlerResponse::Unhandled;
-        }
-        if (!IsJsonContentType(req.get_header_value("Content-Type")))
-          return Refuse(res, 415, "changes must be sent as application/json");
-      }
-      if (req.get_header_value<std::uint64_t>("Content-Length") > options.max_request_bytes)
-        return Refuse(res, 413, "request too large (at most " + std::to_string(options.max_request_bytes / 1024) + " KiB)");
-      return httplib::Server::HandlerResponse::Unhandled;
-    });
-    http.set_post_routing_handler([](const httplib::Request&, httplib::Response& res) { SecurityHeaders(res); });
-    http.set_error_handler([this](const httplib::Request&, httplib::Response& res) {
-      if (internal::BoundedHttpServer::RequestOverBudget()) {
-        res.status = 413;
-        res.body.clear();
-      } else if (internal::BoundedHttpServer::RequestTimedOut() && res.body.empty()) {
-        res.status = 408;  // an upload that stalled has said so itself
-      }
-      if (res.body.empty()) {
-        const std::string message =
-            res.status == 413 ? "request too large (at most " + std::to_string(options.max_request_bytes / 1024) + " KiB)"
-            : res.status == 408 ? "request not received in time"
-            : res.status == 404 ? "not found"
-            : res.status == 400 ? "malformed request"
-                                : "error";
-        SendError(res, res.status, message);
-      }
-      // A request that was refused before its body was read, or could not be read: the rest of
-      // the connection cannot be trusted to start a new request.
-      if (res.status == 400 || res.status == 408 || res.status == 411 || res.status == 413 || res.status == 414) {
-        res.set_header("Connection", "close");
-        internal::BoundedHttpServer::CloseAfterResponse();
-      }
-      SecurityHeaders(res);
-    });
-    http.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
-      std::string message = "internal error";
-      try {
-        if (ep) std::rethrow_exception(ep);
-      } catch (const std::exception& e) {
-        message += std::string(": ") + e.what();
-      } catch (...) {
-      }
-      SendError(res, 500, message);
-      SecurityHeaders(res);
-    });
+    internal::GuardRequests(http, options, port);
 
     for (const PageAsset& asset : PageAssets()) {
       const auto serve = [asset](const httplib::Request&, httplib::Response& res) {
