@@ -11,6 +11,7 @@
 
 #include "app/conversion.hpp"
 #include "app/convert_batch.hpp"
+#include "app/row_check.hpp"
 #include "bindings.hpp"
 #include "io/configuration.hpp"
 #include "io/experiment.hpp"
@@ -105,6 +106,14 @@ struct Analysis {
   std::shared_ptr<LoadedExperiment> loaded;
   ExperimentAnalysis analysis;
 };
+
+// An uphill.Experiment as it is, or a folder path read now.
+std::shared_ptr<LoadedExperiment> ExperimentOf(const py::object& experiment) {
+  if (py::isinstance<LoadedExperiment>(experiment)) return experiment.cast<std::shared_ptr<LoadedExperiment>>();
+  auto loaded = std::make_shared<LoadedExperiment>();
+  loaded->experiment = LoadExperiment(py::str(experiment).cast<std::string>());
+  return loaded;
+}
 
 template <typename F>
 py::array_t<double> RowArray(const ExperimentAnalysis& a, F&& value) {
@@ -271,7 +280,8 @@ Rows that cannot be used keep their error (file, row, column, rule); the others 
   py::class_<Analysis>(m, "Analysis", R"(The analysis of an experiment, as `uphill fit EXP` prints it (report/analysis.hpp).
 
 Per usable row (NumPy arrays, file order): theta, alpha (rad), x_eq (X) with u_x_eq (first order)
-and u_x_eq_mc (Monte Carlo), x_max, y and u_y (m). fits: dict method -> FitReport ("ols", "wls",
+and u_x_eq_mc (Monte Carlo), x_max, y and u_y (m); flags: per row a list of dicts (code, field,
+message, severity), the row check's (uphill.check_row) and the Monte Carlo's u_disagrees. fits: dict method -> FitReport ("ols", "wls",
 "york", "robust", "friction"), unavailable: dict method -> reason. friction_vs_line: dict
 (delta_chi2, delta_aic, delta_bic, akaike_weight_friction, verdict). to_json(): `uphill fit EXP --json`.)")
       .def_property_readonly("experiment", [](const Analysis& a) { return a.loaded; })
@@ -292,8 +302,8 @@ and u_x_eq_mc (Monte Carlo), x_max, y and u_y (m). fits: dict method -> FitRepor
                              })
       .def_property_readonly("flags",
                              [](const Analysis& a) {
-                               std::vector<std::vector<std::string>> f;
-                               for (const auto& r : a.analysis.rows) f.push_back(r.flags);
+                               py::list f;
+                               for (const auto& r : a.analysis.rows) f.append(ToPython(FlagsJson(r.flags)));
                                return f;
                              })
       .def_property_readonly("fits",
@@ -329,13 +339,7 @@ and u_x_eq_mc (Monte Carlo), x_max, y and u_y (m). fits: dict method -> FitRepor
       "analyse_experiment",
       [](const py::object& experiment, const py::object& mc_trials, const py::object& seed,
          const py::object& outlier_threshold) {
-        std::shared_ptr<LoadedExperiment> loaded;
-        if (py::isinstance<LoadedExperiment>(experiment)) {
-          loaded = experiment.cast<std::shared_ptr<LoadedExperiment>>();
-        } else {
-          loaded = std::make_shared<LoadedExperiment>();
-          loaded->experiment = LoadExperiment(py::str(experiment).cast<std::string>());
-        }
+        const std::shared_ptr<LoadedExperiment> loaded = ExperimentOf(experiment);
         AnalysisOptions options;
         options.mc_trials = Count(mc_trials, "mc_trials");
         RequireMonteCarloTrials("mc_trials", static_cast<double>(options.mc_trials));
@@ -354,6 +358,32 @@ and u_x_eq_mc (Monte Carlo), x_max, y and u_y (m). fits: dict method -> FitRepor
       R"(Analyses an experiment (a folder path or an uphill.Experiment) as `uphill fit EXP` does: per row
 theta, alpha, X ± u(X) (first order and Monte Carlo with mc_trials per row) against Y ± u(Y), and the
 five fits of Y against X. Returns an uphill.Analysis. InputError when no row is usable.)");
+
+  m.def(
+      "check_row",
+      [](const py::object& experiment, const py::object& row, const std::string& unit) {
+        const std::shared_ptr<LoadedExperiment> loaded = ExperimentOf(experiment);
+        const std::vector<ExperimentRow>& rows = loaded->experiment.rows;
+        const ExperimentRow* chosen = nullptr;
+        if (py::isinstance<py::str>(row)) {
+          const std::string trial = row.cast<std::string>();
+          for (const ExperimentRow& r : rows)
+            if (r.trial == trial && !chosen) chosen = &r;
+          if (!chosen) throw InputError("row", "no row has the trial label '" + trial + "'");
+        } else {
+          const std::uint64_t index = Count(row, "row");
+          if (index >= rows.size())
+            throw InputError("row", "must be an index of the experiment's rows, 0 to " + std::to_string(rows.size() - 1) +
+                                        " (got " + std::to_string(index) + ")");
+          chosen = &rows[index];
+        }
+        return ToPython(RowCheckJson(CheckRow(loaded->experiment, *chosen), unit));
+      },
+      py::arg("experiment"), py::arg("row"), py::kw_only(), py::arg("unit") = "m",
+      R"(The row check the page, `uphill fit` and `uphill report` show (app/row_check.hpp): row is an index
+into experiment.rows or a trial label of an experiment (a folder path or an uphill.Experiment). Returns
+a dict: theta_deg, alpha_deg, x, u_x, x_max, crossbar, y, u_y, residual (lengths in `unit`, None when
+unknown) and flags, a list of dicts code, field, message, severity.)");
 
   m.def(
       "read_xy",

@@ -71,6 +71,17 @@ TEST(Experiment, BadRowsAreNamedAndTheOthersKept) {
   EXPECT_EQ(errors[3], csv + ", row 6, column D_mm: must be > 0 (got -0.14999999999999999)");
   EXPECT_EQ(e.UsableRows().size(), 2u);
   EXPECT_EQ(e.UsableRows()[1]->trial, "t6");
+  // Where a page marks each error, and the cells kept for a row check (SI, from the CSV's text).
+  EXPECT_EQ(e.rows[1].error_column, "trial");
+  EXPECT_EQ(e.rows[2].error_column, "D");
+  EXPECT_EQ(e.rows[3].error_column, "Y");
+  EXPECT_EQ(e.rows[4].error_column, "D");
+  EXPECT_EQ(e.rows[0].error_column, "");
+  EXPECT_DOUBLE_EQ(e.rows[4].cells.at("D"), -0.15);
+  EXPECT_DOUBLE_EQ(e.rows[3].cells.at("L"), 1.165);
+  EXPECT_EQ(e.rows[3].cells.count("Y"), 0u);  // 'abc'
+  EXPECT_EQ(e.rows[2].cells.count("D"), 0u);  // empty
+  EXPECT_EQ(e.column_units.at("D"), "mm");
 }
 
 TEST(Experiment, FolderLevelProblemsThrowWithTheFileAndKey) {

@@ -35,11 +35,7 @@ using uphill::testing::Row;  // the sample row, not the state's Row
 
 class ServerTest : public ServerFixture {
  protected:
-  static std::vector<std::string> Codes(const json& check) {
-    std::vector<std::string> codes;
-    for (const json& f : check["flags"]) codes.push_back(f["code"]);
-    return codes;
-  }
+  static std::vector<std::string> Codes(const json& check) { return FlagCodes(check); }
   static bool Has(const std::vector<std::string>& codes, const std::string& code) {
     return std::find(codes.begin(), codes.end(), code) != codes.end();
   }

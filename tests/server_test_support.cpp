@@ -26,6 +26,12 @@ json ExperimentMetadata() {
           {"uncertainties", {{"L", "1 mm"}, {"H", "0.5 mm"}, {"D", "0.2 mm"}, {"Y", "0.5 mm"}}}};
 }
 
+std::vector<std::string> FlagCodes(const json& check) {
+  std::vector<std::string> codes;
+  for (const json& f : check["flags"]) codes.push_back(f["code"]);
+  return codes;
+}
+
 json Row(const std::string& trial, double D, double Y) {
   char d[32], y[32];
   std::snprintf(d, sizeof d, "%g", D);

@@ -14,6 +14,7 @@
 #include <string>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "server/http_server.hpp"
 // Last: <httplib.h> includes <resolv.h>, whose `_res` macro breaks Eigen.
@@ -35,6 +36,9 @@ json ExperimentMetadata();
 // A plausible row of series 2 (L = 1165 mm, D varied). X is 389.8 mm at D = 150 mm, 289.7 at
 // 200, 229.1 at 250 (the fall-off 5-8 mm further): Y a little beyond X.
 json Row(const std::string& trial, double D = 150, double Y = 392);
+
+// The codes of a check's flags ({"flags":[{"code"…}]}, src/server/row_check.hpp), in order.
+std::vector<std::string> FlagCodes(const json& check);
 
 // A TCP connection to 127.0.0.1:port, its descriptor (the caller closes it), or -1.
 int ConnectLoopback(int port);

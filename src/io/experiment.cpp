@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <utility>
 
 #include "io/contained_directory.hpp"
 #include "io/csv_table.hpp"
@@ -163,11 +164,17 @@ void ReadVideoCells(const Experiment& e, const CsvTable& table, int row_number, 
 
 Experiment LoadExperiment(const std::string& directory) {
   ExperimentFolder folder = ReadExperimentJson(directory);
+  // Required here (the page may create a folder before its first row; an analysis needs rows).
+  const CsvTable table = ReadCsvFile(folder.csv_path);
+  return ParseExperiment(std::move(folder), table);
+}
+
+Experiment ParseExperiment(ExperimentFolder folder, const CsvTable& table) {
   const std::string& json_path = folder.json_path;
   const std::string& csv_path = folder.csv_path;
   Experiment e;
-  e.directory = directory;
-  e.metadata = std::move(folder.metadata);
+  e.directory = folder.directory;
+  e.metadata = std::move(folder.metadata);  // moved: a copy recurses once per nesting level
   const json& meta = e.metadata;
   CheckKeys(meta, ExperimentKeys(), json_path);
   if (meta.contains("format") && meta.at("format") == kExperimentFormat2) {
@@ -205,8 +212,6 @@ Experiment LoadExperiment(const std::string& directory) {
                                      {&apparatus, "apparatus"}, {&defaults, "uncertainties"}})
     for (const auto& [key, value] : object->items()) Text(value, json_path + ": " + name + "." + key);
 
-  // Required here (the page may create a folder before its first row; an analysis needs rows).
-  const CsvTable table = ReadCsvFile(csv_path);
   std::map<std::string, int> column;  // quantity -> column index
   for (size_t i = 0; i < table.header.size(); ++i) {
     const std::string base = SplitUnitSuffix(table.header[i]).first;
@@ -217,6 +222,7 @@ Experiment LoadExperiment(const std::string& directory) {
       throw InputError(where, "'" + base + "' is text: its header has no unit");
     if (!column.emplace(base, static_cast<int>(i)).second)
       throw InputError(where, "gives '" + base + "' a second time");
+    if (Contains(MeasurementQuantities(), base)) e.column_units[base] = SplitUnitSuffix(table.header[i]).second;
     if (apparatus.contains(base))
       throw InputError(where, "'" + base + "' is also a constant in experiment.json (apparatus." + base +
                                   "): give it in one place only");
@@ -234,6 +240,18 @@ Experiment LoadExperiment(const std::string& directory) {
       auto it = column.find(name);
       return it == column.end() || !csv_row.error.empty() ? "" : csv_row.cells[it->second];
     };
+    // Which column an error names: its cell's context, as CellContext writes it.
+    std::map<std::string, std::string> column_of_context;
+    for (const auto& [name, index] : column) column_of_context[CellContext(table, row.row, table.header[index])] = name;
+    if (csv_row.error.empty())
+      for (const std::string& q : MeasurementQuantities())
+        if (const auto it = column.find(q); it != column.end()) try {
+            const std::string& text = csv_row.cells[it->second];
+            if (text.find_first_not_of(" \t") != std::string::npos)
+              row.cells[q] = ParseQuantity(text, Dimension::kLength, q, SplitUnitSuffix(table.header[it->second]).second);
+          } catch (const InputError&) {
+            // the configuration's parse below names it
+          }
     try {
       if (!csv_row.error.empty()) throw InputError(csv_path + ", row " + std::to_string(row.row), csv_row.error);
       row.trial = cell("trial");
@@ -302,6 +320,8 @@ Experiment LoadExperiment(const std::string& directory) {
       }
     } catch (const InputError& err) {
       row.error = err.what();
+      if (const auto it = column_of_context.find(err.quantity()); it != column_of_context.end())
+        row.error_column = it->second;
       row.configuration.reset();
     }
     e.rows.push_back(std::move(row));

@@ -46,6 +46,12 @@ struct ExperimentRow {
   std::string video;  // version 2: the recording, relative to the folder ("" none)
   std::string scene;  // version 2: the name of its scene in Experiment::scenes ("" when no video)
   std::string error;  // one line: file, row, column, rule
+  // The column the error is about (its quantity or label: "D", "Y", "trial", "video"…), or ""
+  // when it names experiment.json or the whole record: where a page puts the mark.
+  std::string error_column;
+  // The row's length cells (L, H, D, Y, u_L…) that parse, SI, kept even when the row has an
+  // error: a row check (report/row_check.hpp) can then say which value looks wrong.
+  std::map<std::string, double> cells;
 
   bool HasY() const { return Y.value > 0.0; }
 };
@@ -65,6 +71,8 @@ struct Experiment {
   std::string camera;                         // version 2: camera file, relative ("" none)
   std::map<std::string, std::string> scenes;  // version 2: scene name -> scene file, relative
   VideoAnalysisSettings video_analysis;
+  // Quantity -> the unit its header names ("mm" for `D_mm`); "" when every cell names its own.
+  std::map<std::string, std::string> column_units;
   std::vector<ExperimentRow> rows;
 
   // Rows without an error and with a Y (typed, or filled in from the video).
@@ -79,5 +87,9 @@ struct Experiment {
 // a path that leaves the folder, a quantity given twice, or a missing Y column. A bad `video` or
 // `scene` cell, or an empty Y without a video, is the row's error.
 Experiment LoadExperiment(const std::string& directory);
+
+// The same from files already read (experiment_folder.hpp), e.g. a page's state written to text:
+// `measurements` is the folder's measurements.csv. Throws as LoadExperiment does.
+Experiment ParseExperiment(ExperimentFolder folder, const CsvTable& measurements);
 
 }  // namespace uphill

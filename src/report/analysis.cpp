@@ -12,12 +12,6 @@
 namespace uphill {
 namespace {
 
-std::string Mm(double metres) {
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "%.1f mm", metres * 1e3);
-  return buffer;
-}
-
 template <typename Fit>
 FitOutcome TryFit(const std::string& method, const std::string& title, Fit fit) {
   FitOutcome outcome{method, title, std::nullopt, ""};
@@ -29,7 +23,7 @@ FitOutcome TryFit(const std::string& method, const std::string& title, Fit fit) 
   return outcome;
 }
 
-AnalysedRow AnalyseRow(const ExperimentRow& row, const AnalysisOptions& options) {
+AnalysedRow AnalyseRow(const ExperimentRow& row, const RowCheck& check, const AnalysisOptions& options) {
   const Configuration& c = *row.configuration;
   const Scene scene = c.MakeScene();
   AnalysedRow r;
@@ -52,13 +46,8 @@ AnalysedRow AnalyseRow(const ExperimentRow& row, const AnalysisOptions& options)
   for (const double v : {r.x_eq, r.u_x_eq, r.u_x_eq_mc, r.x_max, r.theta, r.alpha})
     if (!std::isfinite(v))
       throw InputError("the setting", "the model's X or its uncertainty is not a finite number for these values");
-  if (const auto crossbar = c.CrossbarDistance(); crossbar && r.x_eq > *crossbar)
-    r.flags.push_back("X beyond the crossbar (" + Mm(*crossbar) + ")");
-  // Measured values scatter: flag only departures beyond two combined standard uncertainties.
-  const double u = 2 * std::hypot(r.u_y, r.u_x_eq);
-  if (r.y > r.x_max + u) r.flags.push_back("Y beyond the fall-off x_max = " + Mm(r.x_max) + " (by > 2u): impossible");
-  if (r.y < r.x_eq - u) r.flags.push_back("Y below X by > 2u: the body cannot rest there");
-  if (r.u_disagrees) r.flags.push_back("u(X): first order and Monte Carlo differ by > 5 %");
+  r.flags = check.flags;
+  if (r.u_disagrees) r.flags.push_back(UncertaintyDisagreement());
   return r;
 }
 
@@ -74,9 +63,10 @@ ExperimentAnalysis AnalyseExperiment(const Experiment& experiment, const Analysi
   ExperimentAnalysis a;
   a.experiment = &experiment;
   a.row_errors = experiment.Errors();
+  const std::vector<RowCheck> checks = CheckRows(experiment);
   for (const ExperimentRow* row : experiment.UsableRows()) {
     try {
-      a.rows.push_back(AnalyseRow(*row, options));
+      a.rows.push_back(AnalyseRow(*row, checks[static_cast<std::size_t>(row - experiment.rows.data())], options));
     } catch (const InputError& e) {
       a.row_errors.push_back(experiment.directory + "/measurements.csv, row " + std::to_string(row->row) +
                              ": " + e.what());

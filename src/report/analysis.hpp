@@ -2,7 +2,7 @@
 //
 // For each usable row of an experiment: the rails' angles, the theoretical equilibrium X with its
 // standard uncertainty (first order and Monte Carlo, model/propagation.hpp), the measured Y ± u(Y),
-// and plain-language flags. Then the fits of Y against X (fit/): ordinary least squares (the
+// and the row check's flags (row_check.hpp, the same the page shows) with the Monte Carlo's own. Then the fits of Y against X (fit/): ordinary least squares (the
 // paper's), weighted least squares with u(Y), errors in both variables (York) with u(X) and u(Y),
 // a robust Huber fit, and the physical friction model Y = x_rest(μ) compared with the straight
 // line by χ², AIC and BIC. A fit that cannot be made (too few rows, all X equal, missing
@@ -16,6 +16,7 @@
 #include "fit/fit_report.hpp"
 #include "fit/friction_fit.hpp"
 #include "io/experiment.hpp"
+#include "report/row_check.hpp"
 #include "report/video_trials.hpp"
 
 namespace uphill {
@@ -33,7 +34,9 @@ struct AnalysedRow {
   bool u_disagrees = false;                  // first order and MC differ by > 5 %
   double x_max = 0;                          // m
   double y = 0, u_y = 0;                     // m
-  std::vector<std::string> flags;            // e.g. "X beyond the crossbar", "Y > x_max"
+  // The row check's warnings (row_check.hpp: y_below_x, x_beyond_crossbar, …), then
+  // u_disagrees when the Monte Carlo's u(X) differs from the first order's.
+  std::vector<RowFlag> flags;
 };
 
 // One fit: its report, or why it could not be made.

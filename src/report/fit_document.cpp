@@ -86,7 +86,7 @@ Table RowTable(const ExperimentAnalysis& a) {
                                     Mm(r.u_x_eq, "%.3f"), Mm(r.u_x_eq_mc, "%.3f"), Mm(r.y), Mm(r.u_y, "%.3f"),
                                     Mm(r.y - r.x_eq)};
     std::string flags;
-    for (const auto& f : r.flags) flags += (flags.empty() ? "" : "; ") + f;
+    for (const RowFlag& f : r.flags) flags += (flags.empty() ? "" : "; ") + f.message;
     if (ols && ols->report) {
       row.push_back(Mm(ols->report->rows[i].residual));
       if (ols->report->rows[i].outlier) flags += std::string(flags.empty() ? "" : "; ") + "OLS outlier";

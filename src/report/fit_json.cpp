@@ -170,7 +170,7 @@ ordered_json AnalysisToJson(const ExperimentAnalysis& a) {
     ordered_json row = {{"trial", r.source->trial}, {"series", r.source->series}, {"csv_row", r.source->row},
                         {"theta", r.theta}, {"alpha", r.alpha}, {"x_eq", r.x_eq}, {"u_x_eq", r.u_x_eq},
                         {"u_mc_x_eq", r.u_x_eq_mc}, {"x_max", r.x_max}, {"y", r.y}, {"u_y", r.u_y},
-                        {"flags", r.flags}};
+                        {"flags", FlagsJson(r.flags)}};
     ordered_json residuals = ordered_json::object();
     for (const FitOutcome& f : a.fits)
       if (f.report && i < f.report->rows.size())

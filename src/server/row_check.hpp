@@ -1,62 +1,40 @@
-// CheckRow: what the page shows beside a row as it is typed — the model's θ, α and X ± u(X)
-// (first-order propagation only: microseconds, so every keystroke can ask), the residual Y − X,
-// and flags for the mistakes technicians make. The server computes these; the page's own checks
-// are only a convenience.
-//
-// Flags (code, field, message; severity "error" when the row cannot be analysed as typed):
-//   invalid            the configuration or Y cannot be made (ParseConfiguration's message)
-//   implausible        a value outside what the apparatus can be: L ∉ [50 mm, 5 m], H ∉ [0, 2 m]
-//                      or H ≥ L, D ∉ [3 mm, 1 m], Y ∉ (0, 5 m]
-//   unit_mixup         a value that looks typed in another unit: within a factor 1.6 of 1/25.4
-//                      (inches in a mm field) or 1.45 of 1/10 (cm in a mm field) times the other
-//                      rows' median of that column (for Y: times X); without a reference, a value
-//                      that is implausible while read as inches it is not
-//   y_far              |Y − X| > 3·sqrt(u(X)² + u(Y)²) and > 20 % of X: far from the prediction
-//   y_beyond_fall_off  Y > x_max: the body would have fallen through
-//   x_beyond_crossbar  X > L (horizontal): the apparatus cannot show the effect
-//   duplicate_trial    another row has this trial label (the report would drop one)
-//   duplicate_row      another row has the same L, H, D and Y (typed twice?)
+// The page's row checks: what the page shows beside a row as it is typed. The server does not
+// judge rows itself: it writes its state as the folder's files would be (experiment.json,
+// measurements.csv), reads them back as `uphill fit` does (io/experiment.hpp) and asks the one
+// row check (app/row_check.hpp; rules and thresholds in report/row_check.hpp), so the page, fit,
+// report and Python flag the same rows with the same codes and words. Messages name the file,
+// row and column ("measurements.csv, row 3, column D_mm: …").
 //
 // The fit summary is the ordinary least-squares line Y = k·X + c (fit/least_squares_line.hpp)
-// over the rows whose X could be computed, with the usual (scaled) standard errors.
+// over the rows whose X and Y are known, with the usual (scaled) standard errors.
 #pragma once
 
-#include <cstdint>
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <string>
-#include <vector>
 
+#include "app/row_check.hpp"
 #include "io/configuration.hpp"
+#include "io/experiment.hpp"
 #include "server/experiment_state.hpp"
 
 namespace uphill {
-
-struct RowFlag {
-  std::string code, field, message;
-  bool error = false;
-};
-
-struct RowCheck {
-  // SI (m, rad); empty when they cannot be computed.
-  std::optional<double> theta, alpha, x_eq, u_x_eq, x_max, crossbar, y, u_y;
-  std::vector<RowFlag> flags;
-};
 
 // The row's setting (body, rails, rods) from its cells and the experiment's constants. Throws
 // InputError naming the field.
 Configuration RowConfiguration(const ExperimentState& state, const Row& row);
 
-// Checks `row` against the experiment and the stored rows (a stored row with the same id is not
-// compared with itself). Never throws for bad input: that becomes a flag.
+// The state as the experiment reader sees its files (directory ""), rows in the state's order.
+// Throws InputError when there is no experiment yet or its files cannot be read.
+Experiment StateExperiment(const ExperimentState& state);
+
+// Checks `row` as it would stand in the state: in place of the stored row with its id, or after
+// the others (a new row). Never throws for bad input: that becomes an `invalid` flag.
 RowCheck CheckRow(const ExperimentState& state, const Row& row);
 
-// JSON for the page, lengths in the experiment's unit and angles in degrees:
-//   {"theta_deg","alpha_deg","x","u_x","x_max","crossbar","y","residual","flags":[{code,field,
-//    message,severity}]}, absent numbers as null.
+// RowCheckJson (app/row_check.hpp) in the experiment's unit.
 nlohmann::ordered_json ToJson(const RowCheck& check, const std::string& unit);
 
-// Every row's check (keyed by row id, in row order) and the OLS fit of the computable rows:
+// Every row's check (keyed by row id, in row order) and the OLS fit of the rows with X and Y:
 //   {"checks":[{"id":..,<ToJson>}...],"fit":{"n","slope","intercept","u_slope","u_intercept",
 //    "r_squared","residual_sd"} or {"n","unavailable":reason}}; fit lengths in `unit`.
 nlohmann::ordered_json CheckAll(const ExperimentState& state);

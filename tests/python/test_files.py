@@ -48,6 +48,39 @@ def test_a_bad_row_is_kept_with_its_error(tmp_path):
     assert len(analysis.y) == len(lines) - 2 and analysis.row_errors
 
 
+ROW_CHECK_JSON = {"format": "uphill-experiment/1",
+                  "body": {"type": "spheroid", "a": "15.875 mm", "b": "25.4 mm"},
+                  "apparatus": {"H": "300 mm", "L_convention": "horizontal"},
+                  "uncertainties": {"L": "1 mm", "H": "0.5 mm", "D": "0.2 mm", "Y": "0.5 mm"}}
+
+
+def test_check_row_flags_as_fit_and_the_page_do(tmp_path):
+    """The one row check (app/row_check.hpp) through Python, the analysis and `uphill fit --json`:
+    the issue's Y below X (L = 906 mm, D = 165 mm: X = 274.9 mm by the closed form of
+    docs/physics.md, "Lab shortcut"; Y = 270 mm) and a Y typed in cm, same codes and words."""
+    folder = tmp_path / "exp"
+    folder.mkdir()
+    (folder / "experiment.json").write_text(json.dumps(ROW_CHECK_JSON))
+    (folder / "measurements.csv").write_text("trial,L_mm,D_mm,Y_mm\nbelow,906,165,270\ncm,906,165,27.55\n")
+    x = 906 * (2 * 25.4 / 165) / (1 + (15.875 * 165 / (2 * 25.4 * 300)) ** 2) ** 0.5
+    below = uphill.check_row(str(folder), "below", unit="mm")
+    assert below["x"] == pytest.approx(x, rel=1e-12)
+    assert [f["code"] for f in below["flags"]] == ["y_below_x"]
+    assert "the body cannot rest there" in below["flags"][0]["message"]
+    cm = uphill.check_row(uphill.read_experiment(str(folder)), 1)
+    assert [f["code"] for f in cm["flags"]] == ["unit_mixup"] and cm["flags"][0]["field"] == "Y"
+    assert cm["x"] == pytest.approx(x / 1000, rel=1e-12)  # the default unit: m
+    analysis = uphill.analyse_experiment(str(folder))  # as `uphill fit`: 10^5 Monte Carlo trials
+    assert analysis.flags == [below["flags"], cm["flags"]]
+    status, out, err = run_cli("fit", folder, "--json")
+    assert status == 0, err
+    assert [r["flags"] for r in json.loads(out)["rows"]] == [below["flags"], cm["flags"]]
+    with pytest.raises(uphill.InputError, match="no row has the trial label 'nope'"):
+        uphill.check_row(str(folder), "nope")
+    with pytest.raises(uphill.InputError, match="row: must be an index"):
+        uphill.check_row(str(folder), 2)
+
+
 @pytest.fixture(scope="module")
 def clip(tmp_path_factory):
     out = tmp_path_factory.mktemp("clip")

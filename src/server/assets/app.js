@@ -5,7 +5,7 @@
 
 const QUANTITIES = ['L', 'H', 'D', 'Y'];
 const FLAG_LABELS = {
-  invalid: 'invalid', implausible: 'range?', unit_mixup: 'units?', y_far: 'Y far from X',
+  invalid: 'invalid', implausible: 'range?', unit_mixup: 'units?', y_below_x: 'Y < X', y_far: 'Y far from X',
   y_beyond_fall_off: 'Y > x_max', x_beyond_crossbar: 'X > crossbar',
   duplicate_trial: 'same label', duplicate_row: 'duplicate',
 };
