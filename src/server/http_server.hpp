@@ -10,6 +10,7 @@
 //   POST   /api/undo                      {version}: undo the last change
 //   POST   /api/check                     {row}: check a draft row (nothing stored)
 //   POST   /api/report                    {}: write the fit report to EXP/report/
+//   POST   /api/fit-xy                    {method, x, y, u_x?, u_y?}: `uphill fit --xy --json`'s JSON
 //   GET    /report/<name>                 a file of EXP/report/, read-only
 // Videos and calibration (internal/calibration_api.hpp says what each answers):
 //   GET    /api/videos                    the video files in the folder
