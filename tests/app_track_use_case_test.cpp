@@ -113,6 +113,28 @@ TEST_F(TrackUseCase, TheClipIsTrackedAlikeThroughEveryFront) {
   }
 }
 
+// AnalyseExperimentFolder (app/experiment_folder_analysis.hpp) of a folder with a video: the
+// program, the page's report and Python's analyse_experiment track it and analyse alike.
+TEST_F(TrackUseCase, AFolderWithTheClipIsAnalysedAlikeThroughEveryFront) {
+  Stop();
+  std::ofstream(dir_ / "measurements.csv") << "trial,Y_mm,video\na,,clip.mp4\nb,390,\nc,394,\n";
+  Start();
+  const CommandResult cli = RunUphill("fit " + dir_.string() + " --json --quiet --mc-trials 1000");
+  ASSERT_FALSE(cli.out.empty()) << cli.err;
+  const json from_cli = WithoutTimes(json::parse(cli.out));
+  const json from_python = WithoutTimes(PythonJson(dir_, "import json, uphill\n"
+                                                         "a = uphill.analyse_experiment('" + dir_.string() +
+                                                             "', mc_trials=1000)\n"
+                                                         "print(json.dumps(a.to_json()))\n"));
+  const auto [status, answer] = Send("POST", "/api/report", json::object());  // the fixture's 1000 trials
+  ASSERT_EQ(status, 200) << answer.dump();
+  const json from_http = WithoutTimes(json::parse(ReadBytes(dir_ / "report" / "fit.json")));
+  // Trial a's Y is the clip's rest position: all three rows are analysed.
+  EXPECT_EQ(from_cli.at("rows").size(), 3u) << cli.out;
+  EXPECT_EQ(from_cli, from_http);
+  EXPECT_EQ(from_cli, from_python);
+}
+
 TEST_F(TrackUseCase, ADoubleConeIsRefusedInTheSameWords) {
   const std::string refusal = std::string("body: ") + kDoubleConeRefusal;
   const CommandResult cli = RunUphill(TrackFlags(kDoubleCone));

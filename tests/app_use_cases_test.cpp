@@ -39,18 +39,6 @@ Norris ReadNorris() {
   return n;
 }
 
-// A fit's or an analysis' JSON without the solvers' wall-clock times (solver.seconds), the one
-// entry that is not a result of the input.
-json WithoutTimes(json j) {
-  if (j.is_object()) {
-    if (j.contains("solver") && j["solver"].is_object()) j["solver"].erase("seconds");
-    for (auto& [key, value] : j.items()) value = WithoutTimes(value);
-  } else if (j.is_array()) {
-    for (auto& value : j) value = WithoutTimes(value);
-  }
-  return j;
-}
-
 // The keys of `uphill fit --xy --json` that carry the fit's numbers (docs/fit.md).
 void ExpectSameFit(const json& a, const json& b, const std::string& front) {
   for (const char* key : {"slope", "intercept", "u_slope", "u_intercept", "chi2", "dof", "n"})

@@ -36,4 +36,16 @@ inline nlohmann::json PythonJson(const std::filesystem::path& folder, const std:
   return nlohmann::json::parse(last.empty() ? "null" : last);
 }
 
+// A fit's or an analysis' JSON without the solvers' wall-clock times (solver.seconds), the one
+// entry that is not a result of the input.
+inline nlohmann::json WithoutTimes(nlohmann::json j) {
+  if (j.is_object()) {
+    if (j.contains("solver") && j["solver"].is_object()) j["solver"].erase("seconds");
+    for (auto& [key, value] : j.items()) value = WithoutTimes(value);
+  } else if (j.is_array()) {
+    for (auto& value : j) value = WithoutTimes(value);
+  }
+  return j;
+}
+
 }  // namespace uphill::testing
