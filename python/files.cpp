@@ -1,6 +1,6 @@
 // Units (io/units.hpp), one setting converted as `uphill convert` does (io/conversion.hpp),
-// experiment folders and their analysis (io/experiment.hpp, report/analysis.hpp), X-Y tables
-// (io/xy_table.hpp).
+// experiment folders and their analysis as `uphill fit EXP` makes it, videos tracked
+// (app/experiment_folder_analysis.hpp), X-Y tables (io/xy_table.hpp).
 #include <pybind11/stl.h>
 
 #include <algorithm>
@@ -11,6 +11,7 @@
 
 #include "app/conversion.hpp"
 #include "app/convert_batch.hpp"
+#include "app/experiment_folder_analysis.hpp"
 #include "app/row_check.hpp"
 #include "bindings.hpp"
 #include "io/configuration.hpp"
@@ -97,21 +98,23 @@ py::dict ConfigurationToPython(const Configuration& c) {
   return d;
 }
 
-// An experiment folder, read once; its analysis refers into it, so both live here together.
+// An experiment folder, read once; an analysis refers into the experiment it was made of (with
+// the videos' rest positions as Y), which it keeps alive.
 struct LoadedExperiment {
-  Experiment experiment;
+  std::shared_ptr<Experiment> experiment;
 };
 
 struct Analysis {
   std::shared_ptr<LoadedExperiment> loaded;
   ExperimentAnalysis analysis;
+  std::vector<std::string> trial_errors;
 };
 
 // An uphill.Experiment as it is, or a folder path read now.
 std::shared_ptr<LoadedExperiment> ExperimentOf(const py::object& experiment) {
   if (py::isinstance<LoadedExperiment>(experiment)) return experiment.cast<std::shared_ptr<LoadedExperiment>>();
   auto loaded = std::make_shared<LoadedExperiment>();
-  loaded->experiment = LoadExperiment(py::str(experiment).cast<std::string>());
+  loaded->experiment = std::make_shared<Experiment>(LoadExperiment(py::str(experiment).cast<std::string>()));
   return loaded;
 }
 
@@ -182,8 +185,8 @@ void BindFiles(py::module_& m) {
         }
         return ToPython(json);
       },
-      py::kw_only(), py::arg("mu") = py::none(), py::arg("at_x") = py::none(), py::arg("mc_trials") = 1000000,
-      py::arg("seed") = 20261121, py::arg("length_unit") = "mm",
+      py::kw_only(), py::arg("mu") = py::none(), py::arg("at_x") = py::none(),
+      py::arg("mc_trials") = kConvertMonteCarloTrials, py::arg("seed") = kConvertSeed, py::arg("length_unit") = "mm",
       R"(One setting converted exactly as `uphill convert ... --json` does (app/conversion.hpp): returns
 that JSON as a dict (SI units: m, rad; keys as documented for the command: theta, alpha, phi, x_eq,
 z_eq, x_max, x_low, rolls_up, points, x_rest, x_rest_low, u_<key>, u_mc_<key>, verdict, ...).
@@ -220,7 +223,7 @@ default) as for the command.)");
         return out;
       },
       py::arg("path"), py::kw_only(), py::arg("mu") = py::none(), py::arg("at_x") = py::none(),
-      py::arg("mc_trials") = 1000000, py::arg("seed") = 20261121,
+      py::arg("mc_trials") = kConvertMonteCarloTrials, py::arg("seed") = kConvertSeed,
       R"(A batch CSV converted as `uphill convert --batch PATH --json` does (app/convert_batch.hpp): one
 configuration per row (format: docs/convert.md), keyword arguments as convert_setting's fields give
 the defaults for absent columns and empty cells. Returns a list with a dict per row: "row" (the
@@ -232,18 +235,18 @@ file as a whole (unreadable, an unknown column, no rows).)");
                                                                   R"(An experiment folder (format uphill-experiment/1, data/README.md), read once.
 
 Rows that cannot be used keep their error (file, row, column, rule); the others are loaded.)")
-      .def_property_readonly("directory", [](const LoadedExperiment& e) { return e.experiment.directory; })
-      .def_property_readonly("title", [](const LoadedExperiment& e) { return e.experiment.title; })
-      .def_property_readonly("operator", [](const LoadedExperiment& e) { return e.experiment.operator_name; })
-      .def_property_readonly("date", [](const LoadedExperiment& e) { return e.experiment.date; })
-      .def_property_readonly("notes", [](const LoadedExperiment& e) { return e.experiment.notes; })
-      .def_property_readonly("metadata", [](const LoadedExperiment& e) { return ToPython(e.experiment.metadata); },
+      .def_property_readonly("directory", [](const LoadedExperiment& e) { return e.experiment->directory; })
+      .def_property_readonly("title", [](const LoadedExperiment& e) { return e.experiment->title; })
+      .def_property_readonly("operator", [](const LoadedExperiment& e) { return e.experiment->operator_name; })
+      .def_property_readonly("date", [](const LoadedExperiment& e) { return e.experiment->date; })
+      .def_property_readonly("notes", [](const LoadedExperiment& e) { return e.experiment->notes; })
+      .def_property_readonly("metadata", [](const LoadedExperiment& e) { return ToPython(e.experiment->metadata); },
                              "experiment.json as read (a dict).")
       .def_property_readonly(
           "rows",
           [](const LoadedExperiment& e) {
             py::list rows;
-            for (const ExperimentRow& r : e.experiment.rows) {
+            for (const ExperimentRow& r : e.experiment->rows) {
               py::dict d;
               d["row"] = r.row, d["trial"] = r.trial, d["series"] = r.series, d["note"] = r.note;
               d["Y"] = r.Y.value, d["u_Y"] = r.Y.u;
@@ -259,18 +262,18 @@ Rows that cannot be used keep their error (file, row, column, rule); the others 
           "scenes",
           [](const LoadedExperiment& e) {
             std::vector<Scene> scenes;
-            for (const ExperimentRow* r : e.experiment.UsableRows()) scenes.push_back(r->configuration->MakeScene());
+            for (const ExperimentRow* r : e.experiment->UsableRows()) scenes.push_back(r->configuration->MakeScene());
             return scenes;
           },
           "An uphill.Scene per usable row, in file order.")
-      .def_property_readonly("errors", [](const LoadedExperiment& e) { return e.experiment.Errors(); },
+      .def_property_readonly("errors", [](const LoadedExperiment& e) { return e.experiment->Errors(); },
                              "The rows left out, one line each.");
 
   m.def(
       "read_experiment",
       [](const std::string& directory) {
         auto loaded = std::make_shared<LoadedExperiment>();
-        loaded->experiment = LoadExperiment(directory);
+        loaded->experiment = std::make_shared<Experiment>(LoadExperiment(directory));
         return loaded;
       },
       py::arg("directory"),
@@ -331,6 +334,8 @@ message, severity), the row check's (uphill.check_row) and the Monte Carlo's u_d
                                return d;
                              })
       .def_property_readonly("row_errors", [](const Analysis& a) { return a.analysis.row_errors; })
+      .def_property_readonly("trial_errors", [](const Analysis& a) { return a.trial_errors; },
+                             "The videos that could not be analysed, one line each (trial, file, why).")
       .def_property_readonly("notes", [](const Analysis& a) { return a.analysis.notes; })
       .def("to_json", [](const Analysis& a) { return ToPython(AnalysisToJson(a.analysis)); },
            "The analysis as `uphill fit EXP --json` prints it (fit.json's content, SI units).");
@@ -338,32 +343,44 @@ message, severity), the row check's (uphill.check_row) and the Monte Carlo's u_d
   m.def(
       "analyse_experiment",
       [](const py::object& experiment, const py::object& mc_trials, const py::object& seed,
-         const py::object& outlier_threshold) {
-        const std::shared_ptr<LoadedExperiment> loaded = ExperimentOf(experiment);
-        AnalysisOptions options;
-        options.mc_trials = Count(mc_trials, "mc_trials");
-        RequireMonteCarloTrials("mc_trials", static_cast<double>(options.mc_trials));
-        options.seed = Count(seed, "seed");
-        options.outlier_threshold = Number(outlier_threshold, "outlier_threshold");
-        auto result = std::make_unique<Analysis>();
-        result->loaded = loaded;
+         const py::object& outlier_threshold, unsigned jobs) {
+        ExperimentFolderOptions options;
+        options.analysis.mc_trials = Count(mc_trials, "mc_trials");
+        RequireMonteCarloTrials("mc_trials", static_cast<double>(options.analysis.mc_trials));
+        options.analysis.seed = Count(seed, "seed");
+        options.analysis.outlier_threshold = Number(outlier_threshold, "outlier_threshold");
+        options.jobs = jobs;
+        const bool loaded = py::isinstance<LoadedExperiment>(experiment);
+        const std::shared_ptr<Experiment> given =
+            loaded ? experiment.cast<std::shared_ptr<LoadedExperiment>>()->experiment : nullptr;
+        const std::string directory = loaded ? "" : py::str(experiment).cast<std::string>();
+        ExperimentFolderAnalysis folder;
         {
           py::gil_scoped_release release;
-          result->analysis = AnalyseExperiment(loaded->experiment, options);
+          // The given uphill.Experiment stays as read: the analysis fills Y from the videos in its own copy.
+          folder = given ? AnalyseLoadedExperiment(*given, options) : AnalyseExperimentFolder(directory, options);
         }
+        auto result = std::make_unique<Analysis>();
+        result->loaded = std::make_shared<LoadedExperiment>(LoadedExperiment{folder.experiment});
+        result->analysis = std::move(folder.analysis);
+        result->trial_errors = std::move(folder.trial_errors);
         return result;
       },
-      py::arg("experiment"), py::kw_only(), py::arg("mc_trials") = 100000, py::arg("seed") = 1,
-      py::arg("outlier_threshold") = 3.0,
-      R"(Analyses an experiment (a folder path or an uphill.Experiment) as `uphill fit EXP` does: per row
-theta, alpha, X ± u(X) (first order and Monte Carlo with mc_trials per row) against Y ± u(Y), and the
-five fits of Y against X. Returns an uphill.Analysis. InputError when no row is usable.)");
+      py::arg("experiment"), py::kw_only(), py::arg("mc_trials") = kAnalysisMonteCarloTrials,
+      py::arg("seed") = kAnalysisSeed, py::arg("outlier_threshold") = 3.0, py::arg("jobs") = 0,
+      R"(Analyses an experiment (a folder path or an uphill.Experiment) as `uphill fit EXP` does
+(app/experiment_folder_analysis.hpp): the trials' videos, when the folder has any, are tracked
+(jobs at a time, 0: one per core; cached in the folder) and a row with an empty Y takes its video's
+rest position; then per row theta, alpha, X ± u(X) (first order and Monte Carlo with mc_trials per
+row, the command's default) against Y ± u(Y), and the five fits of Y against X. Returns an
+uphill.Analysis (trial_errors: the videos that could not be analysed). InputError when no row is
+usable.)");
 
   m.def(
       "check_row",
       [](const py::object& experiment, const py::object& row, const std::string& unit) {
         const std::shared_ptr<LoadedExperiment> loaded = ExperimentOf(experiment);
-        const std::vector<ExperimentRow>& rows = loaded->experiment.rows;
+        const std::vector<ExperimentRow>& rows = loaded->experiment->rows;
         const ExperimentRow* chosen = nullptr;
         if (py::isinstance<py::str>(row)) {
           const std::string trial = row.cast<std::string>();
@@ -377,7 +394,7 @@ five fits of Y against X. Returns an uphill.Analysis. InputError when no row is 
                                         " (got " + std::to_string(index) + ")");
           chosen = &rows[index];
         }
-        return ToPython(RowCheckJson(CheckRow(loaded->experiment, *chosen), unit));
+        return ToPython(RowCheckJson(CheckRow(*loaded->experiment, *chosen), unit));
       },
       py::arg("experiment"), py::arg("row"), py::kw_only(), py::arg("unit") = "m",
       R"(The row check the page, `uphill fit` and `uphill report` show (app/row_check.hpp): row is an index

@@ -1,16 +1,15 @@
-// The five fits (fit/*.hpp) and their reports: uphill.fit_ols, fit_wls, fit_york, fit_robust,
-// fit_friction and uphill.FitReport (parameters, covariances, goodness of fit, per-row results as a
+// The five fits (fit/*.hpp) and their reports: uphill.fit_xy (app/fit_xy.hpp, the use case of
+// `uphill fit --xy`, which fit_ols, fit_wls, fit_york and fit_robust call too), fit_friction and
+// uphill.FitReport (parameters, covariances, goodness of fit, per-row results as a
 // NumPy structured array over the report's own memory).
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include <regex>
 
+#include "app/fit_xy.hpp"
 #include "bindings.hpp"
 #include "fit/friction_fit.hpp"
-#include "fit/least_squares_line.hpp"
-#include "fit/robust_line.hpp"
-#include "fit/york_line.hpp"
 #include "report/fit_json.hpp"
 
 namespace uphill::python {
@@ -56,6 +55,16 @@ FitReport Run(F&& fit) {
   } catch (const InputError& e) {
     RethrowWithRow(e);
   }
+}
+
+// A line fit of the use case (app/fit_xy.hpp), the GIL released while it runs.
+FitReport LineFit(FitMethod method, const LineData& data, const py::object& outlier_threshold,
+                  RobustLoss loss = RobustLoss::kHuber, double loss_scale = 0.0) {
+  FitXyOptions options;
+  options.fit = Options(outlier_threshold);
+  options.loss = loss;
+  options.loss_scale = loss_scale;
+  return Run([&] { return FitXy(method, data, options); });
 }
 
 // One double field of the per-row results as a strided, read-only view of the report's memory.
@@ -160,12 +169,24 @@ void BindFit(py::module_& m) {
       });
 
   m.def(
+      "fit_xy",
+      [](const py::object& x, const py::object& y, const py::object& u_x, const py::object& u_y,
+         const std::string& method, const py::object& outlier_threshold) {
+        const FitMethod m = ParseFitMethod(method, "method");
+        return LineFit(m, MakeLineData(x, y, u_x, u_y), outlier_threshold);
+      },
+      py::arg("x"), py::arg("y"), py::arg("u_x") = py::none(), py::arg("u_y") = py::none(), py::kw_only(),
+      py::arg("method") = kDefaultFitXyMethod, py::arg("outlier_threshold") = 3.0,
+      R"(The line fit of `uphill fit --xy FILE --method METHOD` (app/fit_xy.hpp): method "ols" (the default,
+as the command's), "wls", "york" or "robust" (Huber's loss, its default scale); x, y, u_x, u_y
+one-dimensional float64 arrays, each
+method using the uncertainties it needs (wls: u_y; york: u_x and u_y; robust: u_y when given).
+report.to_json() is the command's --json output. Returns a FitReport.)");
+  m.def(
       "fit_ols",
       [](const py::object& x, const py::object& y, const py::object& u_x, const py::object& u_y,
          const py::object& outlier_threshold) {
-        const LineData d = MakeLineData(x, y, u_x, u_y);
-        const FitOptions options = Options(outlier_threshold);
-        return Run([&] { return FitOrdinaryLeastSquares(d, options); });
+        return LineFit(FitMethod::kOrdinaryLeastSquares, MakeLineData(x, y, u_x, u_y), outlier_threshold);
       },
       py::arg("x"), py::arg("y"), py::arg("u_x") = py::none(), py::arg("u_y") = py::none(), py::kw_only(),
       py::arg("outlier_threshold") = 3.0,
@@ -177,9 +198,7 @@ note says so). Standard errors: the usual, scaled by sqrt(chi2/dof). Accuracy: N
       "fit_wls",
       [](const py::object& x, const py::object& y, const py::object& u_y, const py::object& u_x,
          const py::object& outlier_threshold) {
-        const LineData d = MakeLineData(x, y, u_x, u_y);
-        const FitOptions options = Options(outlier_threshold);
-        return Run([&] { return FitWeightedLeastSquares(d, options); });
+        return LineFit(FitMethod::kWeightedLeastSquares, MakeLineData(x, y, u_x, u_y), outlier_threshold);
       },
       py::arg("x"), py::arg("y"), py::arg("u_y"), py::kw_only(), py::arg("u_x") = py::none(),
       py::arg("outlier_threshold") = 3.0,
@@ -189,9 +208,7 @@ note says so). Returns a FitReport.)");
   m.def(
       "fit_york",
       [](const py::object& x, const py::object& y, const py::object& u_x, const py::object& u_y, const py::object& outlier_threshold) {
-        const LineData d = MakeLineData(x, y, u_x, u_y);
-        const FitOptions options = Options(outlier_threshold);
-        return Run([&] { return FitErrorsInVariables(d, options); });
+        return LineFit(FitMethod::kErrorsInVariables, MakeLineData(x, y, u_x, u_y), outlier_threshold);
       },
       py::arg("x"), py::arg("y"), py::arg("u_x"), py::arg("u_y"), py::kw_only(), py::arg("outlier_threshold") = 3.0,
       R"(Errors in both variables: the maximum-likelihood line of York et al. (2004)
@@ -202,13 +219,10 @@ Standard errors unscaled (York's), scaled also given. Returns a FitReport.)");
       [](const py::object& x, const py::object& y, const py::object& u_y, const py::object& u_x, const std::string& loss,
          const py::object& loss_scale, const py::object& outlier_threshold) {
         const LineData d = MakeLineData(x, y, u_x, u_y);
-        RobustOptions o;
-        if (loss == "huber") o.loss = RobustLoss::kHuber;
-        else if (loss == "cauchy") o.loss = RobustLoss::kCauchy;
-        else throw InputError("loss", "must be \"huber\" or \"cauchy\" (got \"" + loss + "\")");
-        o.loss_scale = Number(loss_scale, "loss_scale");
-        o.fit = Options(outlier_threshold);
-        return Run([&] { return FitRobust(d, o); });
+        RobustLoss kind = RobustLoss::kHuber;
+        if (loss == "cauchy") kind = RobustLoss::kCauchy;
+        else if (loss != "huber") throw InputError("loss", "must be \"huber\" or \"cauchy\" (got \"" + loss + "\")");
+        return LineFit(FitMethod::kRobust, d, outlier_threshold, kind, Number(loss_scale, "loss_scale"));
       },
       py::arg("x"), py::arg("y"), py::arg("u_y") = py::none(), py::kw_only(), py::arg("u_x") = py::none(),
       py::arg("loss") = "huber",

@@ -1,14 +1,15 @@
 // Track CSVs (vision/track_table.hpp), camera and scene calibration files (vision/camera.hpp) and
-// uphill.track: the ball's centre in every frame of a video (vision/video_tracking.hpp).
+// uphill.track: the ball's centre in every frame of a video, the use case of `uphill track`
+// (app/track_video_file.hpp).
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
 
+#include "app/track_video_file.hpp"
 #include "bindings.hpp"
 #include "vision/camera.hpp"
 #include "vision/track_table.hpp"
-#include "vision/video_tracking.hpp"
 
 namespace uphill::python {
 namespace {
@@ -97,24 +98,25 @@ void BindVision(py::module_& m) {
 
   m.def(
       "track",
-      [](const std::string& video, const std::string& scene_file, const Scene& scene, const py::object& init_uv,
+      [](const std::string& video, const std::string& camera_file, const std::string& scene_file, const Scene& scene,
+         const py::object& init_uv, const py::object& exposure, const py::object& readout, const std::string& transfer,
          const std::string& overlay) {
-        if (scene.body().kind == BodyKind::kDoubleCone)
-          throw InputError("scene", "tracking supports a sphere or a spheroid, not a double cone");
-        const SceneCalibration calibration = ReadSceneFile(scene_file);
-        TrackVideoOptions options;
-        options.calibration_name = scene_file;
+        TrackVideoFileOptions options;
         options.overlay_path = overlay;
         if (!init_uv.is_none()) {
           const auto uv = init_uv.cast<std::vector<double>>();
           if (uv.size() != 2 || !std::isfinite(uv[0]) || !std::isfinite(uv[1]))
             throw InputError("init_uv", "must be (u, v), two finite raw pixel coordinates");
-          options.tracker.init_uv = Eigen::Vector2d(uv[0], uv[1]);
+          options.init_uv = Eigen::Vector2d(uv[0], uv[1]);
         }
+        options.exposure = OptionalQuantity(exposure, Dimension::kTime, "exposure");
+        if (py::isinstance<py::str>(readout) && readout.cast<std::string>() == "auto") options.measure_readout = true;
+        else if (!readout.is_none()) options.readout = Quantity(readout, Dimension::kTime, "readout");
+        options.transfer = ParseVideoTransfer(transfer, "transfer");
         TrackResult result;
         {
           py::gil_scoped_release release;
-          result = TrackVideo(video, scene, calibration, options);
+          result = TrackVideoFile(video, camera_file, scene_file, scene, options);
         }
         TrackColumns c(result.rows.size());
         for (std::size_t i = 0; i < result.rows.size(); ++i) {
@@ -125,16 +127,25 @@ void BindVision(py::module_& m) {
         d["fps"] = result.fps;
         d["partial"] = result.partial;
         d["partial_reason"] = result.partial_reason;
+        const auto seconds = [](const std::optional<double>& s) { return s ? py::object(py::float_(*s)) : py::none(); };
+        d["exposure"] = seconds(result.exposure);
+        d["measured_exposure"] = seconds(result.measured_exposure);
+        d["readout"] = result.readout;
         return d;
       },
-      py::arg("video"), py::arg("scene_file"), py::arg("scene"), py::kw_only(), py::arg("init_uv") = py::none(),
-      py::arg("overlay") = "",
-      (std::string("The ball's centre in every frame of a video (vision/video_tracking.hpp), as `uphill track` "
-                   "finds it: video any file FFmpeg decodes, scene_file the scene calibration of `uphill calibrate "
-                   "scene` (it carries the camera's intrinsics), scene the uphill.Scene filmed (sphere or spheroid). "
-                   "init_uv=(u, v): a raw pixel near the centre in the first frame; overlay: a video to write with the "
-                   "fit drawn. Returns a dict of arrays ") +
-       kTrackColumnsDoc + ", plus fps, partial and partial_reason (a cut video, a ball lost for good).")
+      py::arg("video"), py::arg("camera_file"), py::arg("scene_file"), py::arg("scene"), py::kw_only(),
+      py::arg("init_uv") = py::none(), py::arg("exposure") = py::none(), py::arg("readout") = py::none(),
+      py::arg("transfer") = "srgb", py::arg("overlay") = "",
+      (std::string("The ball's centre in every frame of a video as `uphill track` finds it (app/track_video_file.hpp): "
+                   "video any file FFmpeg decodes, camera_file the camera of `uphill calibrate camera`, scene_file "
+                   "the scene calibration of `uphill calibrate scene` made with that camera (checked), scene the "
+                   "uphill.Scene filmed (sphere or spheroid). init_uv=(u, v): a raw pixel near the centre in the "
+                   "first frame; exposure: per frame (s, or text with a unit; None: measured from the motion blur); "
+                   "readout: the rolling shutter's first-to-last-row time (s, or text), \"auto\" to measure it, "
+                   "None for a global shutter; transfer: \"srgb\" (cameras) or \"linear\"; overlay: a video to "
+                   "write with the fit drawn. Returns a dict of arrays ") +
+       kTrackColumnsDoc + ", plus fps, partial and partial_reason (a cut video, a ball lost for good), exposure "
+       "and measured_exposure (s, None when not known) and readout (s, as used).")
           .c_str());
 }
 

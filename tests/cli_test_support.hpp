@@ -1,4 +1,5 @@
-// Runs the built `uphill` program (path from CMake) and captures stdout, stderr, exit status.
+// Runs the built `uphill` program (path from CMake), or any command, and captures stdout, stderr,
+// exit status.
 #pragma once
 
 #include <string>
@@ -10,7 +11,10 @@ struct CommandResult {
   std::string out, err;
 };
 
-// `args` is appended to the program path and run by /bin/sh; stdin from `input` if non-empty.
+// `command` run by /bin/sh, stdin from `input` (empty: nothing).
+CommandResult RunCommand(const std::string& command, const std::string& input = "");
+
+// `args` is appended to the program path (UPHILL_PROGRAM) and run as RunCommand does.
 CommandResult RunUphill(const std::string& args, const std::string& input = "");
 
 }  // namespace uphill::testing

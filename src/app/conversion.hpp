@@ -10,6 +10,7 @@
 // (inputs with uncertainties), verdict.
 #pragma once
 
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -19,6 +20,12 @@
 #include "model/propagation.hpp"
 
 namespace uphill {
+
+// The Monte Carlo of every front end's conversion (`uphill convert`, Python's convert_setting and
+// convert_batch_file): 10^6 trials give u to about 0.1 % (model/propagation.hpp), and one fixed
+// seed makes the same input give the same numbers in each.
+inline constexpr std::uint64_t kConvertMonteCarloTrials = 1'000'000;
+inline constexpr std::uint64_t kConvertSeed = 20261121;
 
 struct ConversionOptions {
   std::optional<double> mu;       // rolling-resistance coefficient for the rest band

@@ -16,7 +16,7 @@
 #include <opencv2/core.hpp>
 #include <thread>
 
-#include "app/tracking_inputs.hpp"
+#include "app/track_video_file.hpp"
 #include "io/atomic_file.hpp"
 #include "io/contained_directory.hpp"
 #include "model/environment_error.hpp"
@@ -25,7 +25,6 @@
 #include "vision/track_analysis.hpp"
 #include "vision/track_analysis_output.hpp"
 #include "vision/track_table.hpp"
-#include "vision/video_tracking.hpp"
 
 namespace uphill {
 namespace {
@@ -287,8 +286,6 @@ VideoTrial TrackTrial(const Experiment& experiment, const ExperimentRow& row, st
   try {
     if (!row.configuration) throw InputError("row " + std::to_string(row.row), "has no usable apparatus values");
     const Scene scene = row.configuration->MakeScene();
-    if (scene.body().kind == BodyKind::kDoubleCone)
-      throw InputError(experiment.directory, "a double cone cannot be tracked (a sphere or a spheroid can)");
     const ContainedDirectory root = ContainedDirectory::Open(experiment.directory);
     const std::string scene_file = experiment.scenes.at(row.scene);
     const auto camera_bytes = root.ReadFile(experiment.camera, kMaxCalibrationBytes);
@@ -316,16 +313,16 @@ VideoTrial TrackTrial(const Experiment& experiment, const ExperimentRow& row, st
     }
     const std::string camera_path = (fs::path(root.path()) / experiment.camera).string();
     const std::string scene_path = (fs::path(root.path()) / scene_file).string();
-    const SceneCalibration calibration = ReadTrackingCalibration(camera_path, scene_path);
-    TrackVideoOptions options;
-    options.calibration_name = scene_file;
-    options.progress = [&](int done, long total) {
+    TrackVideoFileOptions options;
+    options.video_label = row.video;
+    options.scene_label = scene_file;
+    const FrameProgressCallback frames = [&](int done, long total) {
       p.frames_done = done;
       p.frames_total = total;
       tell(VideoProgress::Stage::kTracking);
     };
     tell(VideoProgress::Stage::kTracking);
-    const TrackResult track = TrackVideo(video_path, scene, calibration, options);
+    const TrackResult track = TrackVideoFile(video_path, camera_path, scene_path, scene, options, frames);
     trial.partial = track.partial;
     trial.partial_reason = track.partial_reason;
     trial.tracker_cpu_seconds = track.tracker_cpu_seconds;

@@ -11,6 +11,7 @@
 #include <tuple>
 #include <type_traits>
 
+#include "app/experiment_folder_analysis.hpp"
 #include "io/contained_directory.hpp"
 #include "io/experiment.hpp"
 #include "io/utf8.hpp"
@@ -21,6 +22,7 @@
 #include "report/report_outputs.hpp"
 #include "vision/camera.hpp"
 #include "internal/calibration_api.hpp"
+#include "internal/fit_api.hpp"
 #include "internal/folder_claim.hpp"
 #include "internal/page_assets.hpp"
 #include "internal/request_values.hpp"
@@ -277,6 +279,7 @@ struct Server::Impl {
       }
     });
     VideoRoutes();
+    http.Post("/api/fit-xy", [this](const httplib::Request& req, httplib::Response& res) { Respond(req, res, internal::FitXyAnswer); });
     http.Get("/report/(.*)", [this](const httplib::Request& req, httplib::Response& res) {
       const std::string name = req.matches[1].str();
       if (!ValidReportName(name)) {
@@ -524,11 +527,11 @@ struct Server::Impl {
                               "the experiment folder");
       return;
     }
-    AnalysisOptions analysis_options;
-    analysis_options.mc_trials = options.report_mc_trials;
-    Experiment experiment;
-    const ExperimentAnalysis analysis = internal::AnalyseFolder(store.directory(), analysis_options, &experiment);
-    CheckReportOutputs(experiment, (fs::path(store.directory()) / "report").string(), "report");  // 422: never over an input
+    ExperimentFolderOptions analysis_options;
+    analysis_options.analysis.mc_trials = options.report_mc_trials;
+    const ExperimentFolderAnalysis folder_analysis = AnalyseExperimentFolder(store.directory(), analysis_options);
+    const ExperimentAnalysis& analysis = folder_analysis.analysis;
+    CheckReportOutputs(*folder_analysis.experiment, (fs::path(store.directory()) / "report").string(), "report");  // 422: never over an input
     ClaimFolder();
     ContainedDirectory staging = folder->MakeStagingDirectory(internal::kReportStagingPrefix);
     std::vector<std::string> names;

@@ -10,6 +10,7 @@
 //   POST   /api/undo                      {version}: undo the last change
 //   POST   /api/check                     {row}: check a draft row (nothing stored)
 //   POST   /api/report                    {}: write the fit report to EXP/report/
+//   POST   /api/fit-xy                    {method, x, y, u_x?, u_y?}: `uphill fit --xy --json`'s JSON
 //   GET    /report/<name>                 a file of EXP/report/, read-only
 // Videos and calibration (internal/calibration_api.hpp says what each answers):
 //   GET    /api/videos                    the video files in the folder
@@ -56,6 +57,7 @@
 #include <memory>
 #include <string>
 
+#include "app/analysis_defaults.hpp"
 #include "server/experiment_store.hpp"
 
 namespace uphill {
@@ -78,7 +80,9 @@ struct ServerOptions {
   // larger than the whole budget); the pixel limit itself: vision/decode_limits.hpp.
   std::size_t frame_decode_budget_bytes = std::size_t{512} << 20;
   std::chrono::milliseconds frame_decode_wait{10 * 1000};
-  std::uint64_t report_mc_trials = 10000;  // per row, for u(X) by Monte Carlo in the report
+  // Per row, for u(X) by Monte Carlo in the report: the app's default, so that the page's report
+  // is `uphill report`'s.
+  std::uint64_t report_mc_trials = kAnalysisMonteCarloTrials;
   // A request must arrive whole within request_deadline; a connection idle for idle_timeout is
   // closed; at most max_connections are served at once (one thread each).
   std::chrono::milliseconds request_deadline{10000};

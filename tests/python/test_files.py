@@ -97,7 +97,7 @@ def scene_of_clip():
 
 def test_track_recovers_the_rendered_truth(clip):
     video = next(p for p in clip.iterdir() if p.suffix in (".avi", ".mp4"))
-    run = uphill.track(str(video), str(clip / "scene.json"), scene_of_clip())
+    run = uphill.track(str(video), str(clip / "cam.json"), str(clip / "scene.json"), scene_of_clip())
     truth = np.genfromtxt(clip / "truth.csv", delimiter=",", names=True)
     assert run["found"].all() and not run["partial"]
     np.testing.assert_array_equal(run["frame"], truth["frame"].astype(int))
@@ -115,7 +115,7 @@ def test_track_csv_of_the_program_reads_back(clip, tmp_path):
                              "--rod-diameter", "8mm", "-o", csv_path, "--quiet")
     assert status == 0, err
     from_cli = uphill.read_track(str(csv_path))
-    run = uphill.track(str(video), str(clip / "scene.json"), scene_of_clip())
+    run = uphill.track(str(video), str(clip / "cam.json"), str(clip / "scene.json"), scene_of_clip())
     np.testing.assert_array_equal(from_cli["frame"], run["frame"])
     np.testing.assert_array_equal(from_cli["found"], run["found"])
     # The CSV prints x, z in mm and pixels with a fixed number of decimals.

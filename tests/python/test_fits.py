@@ -37,6 +37,23 @@ def test_norris_certified_values():
     assert np.max(np.abs(fit.residuals - (y - fit.fitted))) < 1e-12 * np.max(np.abs(y))
 
 
+def test_fit_xy_is_the_per_method_functions_by_name():
+    # One use case (app/fit_xy.hpp) behind both: the same numbers, and the command's refusal.
+    data = load("pearson_york.dat")
+    x, w_x, y, w_y = (data[:, i].copy() for i in range(4))
+    u_x, u_y = 1 / np.sqrt(w_x), 1 / np.sqrt(w_y)
+    pairs = [(uphill.fit_xy(x, y), uphill.fit_ols(x, y)),
+             (uphill.fit_xy(x, y, None, u_y, method="wls"), uphill.fit_wls(x, y, u_y)),
+             (uphill.fit_xy(x, y, u_x, u_y, method="york"), uphill.fit_york(x, y, u_x, u_y)),
+             (uphill.fit_xy(x, y, None, u_y, method="robust"), uphill.fit_robust(x, y, u_y))]
+    for by_name, direct in pairs:
+        a, b = by_name.to_json(), direct.to_json()
+        del a["solver"]["seconds"], b["solver"]["seconds"]  # wall-clock time, not a result
+        assert a == b
+    with pytest.raises(uphill.InputError, match=r"^method: must be ols, wls, york or robust \(got 'lsq'\)$"):
+        uphill.fit_xy(x, y, method="lsq")
+
+
 def test_york_pearson_published_values():
     data = load("pearson_york.dat")
     x, wx, y, wy = (data[:, k].copy() for k in range(4))

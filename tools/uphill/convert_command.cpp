@@ -25,8 +25,8 @@ struct ConvertFlags {
   bool csv = false;
   bool json = false;
   std::string length_unit = "mm";
-  std::int64_t mc_trials = 1000000;  // signed: "-1" is refused as -1, not wrapped
-  std::uint64_t seed = 20261121;
+  std::int64_t mc_trials = kConvertMonteCarloTrials;  // signed: "-1" is refused as -1, not wrapped
+  std::uint64_t seed = kConvertSeed;
   const CLI::App* command = nullptr;  // to ask which flags were given
 };
 

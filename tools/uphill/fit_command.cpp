@@ -2,21 +2,22 @@
 //   uphill fit EXP [--json]                       an experiment folder (data/README.md)
 //   uphill fit --xy FILE.csv [--method M] [--json]  arbitrary X-Y data, header X,Y[,uX,uY]
 // `uphill report EXP -o DIR`: the full report (HTML, Markdown, fit.json, figures).
-// An experiment with recordings (format uphill-experiment/2) has its videos tracked and analysed
-// first (app/video_trials.hpp, OpenCV): `uphill` then hands the command to `uphill-vision`
-// (vision_program.hpp), whose build of this file does that work.
+// The work is the app's: FitXy (app/fit_xy.hpp) for --xy data, AnalyseExperimentFolder
+// (app/experiment_folder_analysis.hpp) for a folder, which tracks its videos when it has any
+// (OpenCV). So an experiment is always analysed in `uphill-vision` (vision_program.hpp): one path
+// for folders with and without videos.
 #include <unistd.h>
 
 #include <optional>
 #include <iostream>
 
+#include "app/analysis_defaults.hpp"
+#include "app/fit_xy.hpp"
 #include "commands.hpp"
 #include "flag_checks.hpp"
-#include "fit/least_squares_line.hpp"
-#include "fit/robust_line.hpp"
-#include "fit/york_line.hpp"
 #include "io/xy_table.hpp"
 #include "model/input_error.hpp"
+#include "model/input_ranges.hpp"
 #include "report/fit_document.hpp"
 #include "report/fit_json.hpp"
 #include "report/figure_pool.hpp"
@@ -24,7 +25,7 @@
 #include "report/video_report.hpp"
 #include "vision_program.hpp"
 #if UPHILL_VISION_PROGRAM
-#include "app/video_trials.hpp"
+#include "app/experiment_folder_analysis.hpp"
 #include "video_progress.hpp"
 #endif
 
@@ -34,10 +35,10 @@ namespace {
 struct FitFlags {
   std::string experiment;
   std::string xy;
-  std::string method = "ols";
+  std::string method = kDefaultFitXyMethod;
   bool json = false;
   bool no_rows = false;
-  std::int64_t mc_trials = 100000;  // signed: "-1" is refused as -1, not wrapped
+  std::int64_t mc_trials = kAnalysisMonteCarloTrials;  // signed: "-1" is refused as -1, not wrapped
   const CLI::App* command = nullptr;  // to ask which flags were given
   std::string output;
   unsigned jobs = 0;  // videos tracked at once; 0: one per core
@@ -61,29 +62,8 @@ void PrintFitText(const FitReport& r) {
   for (const auto& n : r.notes) std::cout << "  note: " << n << "\n";
 }
 
-void RequireMethod(const std::string& method) {
-  if (method != "ols" && method != "wls" && method != "york" && method != "robust")
-    throw InputError("--method", "must be ols, wls, york or robust (got '" + method + "')");
-}
-
-// The per-row results are not kept: the JSON output streams them from the data (line_rows.hpp).
-FitReport FitXy(const std::string& method, const LineData& data) {
-  FitOptions options;
-  options.keep_rows = false;
-  if (method == "ols") return FitOrdinaryLeastSquares(data, options);
-  if (method == "wls") return FitWeightedLeastSquares(data, options);
-  if (method == "york") return FitErrorsInVariables(data, options);
-  if (method == "robust") {
-    RobustOptions robust;
-    robust.fit = options;
-    return FitRobust(data, robust);
-  }
-  RequireMethod(method);
-  return {};
-}
-
 void RunXy(const FitFlags& f) {
-  RequireMethod(f.method);  // before the file is read
+  const FitMethod method = ParseFitMethod(f.method, "--method");  // before the file is read
   // X,Y[,uX,uY] (io/xy_table.hpp): a row that cannot be read is named on stderr as it is met and
   // left out; the fit uses the others (exit status 2 tells).
   XyTable table = ReadXyFile(f.xy, [](const std::string& error) {
@@ -93,7 +73,9 @@ void RunXy(const FitFlags& f) {
   const LineData data{std::move(table.x), std::move(table.y), std::move(table.u_x), std::move(table.u_y)};
   FitReport r;
   try {
-    r = FitXy(f.method, data);
+    FitXyOptions options;
+    options.fit.keep_rows = false;  // the JSON output streams the rows from the data (line_rows.hpp)
+    r = FitXy(method, data, options);
   } catch (const InputError& e) {
     throw InputError(table.Locate(e.quantity()), e.rule());  // name the file's row and column
   }
@@ -104,68 +86,64 @@ void RunXy(const FitFlags& f) {
   }
 }
 
-// `keep` is the loaded experiment (the analysis points into it). `figures`, when given
-// (`uphill report`), draws each video trial's figures into f.output as soon as the trial is
-// tracked, while the other videos are tracked.
-ExperimentAnalysis Analyse(const FitFlags& f, Experiment* keep, FigurePool* figures = nullptr) {
-  AnalysisOptions options;
-  // Per row; 10^7 take about half a second a row. Fewer than 100 give no usable u(X): 0 gave
-  // u_MC = 0 on every row.
-  if (f.mc_trials < 100 || f.mc_trials > 10000000)
-    throw InputError("--mc-trials", "must be between 100 and 10000000 trials per row (got " +
-                                        std::to_string(f.mc_trials) + ")");
-  options.mc_trials = static_cast<std::uint64_t>(f.mc_trials);
 #if UPHILL_VISION_PROGRAM
-  ExperimentAnalysis a;
-  if (keep->HasVideos()) {
-    const std::vector<const ExperimentRow*> rows = VideoRows(*keep);
-    std::vector<std::string> labels;
-    for (const ExperimentRow* r : rows) labels.push_back(r->trial + "  " + r->video);
-    OneDecodeThreadPerVideo();
-    std::optional<VideoProgressDisplay> display;
-    if (!f.quiet && isatty(STDERR_FILENO) && !rows.empty()) display.emplace(labels);
-    const std::vector<VideoTrial> trials = TrackExperimentVideos(
-        *keep, f.jobs, [&](const VideoProgress& p) { if (display) display->Update(p); },
-        [&, folder_made = false](std::size_t index, const VideoTrial& trial) mutable {
-          std::vector<GnuplotFigure> list = figures ? VideoTrialFigures(trial, index) : std::vector<GnuplotFigure>{};
-          if (list.empty()) return;
-          if (!folder_made) CreateReportFolder(f.output);  // not before: a failed report leaves nothing
-          folder_made = true;
-          for (GnuplotFigure& figure : list) figures->Render(std::move(figure), f.output);
-        });
-    if (display) display->Finish();
-    for (const VideoTrial& t : trials) {
-      if (!t.cache_note.empty()) std::cerr << "uphill: note: " << t.cache_note << "\n";
-      if (!t.error.empty()) {
-        std::cerr << "uphill: " << t.error << " (video left out)\n";
-        ExitStatus() = 2;
-      }
-    }
-    a = AnalyseExperimentWithVideos(keep, trials, options);
-  } else {
-    a = AnalyseExperiment(*keep, options);
-  }
-#else
-  if (keep->HasVideos()) RunInVisionProgram();  // the videos are tracked with OpenCV
-  (void)figures;
-  ExperimentAnalysis a = AnalyseExperiment(*keep, options);
-#endif
-  for (const auto& e : a.row_errors) {
-    std::cerr << "uphill: " << e << " (row left out)\n";
-    ExitStatus() = 2;
-  }
+
+// `figures`, when given (`uphill report`), draws each video trial's figures into f.output as soon
+// as the trial is tracked, while the other videos are tracked.
+ExperimentFolderAnalysis Analyse(const FitFlags& f, Experiment experiment, FigurePool* figures = nullptr) {
+  RequireMonteCarloTrials("--mc-trials", static_cast<double>(f.mc_trials));
+  ExperimentFolderOptions options;
+  options.analysis.mc_trials = static_cast<std::uint64_t>(f.mc_trials);
+  options.jobs = f.jobs;
+  options.trial_done = [&, folder_made = false](std::size_t index, const VideoTrial& trial) mutable {
+    std::vector<GnuplotFigure> list = figures ? VideoTrialFigures(trial, index) : std::vector<GnuplotFigure>{};
+    if (list.empty()) return;
+    if (!folder_made) CreateReportFolder(f.output);  // not before: a failed report leaves nothing
+    folder_made = true;
+    for (GnuplotFigure& figure : list) figures->Render(std::move(figure), f.output);
+  };
+  std::vector<std::string> labels;
+  for (const ExperimentRow* r : VideoRows(experiment)) labels.push_back(r->trial + "  " + r->video);
+  std::optional<VideoProgressDisplay> display;
+  if (!f.quiet && isatty(STDERR_FILENO) && !labels.empty()) display.emplace(labels);
+  ExperimentFolderAnalysis a = AnalyseLoadedExperiment(std::move(experiment), options, [&](const VideoProgress& p) {
+    if (display) display->Update(p);
+  });
+  if (display) display->Finish();
+  for (const std::string& note : a.notes) std::cerr << "uphill: note: " << note << "\n";
+  for (const std::string& e : a.trial_errors) std::cerr << "uphill: " << e << " (video left out)\n";
+  for (const std::string& e : a.analysis.row_errors) std::cerr << "uphill: " << e << " (row left out)\n";
+  if (!a.trial_errors.empty() || !a.analysis.row_errors.empty()) ExitStatus() = 2;
   return a;
 }
 
 void RunExperiment(const FitFlags& f) {
-  Experiment experiment = LoadExperiment(f.experiment);
-  const ExperimentAnalysis a = Analyse(f, &experiment);
+  const ExperimentFolderAnalysis a = Analyse(f, LoadExperiment(f.experiment));
   if (f.json) {
-    std::cout << AnalysisToJson(a).dump(2) << "\n";
+    std::cout << AnalysisToJson(a.analysis).dump(2) << "\n";
   } else {
-    std::cout << RenderText(FitDocument(a, false));
+    std::cout << RenderText(FitDocument(a.analysis, false));
   }
 }
+
+void RunReport(const FitFlags& f) {
+  Experiment experiment = LoadExperiment(f.experiment);
+  CheckReportOutputs(experiment, f.output, "-o");  // before any work: never over an input
+  FigurePool figures(f.jobs);  // drawing while the videos are tracked, one gnuplot per core
+  const ExperimentFolderAnalysis a = Analyse(f, std::move(experiment), &figures);
+  WriteFitReport(a.analysis, f.output, &figures);
+  std::cout << "wrote " << f.output << "/report.html, report.md, fit.json, and the figures "
+            << "fit_y_vs_x, fit_offset, fit_residuals";
+  if (!a.analysis.video_trials.empty()) std::cout << ", and each video's video_<n>_x_vs_t, video_<n>_residuals";
+  std::cout << " (.svg, .png, .gp script, .dat data)\n";
+}
+
+#else  // uphill: an experiment is analysed in uphill-vision, which tracks its videos (OpenCV)
+
+void RunExperiment(const FitFlags&) { RunInVisionProgram(); }
+void RunReport(const FitFlags&) { RunInVisionProgram(); }
+
+#endif
 
 void AddVideoFlags(CLI::App* command, FitFlags* flags) {
   command->add_option("--jobs", flags->jobs, "videos tracked at once (experiment with recordings; 0: one per core)")
@@ -202,17 +180,7 @@ void AddFitCommand(CLI::App& app) {
   report->add_option("-o,--output", flags->output, "output folder (created if needed)")->required();
   report->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials per row for u(X)")->capture_default_str();
   AddVideoFlags(report, flags.get());
-  report->callback([flags] {
-    Experiment experiment = LoadExperiment(flags->experiment);
-    CheckReportOutputs(experiment, flags->output, "-o");  // before any work: never over an input
-    FigurePool figures(flags->jobs);  // drawing while the videos are tracked, one gnuplot per core
-    const ExperimentAnalysis a = Analyse(*flags, &experiment, &figures);
-    WriteFitReport(a, flags->output, &figures);
-    std::cout << "wrote " << flags->output << "/report.html, report.md, fit.json, and the figures "
-              << "fit_y_vs_x, fit_offset, fit_residuals";
-    if (!a.video_trials.empty()) std::cout << ", and each video's video_<n>_x_vs_t, video_<n>_residuals";
-    std::cout << " (.svg, .png, .gp script, .dat data)\n";
-  });
+  report->callback([flags] { RunReport(*flags); });
 }
 
 }  // namespace uphill::cli

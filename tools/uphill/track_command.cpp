@@ -18,18 +18,15 @@
 #include <iostream>
 #include <sstream>
 
-#include "app/tracking_inputs.hpp"
-#include "app/video_frames.hpp"
+#include "app/track_video_file.hpp"
 #include "progress_bars.hpp"
 #include "io/configuration.hpp"
 #include "io/output_paths.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
-#include "vision/camera.hpp"
 #include "vision/track_analysis.hpp"
 #include "vision/track_analysis_output.hpp"
 #include "vision/track_table.hpp"
-#include "vision/video_tracking.hpp"
 #endif
 
 namespace uphill::cli {
@@ -70,8 +67,6 @@ void Run(const TrackFlags& f) {
   if (f.out.empty()) throw InputError("-o", "is required (the track CSV to write)");
   const Configuration configuration = ParseConfiguration(FlagSource(f.scene));
   const Scene scene = configuration.MakeScene();
-  if (scene.body().kind == BodyKind::kDoubleCone)
-    throw InputError("--body", "tracking supports a sphere or a spheroid, not a double cone");
   // Every output checked before any work: never an input, never anything but a regular file.
   OutputPaths outputs;
   outputs.AddInput(f.video, "the input video");
@@ -81,28 +76,25 @@ void Run(const TrackFlags& f) {
   outputs.CheckFile(f.out + ".json", "-o (its sidecar)");
   if (!f.overlay.empty()) outputs.CheckFile(f.overlay, "--overlay");
   if (f.analyse) outputs.CheckFolder(AnalysisFolder(f), "-o (with --analyse)", TrackAnalysisFiles());
-  const SceneCalibration calibration = ReadTrackingCalibration(f.camera, f.scene_file);
 
-  TrackVideoOptions options;
-  options.calibration_name = f.scene_file;
+  TrackVideoFileOptions options;
   options.overlay_path = f.overlay;
-  if (!f.init.empty()) options.tracker.init_uv = ParsePixel(f.init);
-  if (!f.exposure.empty()) options.tracker.exposure = ParseQuantity(f.exposure, Dimension::kTime, "--exposure");
-  if (f.readout == "auto") options.tracker.measure_readout = true;
-  else if (!f.readout.empty()) options.tracker.readout = ParseQuantity(f.readout, Dimension::kTime, "--readout");
-  if (f.transfer == "linear") options.tracker.transfer = VideoTransfer::kLinear;
-  else if (f.transfer != "srgb") throw InputError("--transfer", "must be srgb or linear (got '" + f.transfer + "')");
+  if (!f.init.empty()) options.init_uv = ParsePixel(f.init);
+  if (!f.exposure.empty()) options.exposure = ParseQuantity(f.exposure, Dimension::kTime, "--exposure");
+  if (f.readout == "auto") options.measure_readout = true;
+  else if (!f.readout.empty()) options.readout = ParseQuantity(f.readout, Dimension::kTime, "--readout");
+  options.transfer = ParseVideoTransfer(f.transfer, "--transfer");
   const bool bar = !f.quiet && isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
+  FrameProgressCallback progress;
   if (bar)
-    options.progress = [start](int done, long total) {
+    progress = [start](int done, long total) {
       if (done % 5 != 0 && done != total) return;
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       std::fprintf(stderr, "\r%s ", FrameProgressText(done, total, elapsed).c_str());
       std::fflush(stderr);
     };
-  CheckVideoPixels(f.video, f.video);
-  const TrackResult result = TrackVideo(f.video, scene, calibration, options);
+  const TrackResult result = TrackVideoFile(f.video, f.camera, f.scene_file, scene, options, progress);
   if (bar) std::fprintf(stderr, "\n");
   WriteTrack(f.out, result, {f.video, f.camera, f.scene_file, scene.body().Name()});
 

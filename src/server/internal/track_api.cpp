@@ -117,11 +117,4 @@ RestAsY RowRestAsY(const ExperimentStore& store, const StoreSnapshot& snapshot, 
           r.trial.rest->u ? Number(ToUnit(*r.trial.rest->u, Dimension::kLength, unit)) : ""};
 }
 
-ExperimentAnalysis AnalyseFolder(const std::string& directory, const AnalysisOptions& options, Experiment* experiment) {
-  *experiment = LoadExperiment(directory);
-  if (!experiment->HasVideos()) return AnalyseExperiment(*experiment, options);
-  const std::vector<VideoTrial> trials = TrackExperimentVideos(*experiment);
-  return AnalyseExperimentWithVideos(experiment, trials, options);
-}
-
 }  // namespace uphill::internal

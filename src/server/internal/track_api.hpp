@@ -1,14 +1,12 @@
 // The tracking part of the server's API (http_server.hpp lists the routes): a trial's video
-// tracked and analysed by the use case of app/video_trials.hpp (cached in EXP/.uphill-cache/),
-// and the fit report with the videos. Private to src/server/. Lengths in the experiment's unit.
+// tracked and analysed by the use case of app/video_trials.hpp (cached in EXP/.uphill-cache/).
+// Private to src/server/. Lengths in the experiment's unit.
 #pragma once
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "io/experiment.hpp"
-#include "report/analysis.hpp"
 #include "server/experiment_store.hpp"
 
 namespace uphill::internal {
@@ -27,9 +25,5 @@ struct RestAsY {
   std::string y, u_y;
 };
 RestAsY RowRestAsY(const ExperimentStore& store, const StoreSnapshot& snapshot, std::int64_t id);
-
-// The experiment folder's analysis for the report, its videos tracked (cached) when it has any.
-// `experiment` receives the folder's experiment, into which the analysis points.
-ExperimentAnalysis AnalyseFolder(const std::string& directory, const AnalysisOptions& options, Experiment* experiment);
 
 }  // namespace uphill::internal

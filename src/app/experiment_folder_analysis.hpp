@@ -1,0 +1,52 @@
+// Analysing an experiment folder: the use case of `uphill fit EXP` and `uphill report EXP`
+// (docs/fit.md), of the page's report (POST /api/report) and of Python's
+// uphill.analyse_experiment. The folder is read (io/experiment.hpp); when its rows name videos
+// (format uphill-experiment/2) they are tracked and analysed first, `jobs` at a time and cached
+// (app/video_trials.hpp), and a row whose Y is empty takes its video's rest position; then the
+// analysis and its fits (report/analysis.hpp).
+//
+// Defaults: app/analysis_defaults.hpp (the Monte Carlo's trials per row and seed).
+// Errors: InputError for a folder that cannot be read (LoadExperiment), for mc_trials outside
+// model/input_ranges.hpp's range, and when no row is usable. A video that cannot be analysed is
+// not an error of the whole: it is named in trial_errors, and its row (when its Y was to come from
+// it) in analysis.row_errors; the other trials and rows are analysed.
+// Threads: the videos are decoded one thread each (OneDecodeThreadPerVideo, process-wide), which
+// this sets when the folder has videos. The callbacks are serialised.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app/analysis_defaults.hpp"
+#include "app/video_trials.hpp"
+#include "io/experiment.hpp"
+#include "report/analysis.hpp"
+
+namespace uphill {
+
+struct ExperimentFolderOptions {
+  AnalysisOptions analysis = DefaultAnalysisOptions();
+  unsigned jobs = 0;                   // videos tracked at once; 0: one per core
+  VideoTrialDoneCallback trial_done;   // each video trial as soon as it is finished (the report's figures)
+};
+
+struct ExperimentFolderAnalysis {
+  // The folder as read, with the videos' rest positions filled in as Y; the analysis points into
+  // it, so it lives on the heap (its address is stable however the result is moved).
+  std::shared_ptr<Experiment> experiment;
+  ExperimentAnalysis analysis;
+  std::vector<std::string> trial_errors;  // one line per video that could not be analysed
+  std::vector<std::string> notes;         // one line per damaged cache entry that was replaced
+};
+
+ExperimentFolderAnalysis AnalyseExperimentFolder(const std::string& directory,
+                                                 const ExperimentFolderOptions& options = {},
+                                                 const VideoProgressCallback& progress = {});
+
+// The same for a folder already read (a front end that checks its outputs against the inputs
+// first, or holds an uphill.Experiment): `experiment` is taken by value and kept in the result.
+ExperimentFolderAnalysis AnalyseLoadedExperiment(Experiment experiment, const ExperimentFolderOptions& options = {},
+                                                 const VideoProgressCallback& progress = {});
+
+}  // namespace uphill
