@@ -9,7 +9,7 @@
 #include <memory>
 #include <string>
 
-#include "fit/solver_logs.hpp"
+#include "model/solver_logs.hpp"
 #include "reduced_rows.hpp"
 
 namespace uphill::internal {
