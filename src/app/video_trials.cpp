@@ -16,6 +16,7 @@
 #include <opencv2/core.hpp>
 #include <thread>
 
+#include "app/track_analysis_output.hpp"
 #include "app/tracking_inputs.hpp"
 #include "io/atomic_file.hpp"
 #include "io/contained_directory.hpp"
@@ -23,7 +24,6 @@
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
 #include "vision/track_analysis.hpp"
-#include "vision/track_analysis_output.hpp"
 #include "vision/track_table.hpp"
 #include "vision/video_tracking.hpp"
 

@@ -18,6 +18,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "app/track_analysis_output.hpp"
 #include "app/tracking_inputs.hpp"
 #include "app/video_frames.hpp"
 #include "progress_bars.hpp"
@@ -27,7 +28,6 @@
 #include "model/input_error.hpp"
 #include "vision/camera.hpp"
 #include "vision/track_analysis.hpp"
-#include "vision/track_analysis_output.hpp"
 #include "vision/track_table.hpp"
 #include "vision/video_tracking.hpp"
 #endif
