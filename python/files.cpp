@@ -367,7 +367,7 @@ message, severity), the row check's (uphill.check_row) and the Monte Carlo's u_d
         return result;
       },
       py::arg("experiment"), py::kw_only(), py::arg("mc_trials") = kAnalysisMonteCarloTrials,
-      py::arg("seed") = kAnalysisSeed, py::arg("outlier_threshold") = 3.0, py::arg("jobs") = 0,
+      py::arg("seed") = kAnalysisSeed, py::arg("outlier_threshold") = kAnalysisOutlierThreshold, py::arg("jobs") = 0,
       R"(Analyses an experiment (a folder path or an uphill.Experiment) as `uphill fit EXP` does
 (app/experiment_folder_analysis.hpp): the trials' videos, when the folder has any, are tracked
 (jobs at a time, 0: one per core; cached in the folder) and a row with an empty Y takes its video's

@@ -277,9 +277,9 @@ TEST(VideoTrialsReport, WeightedMotionMuIsTheInverseVarianceMean) {
   // Truth: closed form. μ = (0.04/0.01² + 0.06/0.02²)/(1/0.01² + 1/0.02²) = 0.044, u = 1/sqrt(12500).
   std::vector<VideoTrial> trials(3);
   for (auto& t : trials) t.fit_available = true, t.fitted = "mu";
-  trials[0].fit_value = MeasuredValue{0.04, 0.01};
-  trials[1].fit_value = MeasuredValue{0.06, 0.02};
-  trials[2].fit_value = MeasuredValue{0.5, 0.01};
+  trials[0].fit_value = Estimate{0.04, 0.01};
+  trials[1].fit_value = Estimate{0.06, 0.02};
+  trials[2].fit_value = Estimate{0.5, 0.01};
   trials[2].error = "failed";  // left out
   const auto m = WeightedMotionMu(trials);
   ASSERT_TRUE(m.has_value());
@@ -443,7 +443,7 @@ TEST(VideoTrialsReport, ACachedTrialIsCheckedAsInput) {
   t.video = "v.mp4";
   t.frames = 10;
   t.found = 9;
-  t.rest = MeasuredValue{0.3, 0.001};
+  t.rest = Estimate{0.3, 0.001};
   const nlohmann::json good = VideoTrialToJson(t);
   EXPECT_EQ(VideoTrialFromJson(good).rest->value, 0.3);
   const auto refused = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& key) {

@@ -1,4 +1,4 @@
-// Ceres's own log lines never reach the user's stderr (fit/solver_logs.hpp). Truth: Ceres's
+// Ceres's own log lines never reach the user's stderr (model/solver_logs.hpp). Truth: Ceres's
 // behaviour, observed in a child process with glog untouched. A solve whose first evaluation
 // fails writes "Terminating: Residual and Jacobian evaluation failed." at ERROR severity even with
 // logging_type = SILENT (the premise, checked here so the test cannot pass vacuously); after
@@ -11,7 +11,7 @@
 
 #include <string>
 
-#include "fit/solver_logs.hpp"
+#include "model/solver_logs.hpp"
 
 namespace uphill::testing {
 namespace {

@@ -15,11 +15,11 @@
 #include <unistd.h>
 #include <sstream>
 
+#include "app/track_analysis_output.hpp"
 #include "cli_test_support.hpp"
 #include "model/input_error.hpp"
 #include "motion/motion.hpp"
 #include "vision/track_analysis.hpp"
-#include "vision/track_analysis_output.hpp"
 #include "vision/track_table.hpp"
 
 namespace uphill::testing {

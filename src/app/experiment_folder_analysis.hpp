@@ -26,7 +26,7 @@
 namespace uphill {
 
 struct ExperimentFolderOptions {
-  AnalysisOptions analysis = DefaultAnalysisOptions();
+  AnalysisOptions analysis;  // the defaults: app/analysis_defaults.hpp
   unsigned jobs = 0;                   // videos tracked at once; 0: one per core
   VideoTrialDoneCallback trial_done;   // each video trial as soon as it is finished (the report's figures)
 };

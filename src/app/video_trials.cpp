@@ -16,6 +16,7 @@
 #include <opencv2/core.hpp>
 #include <thread>
 
+#include "app/track_analysis_output.hpp"
 #include "app/track_video_file.hpp"
 #include "io/atomic_file.hpp"
 #include "io/contained_directory.hpp"
@@ -23,7 +24,6 @@
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
 #include "vision/track_analysis.hpp"
-#include "vision/track_analysis_output.hpp"
 #include "vision/track_table.hpp"
 
 namespace uphill {
@@ -50,41 +50,37 @@ TrackAnalysisOptions AnalysisOptionsOf(const VideoAnalysisSettings& v) {
   return o;
 }
 
-MeasuredValue Measured(const Estimate& e) { return {e.value, e.u}; }
-
 // The uncertainty analyse-track says to quote (track_analysis.hpp, "Uncertainty of the fit"):
 // u carries the tracker's systematic error, which the scatter of the residuals does not show
 // (se_scaled shrinks below the real error when chi2/dof < 1).
-MeasuredValue Quoted(const FittedParameter& p) {
+Estimate Quoted(const FittedParameter& p) {
   return {p.value, p.u ? p.u : p.se_scaled ? p.se_scaled : p.se};
 }
-
-VideoTrialEvent EventOf(const TrackEvent& e) { return {e.kind, Measured(e.t), Measured(e.x)}; }
 
 // The report's plain numbers of an analysis.
 void FillFromAnalysis(const TrackAnalysis& a, VideoTrial* t) {
   t->frames = a.frames;
   t->found = a.found;
   if (a.release) {
-    t->release_x = Measured(a.release->x);
-    t->release_t = Measured(a.release->t);
-    t->events.push_back(EventOf(*a.release));
+    t->release_x = a.release->x;
+    t->release_t = a.release->t;
+    t->events.push_back(*a.release);
   }
-  for (const TrackEvent& e : a.turning_points) t->events.push_back(EventOf(e));
+  t->events.insert(t->events.end(), a.turning_points.begin(), a.turning_points.end());
   if (a.rest) {
     // u(Y) = sqrt(se² + u_x²): the rest's standard error from the frames' scatter, and the stated
     // uncertainty of a tracked position, which averaging over frames does not reduce (they share
     // the calibration's and the tracker's systematic error).
-    t->rest = Measured(a.rest->x);
+    t->rest = a.rest->x;
     t->rest->u = std::hypot(a.rest->x.u.value_or(0.0), a.options.u_x);
-    t->events.push_back(EventOf(*a.rest));
+    t->events.push_back(*a.rest);
   } else {
     t->no_rest = a.fall_off    ? "never at rest: falls off the rails"
                  : a.reaches_o ? "never at rest: rolls back to O"
                                : "never at rest in the recording";
   }
-  if (a.fall_off) t->events.push_back(EventOf(*a.fall_off));
-  if (a.reaches_o) t->events.push_back(EventOf(*a.reaches_o));
+  if (a.fall_off) t->events.push_back(*a.fall_off);
+  if (a.reaches_o) t->events.push_back(*a.reaches_o);
   t->fit_available = a.fit.available;
   t->fit_unavailable = a.fit.unavailable;
   t->fitted = a.fit.fitted;

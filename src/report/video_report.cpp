@@ -8,11 +8,11 @@ namespace uphill {
 namespace {
 
 std::string Mm(double m) { return Printf("%.2f", m * 1e3); }
-std::string MmU(const std::optional<MeasuredValue>& v) {
+std::string MmU(const std::optional<Estimate>& v) {
   if (!v || !std::isfinite(v->value)) return "-";
   return Printf("%.2f", v->value * 1e3) + (v->u ? Printf(" ± %.2g", *v->u * 1e3) : "");
 }
-std::string SecondsU(const std::optional<MeasuredValue>& v) {
+std::string SecondsU(const std::optional<Estimate>& v) {
   if (!v || !std::isfinite(v->value)) return "-";
   return Printf("%.4f", v->value) + (v->u ? Printf(" ± %.2g", *v->u) : "");
 }
@@ -76,7 +76,7 @@ void AddVideoSections(const ExperimentAnalysis& a, bool with_figures, Document* 
   for (const VideoTrial& t : a.video_trials) {
     if (!t.error.empty()) continue;
     std::string events;
-    for (const VideoTrialEvent& e : t.events)
+    for (const TrackEvent& e : t.events)
       events += (events.empty() ? "" : "; ") + e.kind + (std::isfinite(e.x.value) ? " at " + Mm(e.x.value) + " mm" : "");
     std::string notes = t.fit_available ? "" : t.fit_unavailable;
     if (t.partial) notes += (notes.empty() ? "" : "; ") + ("partial track: " + t.partial_reason);

@@ -109,7 +109,7 @@ constexpr double kMaxTime = 1e6;       // s
 constexpr double kMaxFitValue = 1e6;   // μ or g_eff (m/s²)
 constexpr int kMaxCount = 1 << 30;     // rows, frames, degrees of freedom
 
-json ValueJson(const std::optional<MeasuredValue>& v) {
+json ValueJson(const std::optional<Estimate>& v) {
   if (!v) return nullptr;
   return {{"value", std::isfinite(v->value) ? json(v->value) : json(nullptr)}, {"u", v->u ? json(*v->u) : json(nullptr)}};
 }
@@ -143,7 +143,7 @@ json VideoTrialToJson(const VideoTrial& t, bool with_figure) {
             {"dof", t.dof},
             {"notes", t.notes}};
   json events = json::array();
-  for (const VideoTrialEvent& e : t.events)
+  for (const TrackEvent& e : t.events)
     events.push_back({{"kind", e.kind}, {"t", ValueJson(e.t)}, {"x", ValueJson(e.x)}});
   j["events"] = events;
   if (with_figure) {
@@ -178,10 +178,10 @@ VideoTrial VideoTrialFromJson(const json& j) {
   t.dof = r.Integer("dof", 0, kMaxCount);
   t.notes = r.Texts("notes");
   r.ForEach("events", [&](const internal::StrictJson& e) {
-    VideoTrialEvent ev;
+    TrackEvent ev;
     ev.kind = e.Text("kind");
-    ev.t = e.Value("t", kMaxTime, kMaxTime).value_or(MeasuredValue{});
-    ev.x = e.Value("x", kMaxLength, kMaxLength).value_or(MeasuredValue{});
+    ev.t = e.Value("t", kMaxTime, kMaxTime).value_or(Estimate{});
+    ev.x = e.Value("x", kMaxLength, kMaxLength).value_or(Estimate{});
     t.events.push_back(ev);
   });
   if (j.contains("figure")) {

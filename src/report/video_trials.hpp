@@ -1,6 +1,7 @@
 // VideoTrial: what one trial's recording measured, as plain numbers for the fit report (the
 // report layer does not see src/vision: app/video_trials.hpp fills these from the tracker and
-// the track analysis, vision/track_analysis.hpp, whose contract the numbers keep). SI units.
+// the track analysis, vision/track_analysis.hpp, whose contract the numbers keep; the values and
+// events are the analysis's own types, model/estimate.hpp). SI units.
 //
 // In the report (fit_document.hpp, fit_json.hpp):
 //  - a row whose Y cell is empty takes the video's rest position as Y ± u(Y);
@@ -19,22 +20,12 @@
 #include <utility>
 #include <vector>
 
+#include "model/estimate.hpp"
 #include "report/gnuplot_figure.hpp"
 
 namespace uphill {
 
-// A value with its standard uncertainty (u absent: not meaningful or not available).
-struct MeasuredValue {
-  double value = 0;
-  std::optional<double> u;
-};
-
-struct VideoTrialEvent {
-  std::string kind;  // "release", "turning point", "comes to rest", "falls off", "reaches O"
-  MeasuredValue t, x;  // s, m
-};
-
-// The data of the per-trial figures (the analyse-track figures, vision/track_analysis_output.hpp).
+// The data of the per-trial figures (the analyse-track figures, app/track_analysis_output.hpp).
 struct TrackFigureData {
   std::vector<std::pair<double, double>> measured;  // (t s, x m) of every frame with the ball
   std::vector<std::pair<double, double>> curve;     // (t, x) of the fitted model, dense
@@ -56,15 +47,15 @@ struct VideoTrial {
   double tracker_cpu_seconds = 0;  // the tracker's own CPU time, decoding excluded (0 from the cache)
   bool partial = false;
   std::string partial_reason;
-  std::optional<MeasuredValue> rest;           // x of the final rest, m: the trial's Y
-  std::string no_rest;                          // why there is no rest ("never at rest" …)
-  std::optional<MeasuredValue> release_x, release_t;  // x0 (m), t0 (s)
-  std::vector<VideoTrialEvent> events;
+  std::optional<Estimate> rest;                  // x of the final rest, m: the trial's Y
+  std::string no_rest;                           // why there is no rest ("never at rest" …)
+  std::optional<Estimate> release_x, release_t;  // x0 (m), t0 (s)
+  std::vector<TrackEvent> events;
   // The motion fit of x(t): x0, t0 and g_eff (m/s²) or μ.
   bool fit_available = false;
   std::string fit_unavailable;
   std::string fitted;                   // "g" or "mu"
-  std::optional<MeasuredValue> fit_value;  // u: analyse-track's u (statistical and the tracker's systematic part)
+  std::optional<Estimate> fit_value;    // u: analyse-track's u (statistical and the tracker's systematic part)
   double reduced_chi2 = 0;
   int dof = 0;
   std::vector<std::string> notes;

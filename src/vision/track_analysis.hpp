@@ -116,6 +116,7 @@
 #include <string>
 #include <vector>
 
+#include "model/estimate.hpp"
 #include "model/scene.hpp"
 #include "vision/track_table.hpp"
 
@@ -136,18 +137,6 @@ struct TrackAnalysisOptions {
   // fit"): tracker_floor_px + tracker_blur × (pixels the centre moves in one frame interval).
   double tracker_floor_px = 0.08;
   double tracker_blur = 0.015;
-};
-
-// A measured or fitted value with its standard uncertainty (none when not meaningful).
-struct Estimate {
-  double value = 0;
-  std::optional<double> u;
-};
-
-struct TrackEvent {
-  std::string kind;    // "release", "turning point", "comes to rest", "falls off", "reaches O"
-  Estimate t, x;       // s, m
-  std::string method;  // how it was measured, in words
 };
 
 struct FittedParameter {

@@ -11,12 +11,12 @@
 #include <cmath>
 #include <iostream>
 
+#include "app/track_analysis_output.hpp"
 #include "io/output_paths.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "model/input_ranges.hpp"
 #include "vision/track_analysis.hpp"
-#include "vision/track_analysis_output.hpp"
 #include "vision/track_table.hpp"
 #endif
 

@@ -18,6 +18,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "app/track_analysis_output.hpp"
 #include "app/track_video_file.hpp"
 #include "progress_bars.hpp"
 #include "io/configuration.hpp"
@@ -25,7 +26,6 @@
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "vision/track_analysis.hpp"
-#include "vision/track_analysis_output.hpp"
 #include "vision/track_table.hpp"
 #endif
 

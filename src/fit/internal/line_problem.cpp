@@ -8,9 +8,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "fit/solver_logs.hpp"
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
+#include "model/solver_logs.hpp"
 
 namespace uphill::internal {
 

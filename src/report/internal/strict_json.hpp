@@ -46,11 +46,11 @@ class StrictJson {
   }
   double Number(const char* key, double lo, double hi) const { return InRange(At(key), Where(key), lo, hi); }
   // {"value": v, "u": u} or null: |v| ≤ max_value (null: NaN, not measured), 0 ≤ u ≤ max_u (null: none).
-  std::optional<MeasuredValue> Value(const char* key, double max_value, double max_u) const {
+  std::optional<Estimate> Value(const char* key, double max_value, double max_u) const {
     const nlohmann::json& v = At(key);
     if (v.is_null()) return std::nullopt;
     const StrictJson o(v, Where(key));
-    MeasuredValue m;
+    Estimate m;
     m.value = o.At("value").is_null() ? std::nan("") : o.Number("value", -max_value, max_value);
     if (!o.At("u").is_null()) m.u = o.Number("u", 0, max_u);
     return m;

@@ -41,7 +41,7 @@ std::string Number(double v) {
 ordered_json TrackRowVideo(const ExperimentStore& store, const StoreSnapshot& snapshot, std::int64_t id) {
   const std::string& unit = snapshot.state.unit;
   const auto L = [&](double si) { return ToUnit(si, Dimension::kLength, unit); };
-  const auto measured = [&](const std::optional<MeasuredValue>& m, bool length) -> ordered_json {
+  const auto measured = [&](const std::optional<Estimate>& m, bool length) -> ordered_json {
     if (!m) return nullptr;
     return {{"value", length ? L(m->value) : m->value},
             {"u", m->u ? ordered_json(length ? L(*m->u) : *m->u) : ordered_json(nullptr)}};
@@ -67,12 +67,12 @@ ordered_json TrackRowVideo(const ExperimentStore& store, const StoreSnapshot& sn
     }
   out["direction"] = direction;
   ordered_json turns = ordered_json::array();
-  for (const VideoTrialEvent& e : t.events)
+  for (const TrackEvent& e : t.events)
     if (e.kind == "turning point") turns.push_back({{"x", L(e.x.value)}, {"t", e.t.value}});
   out["turns"] = turns;
   if (t.rest) {
     double rest_t = 0;
-    for (const VideoTrialEvent& e : t.events)
+    for (const TrackEvent& e : t.events)
       if (e.kind == "comes to rest") rest_t = e.t.value;
     out["rest"] = {{"y", measured(t.rest, true)}, {"t", rest_t}};
   } else {

@@ -9,7 +9,7 @@
 #include <memory>
 #include <string>
 
-#include "fit/solver_logs.hpp"
+#include "model/solver_logs.hpp"
 #include "outline_ray_cost.hpp"
 
 namespace uphill::internal {

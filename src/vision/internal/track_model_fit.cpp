@@ -8,8 +8,8 @@
 #include <memory>
 #include <optional>
 
-#include "fit/solver_logs.hpp"
 #include "model/input_error.hpp"
+#include "model/solver_logs.hpp"
 #include "motion/motion.hpp"
 #include "track_fit_errors.hpp"
 

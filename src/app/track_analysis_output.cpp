@@ -1,4 +1,4 @@
-#include "vision/track_analysis_output.hpp"
+#include "app/track_analysis_output.hpp"
 
 #include <filesystem>
 #include <sstream>

@@ -1,11 +1,13 @@
-// The outputs of a TrackAnalysis (track_analysis.hpp), shared by `uphill analyse-track` and
-// `uphill track … --analyse`:
+// The outputs of a TrackAnalysis (vision/track_analysis.hpp), shared by `uphill analyse-track`,
+// `uphill track … --analyse` and the trials' videos of an experiment (video_trials.hpp):
 //   TrackAnalysisTable    the events and the fit as a plain-text table, lengths in mm, times in s
 //   TrackAnalysisJson     track_analysis.json, format "uphill-track-analysis/1", SI units; keys
 //                         documented in data/README.md, "Track analysis output"
 //   TrackAnalysisFigures  track_x_vs_t (measured x(t) against the fitted model) and
 //                         track_residuals (measured − predicted, mm), drawn by gnuplot
 //   WriteTrackAnalysis    all of them into a directory (created if missing), each file atomically
+// They join vision's analysis to report's figures (report/video_trials.hpp), so they live in the
+// video use cases: vision does not see report.
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -1,4 +1,4 @@
-#include "fit/solver_logs.hpp"
+#include "model/solver_logs.hpp"
 
 #include <glog/logging.h>
 
