@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "io/atomic_file.hpp"
 #include "io/csv_table.hpp"
+#include "io/output_paths.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
@@ -93,6 +96,20 @@ TargetPng ChessboardTargetPng(const ChessboardTarget& target, double dpi) {
   out.width = image.cols;
   out.height = image.rows;
   return out;
+}
+
+std::string WriteChessboardTarget(const std::string& path, const ChessboardTarget& t, double dpi) {
+  OutputPaths::CreateFolders(std::filesystem::path(path).parent_path().string());
+  if (std::filesystem::path(path).extension() == ".svg") {
+    WriteFileAtomically(path, ChessboardTargetSvg(t));
+    return "print at 100 % (no \"fit to page\"), then measure a square: it must be " + Num(t.square * 1000) +
+           " mm (give the measured value to --square)";
+  }
+  const TargetPng png = ChessboardTargetPng(t, dpi);
+  WriteFileAtomically(path, png.bytes);
+  return std::to_string(png.width) + " × " + std::to_string(png.height) + " px, " + std::to_string(png.pixels_per_square) +
+         " px per square; print at " + Num(dpi) + " dpi so that a square measures " + Num(t.square * 1000) +
+         " mm (measure it and give the measured value to --square)";
 }
 
 }  // namespace uphill

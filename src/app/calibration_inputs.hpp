@@ -31,4 +31,10 @@ struct TargetPng {
 };
 TargetPng ChessboardTargetPng(const ChessboardTarget& target, double dpi);
 
+// `calibrate target`: the target written to `path` atomically (its folder created if needed), an
+// SVG when `path` ends in .svg, else a PNG for a printer of `dpi` dots per inch; returns the line
+// that says how to print it and what a square must then measure. The caller has checked `path`
+// (its extension .svg or .png, and that it is no input).
+std::string WriteChessboardTarget(const std::string& path, const ChessboardTarget& target, double dpi);
+
 }  // namespace uphill

@@ -1,6 +1,10 @@
 #include "app/experiment_folder_analysis.hpp"
 
 #include "model/input_ranges.hpp"
+#include "report/figure_pool.hpp"
+#include "report/fit_document.hpp"
+#include "report/report_outputs.hpp"
+#include "report/video_report.hpp"
 
 namespace uphill {
 
@@ -27,6 +31,25 @@ ExperimentFolderAnalysis AnalyseLoadedExperiment(Experiment experiment, const Ex
   }
   out.analysis = AnalyseExperimentWithVideos(out.experiment.get(), trials, options.analysis);
   return out;
+}
+
+ExperimentFolderAnalysis WriteExperimentReport(Experiment experiment, const ExperimentReportTarget& target,
+                                               const ExperimentFolderOptions& options,
+                                               const VideoProgressCallback& progress) {
+  CheckReportOutputs(experiment, target.checked.empty() ? target.output : target.checked, target.flag);
+  FigurePool figures(options.jobs);  // drawing while the videos are tracked, one gnuplot per core
+  ExperimentFolderOptions drawing = options;
+  drawing.trial_done = [&, folder_made = false](std::size_t index, const VideoTrial& trial) mutable {
+    for (GnuplotFigure& figure : VideoTrialFigures(trial, index)) {
+      if (!folder_made) CreateReportFolder(target.output);  // not before: a failed report leaves nothing
+      folder_made = true;
+      figures.Render(std::move(figure), target.output);
+    }
+    if (options.trial_done) options.trial_done(index, trial);
+  };
+  ExperimentFolderAnalysis a = AnalyseLoadedExperiment(std::move(experiment), drawing, progress);
+  WriteFitReport(a.analysis, target.output, &figures);
+  return a;
 }
 
 }  // namespace uphill

@@ -1,5 +1,5 @@
-// Analysing an experiment folder: the use case of `uphill fit EXP` and `uphill report EXP`
-// (docs/fit.md), of the page's report (POST /api/report) and of Python's
+// Analysing an experiment folder, and writing its report: the use cases of `uphill fit EXP` and
+// `uphill report EXP` (docs/fit.md), of the page's report (POST /api/report) and of Python's
 // uphill.analyse_experiment. The folder is read (io/experiment.hpp); when its rows name videos
 // (format uphill-experiment/2) they are tracked and analysed first, `jobs` at a time and cached
 // (app/video_trials.hpp), and a row whose Y is empty takes its video's rest position; then the
@@ -48,5 +48,22 @@ ExperimentFolderAnalysis AnalyseExperimentFolder(const std::string& directory,
 // first, or holds an uphill.Experiment): `experiment` is taken by value and kept in the result.
 ExperimentFolderAnalysis AnalyseLoadedExperiment(Experiment experiment, const ExperimentFolderOptions& options = {},
                                                  const VideoProgressCallback& progress = {});
+
+// The report of an experiment (report/fit_document.hpp) written into `output`: first the report
+// folder `checked` (the folder the files end up in: `output` itself, or the page's report folder
+// when `output` is its staging folder) is checked against the experiment's inputs
+// (report/report_outputs.hpp: never over an input; InputError naming `flag`); then the folder is
+// analysed as AnalyseLoadedExperiment does, each video trial's figures drawn as soon as the trial
+// is finished while the others are tracked (one gnuplot per job); then the documents. `output`
+// is created only once something is written into it: a report that fails leaves nothing.
+// options.trial_done, when set, is called after a trial's figures were submitted.
+struct ExperimentReportTarget {
+  std::string output;   // where the files are written
+  std::string checked;  // the report folder checked against the inputs ("" : output)
+  std::string flag;     // names the folder in an error ("-o", "report")
+};
+ExperimentFolderAnalysis WriteExperimentReport(Experiment experiment, const ExperimentReportTarget& target,
+                                               const ExperimentFolderOptions& options = {},
+                                               const VideoProgressCallback& progress = {});
 
 }  // namespace uphill

@@ -1,8 +1,11 @@
 #include "app/simulation.hpp"
 
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 #include <string>
 
+#include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "model/number_text.hpp"
 
@@ -129,6 +132,50 @@ nlohmann::json ToJson(const Simulation& s) {
   }
   j["events"] = events;
   return j;
+}
+
+namespace {
+
+std::string Num(double v) {
+  std::ostringstream out;
+  out.precision(10);
+  out << v;
+  return out.str();
+}
+
+}  // namespace
+
+std::string SimulationCsv(const Simulation& r) {
+  std::ostringstream out;
+  out << "t_s,x_m,z_m,v_m/s,vx_m/s,vz_m/s,angle_rad\n";
+  out << std::setprecision(17);
+  for (const auto& s : r.samples)
+    out << s.t << "," << s.x << "," << s.z << "," << s.v << "," << s.vx << "," << s.vz << "," << s.angle << "\n";
+  return out.str();
+}
+
+std::string SimulationTable(const Simulation& r, const std::string& length_unit) {
+  std::ostringstream out;
+  const std::string& lu = length_unit;
+  const auto L = [&](double v) { return ToUnit(v, Dimension::kLength, lu); };
+  out << "released at x0 = " << Num(L(r.x0)) << " " << lu;
+  if (r.x_eq) out << "  (X = " << Num(L(*r.x_eq)) << " " << lu << ")";
+  out << ", x_max = " << Num(L(r.x_max)) << " " << lu << ", method "
+      << (r.options.method == MotionMethod::kOde ? "ode" : "quadrature") << "\n";
+  const auto col = [](const std::string& h) { return std::string(" ") + std::string(h.size() < 15 ? 15 - h.size() : 0, ' ') + h; };
+  out << col("t [s]") << col("x [" + lu + "]") << col("z [" + lu + "]") << col("v [m/s]") << col("vx [m/s]")
+      << col("vz [m/s]") << col("angle [rad]") << "\n";
+  out << std::setprecision(9);
+  for (const auto& s : r.samples) {
+    for (double v : {s.t, L(s.x), L(s.z), s.v, s.vx, s.vz, s.angle}) out << " " << std::setw(15) << v + 0.0;
+    out << "\n";
+  }
+  out << "events:\n";
+  if (r.events.empty()) out << "  none (rolls toward the apex; it never gets there)\n";
+  for (const auto& e : r.events)
+    out << "  " << std::left << std::setw(14) << EventName(e.kind) << std::right << " t = " << std::setprecision(12)
+        << e.t << " s   x = " << L(e.x) << " " << lu << "\n";
+  return out.str();
 }
 
 }  // namespace uphill

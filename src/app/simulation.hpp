@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "model/scene.hpp"
@@ -59,5 +60,13 @@ Simulation Simulate(const Scene& scene, const SimulationRequest& request);
 //  "samples": [{"t", "x", "z", "v", "vx", "vz", "angle"}...], "events": [{"kind", "x", "t"}...]},
 // SI units; an event's t is null when it is never reached.
 nlohmann::json ToJson(const Simulation& simulation);
+
+// `uphill simulate --csv`: the header t_s,x_m,z_m,v_m/s,vx_m/s,vz_m/s,angle_rad, then one line per
+// sample with 17 significant digits (SI units).
+std::string SimulationCsv(const Simulation& simulation);
+
+// `uphill simulate`'s table: the release, X and x_max, the method, the samples (lengths in
+// `length_unit`, an io/units.hpp length unit; speeds in m/s, angles in rad) and the events.
+std::string SimulationTable(const Simulation& simulation, const std::string& length_unit);
 
 }  // namespace uphill

@@ -13,6 +13,7 @@
 #include "bench/results_document.hpp"
 #include "bench/support.hpp"
 #include "io/experiment.hpp"
+#include "model/input_error.hpp"
 #include "motion/motion.hpp"
 #include "vision/camera.hpp"
 #include "vision/synthetic_clip.hpp"
@@ -164,6 +165,11 @@ double DecodeAll(const std::vector<std::string>& videos, unsigned jobs, long* fr
 }  // namespace
 
 void RunReportBenchmark(const ReportBenchmarkOptions& o, std::ostream& out) {
+  if (o.videos < 2 || o.videos > 200) throw InputError("--videos", "must be between 2 and 200");
+  if (o.rounds < 1 || o.rounds > 20) throw InputError("--rounds", "must be between 1 and 20");
+  if (o.seconds < 3 || o.seconds > 120) throw InputError("--seconds", "must be between 3 and 120 s");
+  if (o.width < 320 || o.height < 180 || o.width > 4096 || o.height > 4096)
+    throw InputError("--width/--height", "must be between 320x180 and 4096x4096");
   Section section = StartSection("report", o.common.command, kMethod);
   section.versions.emplace_back("OpenCV (C++)", CV_VERSION);
   OneDecodeThreadPerVideo();

@@ -23,6 +23,8 @@ struct ReportBenchmarkOptions {
   int rounds = 2;      // each run's best of this many
 };
 
+// Throws InputError (naming the flag) for videos outside 2..200, rounds outside 1..20, seconds
+// outside 3..120 or a size outside 320x180..4096x4096.
 void RunReportBenchmark(const ReportBenchmarkOptions& options, std::ostream& out);
 
 }  // namespace uphill::bench

@@ -529,14 +529,14 @@ struct Server::Impl {
     }
     ExperimentFolderOptions analysis_options;
     analysis_options.analysis.mc_trials = options.report_mc_trials;
-    const ExperimentFolderAnalysis folder_analysis = AnalyseExperimentFolder(store.directory(), analysis_options);
-    const ExperimentAnalysis& analysis = folder_analysis.analysis;
-    CheckReportOutputs(*folder_analysis.experiment, (fs::path(store.directory()) / "report").string(), "report");  // 422: never over an input
+    Experiment experiment = LoadExperiment(store.directory());
     ClaimFolder();
     ContainedDirectory staging = folder->MakeStagingDirectory(internal::kReportStagingPrefix);
     std::vector<std::string> names;
     try {
-      WriteFitReport(analysis, staging.path());
+      // Written into a staging folder, then moved into EXP/report (checked against the inputs: 422).
+      WriteExperimentReport(std::move(experiment), {staging.path(), (fs::path(store.directory()) / "report").string(), "report"},
+                            analysis_options);
       const ContainedDirectory target = folder->Subdirectory("report", true);
       for (const std::string& name : staging.RegularFiles()) {
         if (!ValidReportName(name)) continue;

@@ -229,4 +229,10 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
   return a;
 }
 
+TrackFitParameter ParseTrackFitParameter(const std::string& text, const std::string& field) {
+  if (text == "g") return TrackFitParameter::kEffectiveG;
+  if (text == "mu") return TrackFitParameter::kMu;
+  throw InputError(field, "must be g (an effective g) or mu (rolling resistance), got '" + text + "'");
+}
+
 }  // namespace uphill

@@ -123,6 +123,8 @@
 namespace uphill {
 
 enum class TrackFitParameter { kEffectiveG, kMu };
+// "g" or "mu"; InputError naming `field` otherwise.
+TrackFitParameter ParseTrackFitParameter(const std::string& text, const std::string& field);
 
 struct TrackAnalysisOptions {
   double g = 9.80665;                                // m/s², the reference g (kMu: the g used), in [1e-3, 1e3]

@@ -49,13 +49,7 @@ void Run(const AnalyseTrackFlags& f) {
     throw InputError("--tracker-blur", "must be >= 0 (pixels of error per pixel moved per frame)");
   o.tracker_floor_px = f.tracker_floor_px;
   o.tracker_blur = f.tracker_blur;
-  if (f.fit == "g") {
-    o.fit = TrackFitParameter::kEffectiveG;
-  } else if (f.fit == "mu") {
-    o.fit = TrackFitParameter::kMu;
-  } else {
-    throw InputError("--fit", "must be g (an effective g) or mu (rolling resistance), got '" + f.fit + "'");
-  }
+  o.fit = ParseTrackFitParameter(f.fit, "--fit");
   if (!f.output.empty()) {  // checked before any work
     OutputPaths outputs;
     outputs.AddInput(f.track, "the track file");

@@ -11,7 +11,6 @@
 #include "bench/report_benchmark.hpp"
 #include "bench/track_benchmark.hpp"
 #include "commands.hpp"
-#include "model/input_error.hpp"
 #include "vision_program.hpp"
 
 namespace uphill::cli {
@@ -30,6 +29,24 @@ std::string CommandLine(const std::vector<std::string>& arguments) {
   return line;
 }
 
+// When `cmd` is chosen: `run` with the options, the command line recorded with the results.
+template <class Options>
+void RunsWith(CLI::App* cmd, const std::shared_ptr<Options>& o, const std::shared_ptr<std::vector<std::string>>& argv,
+              void (*run)(const Options&, std::ostream&)) {
+  cmd->callback([o, argv, run] {
+    o->common.command = CommandLine(*argv);
+    run(*o, std::cout);
+  });
+}
+
+#if UPHILL_VISION_PROGRAM
+using bench::RunReportBenchmark;
+using bench::RunTrackBenchmark;
+#else  // uphill: the video benchmarks run in uphill-vision (vision_program.hpp)
+void RunTrackBenchmark(const bench::TrackBenchmarkOptions&, std::ostream&) { RunInVisionProgram(); }
+void RunReportBenchmark(const bench::ReportBenchmarkOptions&, std::ostream&) { RunInVisionProgram(); }
+#endif
+
 void AddFit(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
   auto o = std::make_shared<bench::FitBenchmarkOptions>();
   CLI::App* cmd = bench.add_subcommand(
@@ -46,10 +63,7 @@ void AddFit(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& ar
   cmd->add_flag("--no-peers", o->no_peers, "skip the NumPy/SciPy peers");
   cmd->add_flag("--no-odr", o->no_odr, "skip scipy.odr (slow at 10^6 rows)");
   cmd->add_flag("--no-rlm", o->no_rlm, "skip statsmodels' RLM (slow at 10^6 rows)");
-  cmd->callback([o, argv] {
-    o->common.command = CommandLine(*argv);
-    bench::RunFitBenchmark(*o, std::cout);
-  });
+  RunsWith(cmd, o, argv, bench::RunFitBenchmark);
 }
 
 void AddIo(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
@@ -67,10 +81,7 @@ void AddIo(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& arg
   cmd->add_flag("--no-bad-input", o->no_bad_input, "skip the bad-input cases");
   cmd->add_option("--long-line-bytes", o->long_line_bytes, "length of the line without a line end")
       ->capture_default_str();
-  cmd->callback([o, argv] {
-    o->common.command = CommandLine(*argv);
-    bench::RunIoBenchmark(*o, std::cout);
-  });
+  RunsWith(cmd, o, argv, bench::RunIoBenchmark);
 }
 
 void AddConvert(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
@@ -85,10 +96,7 @@ void AddConvert(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>
   cmd->add_option("--numpy-script", o->script, "path of tools/bench/numpy_convert.py");
   cmd->add_option("--reference", o->reference, "path of tests/data/physics_reference.json");
   cmd->add_flag("--no-numpy", o->no_numpy, "skip the NumPy comparison");
-  cmd->callback([o, argv] {
-    o->common.command = CommandLine(*argv);
-    bench::RunConvertBenchmark(*o, std::cout);
-  });
+  RunsWith(cmd, o, argv, bench::RunConvertBenchmark);
 }
 
 void AddMotion(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
@@ -99,10 +107,7 @@ void AddMotion(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>&
   cmd->add_option("--script", o->script, "path of tools/bench/motion_peers.py");
   cmd->add_flag("--no-python", o->no_python, "skip the SciPy/NumPy comparison");
   cmd->add_flag("--release-only", o->release_only, "only the ReleaseTimes rows (no Motion rows, no peers)");
-  cmd->callback([o, argv] {
-    o->common.command = CommandLine(*argv);
-    bench::RunMotionBenchmark(*o, std::cout);
-  });
+  RunsWith(cmd, o, argv, bench::RunMotionBenchmark);
 }
 
 void AddTrack(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
@@ -119,14 +124,7 @@ void AddTrack(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& 
   cmd->add_option("--footage-cache", o->footage_cache, "ray-traced clips (default ~/.cache/uphill/clips)");
   cmd->add_option("--positions", o->positions,
                   "folder to write each ray-traced clip's frames in, tracked against the truth (<condition>.csv)");
-  cmd->callback([o, argv] {
-    o->common.command = CommandLine(*argv);
-#if UPHILL_VISION_PROGRAM
-    bench::RunTrackBenchmark(*o, std::cout);
-#else
-    RunInVisionProgram();
-#endif
-  });
+  RunsWith(cmd, o, argv, RunTrackBenchmark);
 }
 
 void AddReport(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
@@ -142,19 +140,7 @@ void AddReport(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>&
   cmd->add_option("--jobs", o->jobs, "threads (0: every core)")->capture_default_str();
   cmd->add_option("--rounds", o->rounds, "rounds of all the runs; each run's best is kept")->capture_default_str();
   AddCommonFlags(cmd, &o->common, "unused (no Python peer: decoding is the baseline)");
-  cmd->callback([o, argv] {
-    o->common.command = CommandLine(*argv);
-    if (o->videos < 2 || o->videos > 200) throw InputError("--videos", "must be between 2 and 200");
-    if (o->rounds < 1 || o->rounds > 20) throw InputError("--rounds", "must be between 1 and 20");
-    if (o->seconds < 3 || o->seconds > 120) throw InputError("--seconds", "must be between 3 and 120 s");
-    if (o->width < 320 || o->height < 180 || o->width > 4096 || o->height > 4096)
-      throw InputError("--width/--height", "must be between 320x180 and 4096x4096");
-#if UPHILL_VISION_PROGRAM
-    bench::RunReportBenchmark(*o, std::cout);
-#else
-    RunInVisionProgram();
-#endif
-  });
+  RunsWith(cmd, o, argv, RunReportBenchmark);
 }
 
 void AddPython(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& argv) {
@@ -167,10 +153,7 @@ void AddPython(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>&
   AddCommonFlags(cmd, &o->common, "Python with NumPy that imports the module");
   cmd->add_option("--script", o->script, "path of tools/bench/python_module.py");
   cmd->add_option("--module-dir", o->module_dir, "folder of the module to import (default: this build's)");
-  cmd->callback([o, argv] {
-    o->common.command = CommandLine(*argv);
-    bench::RunPythonBenchmark(*o, std::cout);
-  });
+  RunsWith(cmd, o, argv, bench::RunPythonBenchmark);
 }
 
 }  // namespace

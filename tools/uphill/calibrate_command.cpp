@@ -15,22 +15,16 @@
 #include "vision_program.hpp"
 #if UPHILL_VISION_PROGRAM
 #include <Eigen/Geometry>
-#include <cmath>
 #include <filesystem>
-#include <iomanip>
 #include <iostream>
-#include <numbers>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "app/calibration_files.hpp"
 #include "app/calibration_inputs.hpp"
-#include "io/atomic_file.hpp"
 #include "io/output_paths.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
 #include "vision/calibration.hpp"
-#include "vision/decode_limits.hpp"
-#include "vision/library_logs.hpp"
 #endif
 
 namespace uphill::cli {
@@ -61,33 +55,11 @@ void AddTargetFlags(CLI::App* cmd, TargetFlags* f, bool square_required) {
 
 #if UPHILL_VISION_PROGRAM
 
-std::string Num(double v, int precision = 6) {
-  std::ostringstream out;
-  out.precision(precision);
-  out << v;
-  return out.str();
-}
-
-std::string Fixed(double v, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << v;
-  return out.str();
-}
-
-void Row(const std::string& name, const std::string& value) {
-  std::cout << "  " << std::left << std::setw(34) << name << value << "\n";
-}
-
 ChessboardTarget Target(const TargetFlags& f) {
   if (f.square.empty()) throw InputError("--square", "is required (the side of one square, with unit, e.g. 20mm)");
   ChessboardTarget t{f.cols, f.rows, ParseQuantity(f.square, Dimension::kLength, "--square")};
   ValidateCalibrationTarget(t);
   return t;
-}
-
-void PrintVerdict(const std::string& verdict, const std::vector<std::string>& reasons) {
-  std::cout << "verdict: " << verdict << "\n";
-  for (const auto& r : reasons) std::cout << "  * " << r << "\n";
 }
 
 // ---- camera ----
@@ -115,30 +87,9 @@ void RunCamera(const CalibrateFlags& f) {
   CameraCalibrationOptions options;
   options.fit_k3 = f.fit_k3;
   const CameraCalibration c = CalibrateCameraFromFiles(f.images, target, options);
-  const CameraIntrinsics& k = c.camera;
   MakeOutputFolder(f);
-  WriteCameraFile(f.output, k, c.Summary(target));  // first: the printout then describes a saved file
-  std::cout << "camera calibration: " << c.views_used << " of " << c.views.size() << " views used, chessboard "
-            << target.cols << "×" << target.rows << " inner corners, " << Num(target.square * 1000) << " mm squares\n";
-  Row("image size", std::to_string(k.width) + " × " + std::to_string(k.height) + " px");
-  Row("fx (focal length, x)", Fixed(k.fx, 2) + " px   (± " + Num(c.std_dev_px(0), 2) + ")");
-  Row("fy (focal length, y)", Fixed(k.fy, 2) + " px   (± " + Num(c.std_dev_px(1), 2) + ")");
-  Row("cx (principal point, x)", Fixed(k.cx, 2) + " px   (± " + Num(c.std_dev_px(2), 2) + ")");
-  Row("cy (principal point, y)", Fixed(k.cy, 2) + " px   (± " + Num(c.std_dev_px(3), 2) + ")");
-  static const char* kNames[] = {"k1", "k2", "p1", "p2", "k3"};
-  for (size_t i = 0; i < k.distortion.size() && i < 5; ++i)
-    Row(std::string("distortion ") + kNames[i], Num(k.distortion[i], 5) + (i == 4 && !f.fit_k3 ? "   (fixed)" : ""));
-  Row("RMS reprojection error", Fixed(c.rms_px, 3) + " px");
-  Row("image coverage", Fixed(100 * c.coverage, 0) + " % (cells of a 5×5 grid with corners)");
-  std::cout << "  views:\n";
-  for (const auto& v : c.views) {
-    if (v.used)
-      std::cout << "    " << v.name << ": RMS " << Fixed(v.rms_px, 3) << " px, tilt " << Fixed(v.tilt_deg, 1)
-                << "°, distance " << Fixed(v.distance_m * 1000, 0) << " mm\n";
-    else
-      std::cout << "    " << v.name << ": rejected, " << v.rejected_because << "\n";
-  }
-  PrintVerdict(c.verdict, c.reasons);
+  WriteCameraFile(f.output, c.camera, c.Summary(target));  // first: the printout then describes a saved file
+  std::cout << CameraCalibrationText(c, target, f.fit_k3);
   std::cout << "wrote " << f.output << "\n";
 }
 
@@ -163,14 +114,6 @@ Eigen::Vector3d Point(const std::string& text, const std::string& flag) {
   return {values[0], values[1], values[2]};
 }
 
-cv::Mat ReadImage(const std::string& path, const std::string& flag) {
-  CheckImagePixels(path, flag + " " + path);
-  QuietVideoLibraryLogs();
-  const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (image.empty()) throw InputError(flag + " " + path, "cannot be read as an image");
-  return image;
-}
-
 void RunScene(const CalibrateFlags& f) {
   CheckOutput(f);
   const CameraIntrinsics camera = ReadCameraFile(f.camera);
@@ -178,47 +121,15 @@ void RunScene(const CalibrateFlags& f) {
   if (!f.board_image.empty()) {
     if (!f.points.empty()) throw InputError("--points/--board-image", "give one of them, not both");
     if (f.board_origin.empty()) throw InputError("--board-origin", "is required with --board-image");
-    const Eigen::Vector3d x = Axis(f.board_x_axis, "--board-x-axis"), y = Axis(f.board_y_axis, "--board-y-axis");
-    if (x.dot(y) != 0) throw InputError("--board-x-axis/--board-y-axis", "must be perpendicular");
-    r = CalibrateSceneFromChessboard(camera, {f.board_image, ReadImage(f.board_image, "--board-image")},
-                                             Target(f.target), Point(f.board_origin, "--board-origin"), x, y);
+    r = CalibrateSceneFromBoardFile(camera, f.board_image, Target(f.target), Point(f.board_origin, "--board-origin"),
+                                    Axis(f.board_x_axis, "--board-x-axis"), Axis(f.board_y_axis, "--board-y-axis"));
   } else {
     if (f.points.empty()) throw InputError("--points", "is required (or --board-image)");
-    int frame_width = 0, frame_height = 0;
-    if (!f.frame.empty()) {
-      const cv::Mat frame = ReadImage(f.frame, "--frame");
-      frame_width = frame.cols;
-      frame_height = frame.rows;
-    }
-    try {
-      r = CalibrateScene(camera, ReadScenePoints(f.points), frame_width, frame_height);
-    } catch (const InputError& e) {
-      // The library names rows (labels) or "points"/"frame"; say which file was meant.
-      const std::string& q = e.quantity();
-      if (q == "points") throw InputError(f.points + ": points", e.rule());
-      if (q == "frame") throw InputError("--frame " + f.frame, e.rule() + " (camera file " + f.camera + ")");
-      throw;
-    }
+    r = CalibrateSceneFromPointsFile(camera, f.camera, f.points, f.frame);
   }
   MakeOutputFolder(f);
   WriteSceneFile(f.output, r.scene, r.Summary());  // first: the printout then describes a saved file
-  const CameraPose& pose = r.scene.pose;
-  const Eigen::Vector3d centre = CameraCentre(pose);
-  const Eigen::Vector3d axis = pose.rotation.row(2).transpose();
-  const double degree = std::numbers::pi / 180;
-  std::cout << "scene calibration: " << r.residuals.size() << " points, camera " << f.camera << "\n";
-  Row("camera centre (apparatus frame)", "x = " + Fixed(centre.x() * 1000, 1) + " mm, y = " +
-                                             Fixed(centre.y() * 1000, 1) + " mm, z = " + Fixed(centre.z() * 1000, 1) +
-                                             " mm");
-  Row("distance to O", Fixed(centre.norm() * 1000, 1) + " mm");
-  Row("viewing direction", "(" + Fixed(axis.x(), 4) + ", " + Fixed(axis.y(), 4) + ", " + Fixed(axis.z(), 4) + "): " +
-                               Fixed(std::asin(std::clamp(-axis.z(), -1.0, 1.0)) / degree, 1) +
-                               "° below horizontal, azimuth " + Fixed(std::atan2(axis.y(), axis.x()) / degree, 1) +
-                               "° from +x");
-  Row("RMS reprojection error", Fixed(r.rms_px, 3) + " px");
-  std::cout << "  residuals:\n";
-  for (const auto& p : r.residuals) std::cout << "    " << p.label << ": " << Fixed(p.error_px, 3) << " px\n";
-  PrintVerdict(r.verdict, r.reasons);
+  std::cout << SceneCalibrationText(r, f.camera);
   std::cout << "wrote " << f.output << "\n";
 }
 
@@ -230,20 +141,8 @@ void RunTarget(const CalibrateFlags& f) {
   if (extension != ".svg" && extension != ".png")
     throw InputError("-o", "must end in .svg or .png (got '" + f.output + "')");
   CheckOutput(f);
-  if (extension == ".svg") {
-    MakeOutputFolder(f);
-    WriteFileAtomically(f.output, ChessboardTargetSvg(t));
-    std::cout << "wrote " << f.output << ": print at 100 % (no \"fit to page\"), then measure a square: it must be "
-              << Num(t.square * 1000) << " mm (give the measured value to --square)\n";
-    return;
-  }
-  const double dpi = ParseQuantity(f.dpi, Dimension::kDimensionless, "--dpi");
-  const TargetPng png = ChessboardTargetPng(t, dpi);
-  MakeOutputFolder(f);
-  WriteFileAtomically(f.output, png.bytes);
-  std::cout << "wrote " << f.output << ": " << png.width << " × " << png.height << " px, " << png.pixels_per_square
-            << " px per square; print at " << Num(dpi) << " dpi so that a square measures " << Num(t.square * 1000)
-            << " mm (measure it and give the measured value to --square)\n";
+  const double dpi = extension == ".png" ? ParseQuantity(f.dpi, Dimension::kDimensionless, "--dpi") : 0.0;
+  std::cout << "wrote " << f.output << ": " << WriteChessboardTarget(f.output, t, dpi) << "\n";
 }
 
 #else  // uphill: the work runs in uphill-vision (vision_program.hpp)

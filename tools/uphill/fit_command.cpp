@@ -20,9 +20,7 @@
 #include "model/input_ranges.hpp"
 #include "report/fit_document.hpp"
 #include "report/fit_json.hpp"
-#include "report/figure_pool.hpp"
-#include "report/report_outputs.hpp"
-#include "report/video_report.hpp"
+#include "report/fit_text.hpp"
 #include "vision_program.hpp"
 #if UPHILL_VISION_PROGRAM
 #include "app/experiment_folder_analysis.hpp"
@@ -46,22 +44,6 @@ struct FitFlags {
 };
 
 
-void PrintFitText(const FitReport& r) {
-  std::cout << "method: " << MethodName(r.method) << ", n = " << r.n << ", dof = " << r.dof << "\n";
-  for (const auto& p : r.parameters) {
-    std::cout << "  " << p.name << " = " << p.value << "  ± " << p.se_unscaled << " (unscaled)";
-    if (p.se_scaled) std::cout << "  ± " << *p.se_scaled << " (scaled by sqrt(chi2/dof))";
-    std::cout << "\n";
-  }
-  std::cout << "  chi2 = " << r.chi2;
-  if (r.reduced_chi2) std::cout << ", chi2/dof = " << *r.reduced_chi2;
-  if (r.p_value) std::cout << ", p = " << *r.p_value;
-  std::cout << "\n";
-  for (size_t i : r.outliers) std::cout << "  outlier: row " << i + 1 << " of the data\n";
-  for (const auto& d : r.downweighted) std::cout << "  down-weighted: row " << d.row + 1 << " (weight " << d.weight << ")\n";
-  for (const auto& n : r.notes) std::cout << "  note: " << n << "\n";
-}
-
 void RunXy(const FitFlags& f) {
   const FitMethod method = ParseFitMethod(f.method, "--method");  // before the file is read
   // X,Y[,uX,uY] (io/xy_table.hpp): a row that cannot be read is named on stderr as it is met and
@@ -82,33 +64,27 @@ void RunXy(const FitFlags& f) {
   if (f.json) {
     WriteFitJson(std::cout, r, data, !f.no_rows);
   } else {
-    PrintFitText(r);
+    std::cout << FitReportText(r);
   }
 }
 
 #if UPHILL_VISION_PROGRAM
 
-// `figures`, when given (`uphill report`), draws each video trial's figures into f.output as soon
-// as the trial is tracked, while the other videos are tracked.
-ExperimentFolderAnalysis Analyse(const FitFlags& f, Experiment experiment, FigurePool* figures = nullptr) {
+// `output`, when given (`uphill report`): the report is written there, each video trial's
+// figures as soon as the trial is tracked.
+ExperimentFolderAnalysis Analyse(const FitFlags& f, Experiment experiment, const std::string& output = "") {
   RequireMonteCarloTrials("--mc-trials", static_cast<double>(f.mc_trials));
   ExperimentFolderOptions options;
   options.analysis.mc_trials = static_cast<std::uint64_t>(f.mc_trials);
   options.jobs = f.jobs;
-  options.trial_done = [&, folder_made = false](std::size_t index, const VideoTrial& trial) mutable {
-    std::vector<GnuplotFigure> list = figures ? VideoTrialFigures(trial, index) : std::vector<GnuplotFigure>{};
-    if (list.empty()) return;
-    if (!folder_made) CreateReportFolder(f.output);  // not before: a failed report leaves nothing
-    folder_made = true;
-    for (GnuplotFigure& figure : list) figures->Render(std::move(figure), f.output);
-  };
   std::vector<std::string> labels;
   for (const ExperimentRow* r : VideoRows(experiment)) labels.push_back(r->trial + "  " + r->video);
   std::optional<VideoProgressDisplay> display;
   if (!f.quiet && isatty(STDERR_FILENO) && !labels.empty()) display.emplace(labels);
-  ExperimentFolderAnalysis a = AnalyseLoadedExperiment(std::move(experiment), options, [&](const VideoProgress& p) {
-    if (display) display->Update(p);
-  });
+  const auto progress = [&](const VideoProgress& p) { if (display) display->Update(p); };
+  ExperimentFolderAnalysis a = output.empty()
+                                   ? AnalyseLoadedExperiment(std::move(experiment), options, progress)
+                                   : WriteExperimentReport(std::move(experiment), {output, "", "-o"}, options, progress);
   if (display) display->Finish();
   for (const std::string& note : a.notes) std::cerr << "uphill: note: " << note << "\n";
   for (const std::string& e : a.trial_errors) std::cerr << "uphill: " << e << " (video left out)\n";
@@ -127,11 +103,7 @@ void RunExperiment(const FitFlags& f) {
 }
 
 void RunReport(const FitFlags& f) {
-  Experiment experiment = LoadExperiment(f.experiment);
-  CheckReportOutputs(experiment, f.output, "-o");  // before any work: never over an input
-  FigurePool figures(f.jobs);  // drawing while the videos are tracked, one gnuplot per core
-  const ExperimentFolderAnalysis a = Analyse(f, std::move(experiment), &figures);
-  WriteFitReport(a.analysis, f.output, &figures);
+  const ExperimentFolderAnalysis a = Analyse(f, LoadExperiment(f.experiment), f.output);
   std::cout << "wrote " << f.output << "/report.html, report.md, fit.json, and the figures "
             << "fit_y_vs_x, fit_offset, fit_residuals";
   if (!a.analysis.video_trials.empty()) std::cout << ", and each video's video_<n>_x_vs_t, video_<n>_residuals";

@@ -28,44 +28,10 @@ struct SimulateFlags {
   const CLI::App* command = nullptr;  // to ask which flags were given
 };
 
-std::string Num(double v) {
-  std::ostringstream out;
-  out.precision(10);
-  out << v;
-  return out.str();
-}
-
 void Print(const SimulateFlags& f, const Simulation& r) {
-  if (f.json) {
-    std::cout << ToJson(r).dump(2) << "\n";
-    return;
-  }
-  if (f.csv) {
-    std::cout << "t_s,x_m,z_m,v_m/s,vx_m/s,vz_m/s,angle_rad\n";
-    std::cout << std::setprecision(17);
-    for (const auto& s : r.samples)
-      std::cout << s.t << "," << s.x << "," << s.z << "," << s.v << "," << s.vx << "," << s.vz << "," << s.angle << "\n";
-    return;
-  }
-  const std::string& lu = f.length_unit;
-  const auto L = [&](double v) { return ToUnit(v, Dimension::kLength, lu); };
-  std::cout << "released at x0 = " << Num(L(r.x0)) << " " << lu;
-  if (r.x_eq) std::cout << "  (X = " << Num(L(*r.x_eq)) << " " << lu << ")";
-  std::cout << ", x_max = " << Num(L(r.x_max)) << " " << lu << ", method "
-            << (r.options.method == MotionMethod::kOde ? "ode" : "quadrature") << "\n";
-  const auto col = [](const std::string& h) { return std::string(" ") + std::string(h.size() < 15 ? 15 - h.size() : 0, ' ') + h; };
-  std::cout << col("t [s]") << col("x [" + lu + "]") << col("z [" + lu + "]") << col("v [m/s]") << col("vx [m/s]")
-            << col("vz [m/s]") << col("angle [rad]") << "\n";
-  std::cout << std::setprecision(9);
-  for (const auto& s : r.samples) {
-    for (double v : {s.t, L(s.x), L(s.z), s.v, s.vx, s.vz, s.angle}) std::cout << " " << std::setw(15) << v + 0.0;
-    std::cout << "\n";
-  }
-  std::cout << "events:\n";
-  if (r.events.empty()) std::cout << "  none (rolls toward the apex; it never gets there)\n";
-  for (const auto& e : r.events)
-    std::cout << "  " << std::left << std::setw(14) << EventName(e.kind) << std::right << " t = " << std::setprecision(12)
-              << e.t << " s   x = " << L(e.x) << " " << lu << "\n";
+  if (f.json) std::cout << ToJson(r).dump(2) << "\n";
+  else if (f.csv) std::cout << SimulationCsv(r);
+  else std::cout << SimulationTable(r, f.length_unit);
 }
 
 void Run(const SimulateFlags& f) {
