@@ -10,9 +10,9 @@ BackgroundModel::BackgroundModel(cv::Mat band, Transfer transfer)
     : table_(LinearTable(transfer)), band_(std::move(band)) {
   box_ = cv::boundingRect(band_);
   // Not cleared: a pixel's background is read only once it has been seen (count_), and memory
-  // never written is then usually never faulted in (a block this large comes from mmap; on the
-  // 1080p ray-traced clips the band's box holds 10 MB, four fifths of it outside the band, and
-  // clearing it took half of the tracker's set-up).
+  // never written is then usually never faulted in (a block this large comes from mmap; at
+  // 1080p the band's box holds megabytes, most of it outside the band, and clearing it would
+  // dominate the tracker's set-up).
   background_.create(box_.size(), CV_32FC3);
   count_ = cv::Mat::zeros(box_.size(), CV_8U);
   for (int y = box_.y; y < box_.y + box_.height; ++y) {

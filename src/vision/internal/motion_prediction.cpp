@@ -38,7 +38,7 @@ MotionState MotionFit::AtOwnRow(double frame_t, double row_delay,
   MotionState s = At(frame_t);
   if (row_delay == 0) return s;
   // Each step shrinks the time's error by the map's contraction (see the header); it stops once a
-  // step moves the time by less than 1e-10 s (five or six rows read on the phone clip), after ten
+  // step moves the time by less than 1e-10 s (a few rows of a phone's readout), after ten
   // at most (enough for a contraction up to 0.1).
   for (int step = 0; step < 10; ++step) {
     const double t = frame_t + row(s.centre) * row_delay;

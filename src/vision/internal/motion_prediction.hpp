@@ -8,12 +8,12 @@
 // Under a rolling shutter each row is read at its own time, t = frame_t + row·δ (δ the rows'
 // delay), and the row is the one where the centre lies at that time: a fixed point, which
 // AtOwnRow solves by iteration. Its map contracts by |d row/dt|·δ, the centre's speed across the
-// rows times the delay (0.01 on the phone clip: 425 rows/s × 23 µs): each step cuts the error of
+// rows times the delay (0.01 for a phone: 425 rows/s × 23 µs): each step cuts the error of
 // the time a hundredfold, from the 11 ms of the frame time's. Taking the prediction at the
 // frame's time and shifting it by v·row·δ instead (the row read off that unshifted prediction)
-// misses by ½·a·(row·δ)² plus v·δ·(the rows the centre moved in row·δ): 0.3-0.8 px along the
-// motion on the phone clip's fastest frames, where the ball moves 70 px per frame; there the
-// tracker's check of its prediction then failed on 5 of the last 10 frames.
+// misses by ½·a·(row·δ)² plus v·δ·(the rows the centre moved in row·δ): a fraction of a pixel
+// along the motion where the ball moves tens of pixels per frame, enough for the tracker's
+// check of its prediction to fail.
 #pragma once
 
 #include <Eigen/Core>

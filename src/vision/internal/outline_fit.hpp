@@ -19,8 +19,8 @@
 // fit's start and held through the solve (each sample's mean shading basis is taken once there,
 // and S_i under any lamp follows from it: BodyShading::FromBasis). The shading is read as lit by a lamp at a finite
 // distance (BodyShading::LitFrom: a lamp a metre away is seen from the body in another direction
-// once it has crossed the apparatus; on the ray-traced fast clips the centre otherwise lags by up
-// to 1 px on the longest smears): before the solve, the lamp's inverse distance κ is fitted at
+// once it has crossed the apparatus, and a shading lit from the wrong side pulls the centre
+// along a long smear): before the solve, the lamp's inverse distance κ is fitted at
 // the fit's start to the inlier rays with the centre held (one Gauss–Newton step from the
 // request's κ, prior σ 0.5 /m), and the centre then solved with S_i from there. So the channel in
 // which the fit sees the edge is, ray by ray, the colour difference between the body's limb and
@@ -82,8 +82,8 @@ struct FitRequest {
   double light_inverse_distance = 0;    // 1/m: the lamp's, prior mean (BodyShading::LitFrom)
   bool fit_light = true;                // false: held at its prior mean (a first pass)
   // Ceres iterations at most. With Kaufman's Jacobian the step shrinks about four-fold per
-  // iteration: from a coarse search 3 (the ray-traced clips measure the same with 3 as with 6;
-  // with 2 the phone clip locks on a wrong place); a narrow pass after a coarse search in 2; a
+  // iteration: from a coarse search 3 (more add nothing; fewer can stop on a wrong place under a
+  // rolling shutter's shear); a narrow pass after a coarse search in 2; a
   // pass started within half a pixel or so, at a fit of the same frame or a checked prediction,
   // in 1 (ball_tracker.cpp; docs/track.md, "The fit's Jacobian").
   int iterations = 3;
