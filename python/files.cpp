@@ -108,6 +108,7 @@ struct Analysis {
   std::shared_ptr<LoadedExperiment> loaded;
   ExperimentAnalysis analysis;
   std::vector<std::string> trial_errors;
+  std::vector<std::string> cache_notes;
 };
 
 // An uphill.Experiment as it is, or a folder path read now.
@@ -337,6 +338,8 @@ message, severity), the row check's (uphill.check_row) and the Monte Carlo's u_d
       .def_property_readonly("trial_errors", [](const Analysis& a) { return a.trial_errors; },
                              "The videos that could not be analysed, one line each (trial, file, why).")
       .def_property_readonly("notes", [](const Analysis& a) { return a.analysis.notes; })
+      .def_property_readonly("cache_notes", [](const Analysis& a) { return a.cache_notes; },
+                             "The damaged cache entries that were tracked again, one line each.")
       .def("to_json", [](const Analysis& a) { return ToPython(AnalysisToJson(a.analysis)); },
            "The analysis as `uphill fit EXP --json` prints it (fit.json's content, SI units).");
 
@@ -364,6 +367,7 @@ message, severity), the row check's (uphill.check_row) and the Monte Carlo's u_d
         result->loaded = std::make_shared<LoadedExperiment>(LoadedExperiment{folder.experiment});
         result->analysis = std::move(folder.analysis);
         result->trial_errors = std::move(folder.trial_errors);
+        result->cache_notes = std::move(folder.notes);
         return result;
       },
       py::arg("experiment"), py::kw_only(), py::arg("mc_trials") = kAnalysisMonteCarloTrials,

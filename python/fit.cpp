@@ -79,6 +79,9 @@ py::array_t<double> RowField(const py::object& self, double RowResult::*field) {
 
 py::object Optional(const std::optional<double>& v) { return v ? py::object(py::float_(*v)) : py::none(); }
 
+// The fits' own default (fit/fit_options.hpp), shown in every signature.
+constexpr double kOutlierThreshold = FitOptions{}.outlier_threshold;
+
 constexpr const char* kReportDoc = R"(What every fit returns (fit/fit_report.hpp).
 
 parameters: list of Parameter (name, value, se_unscaled, se_scaled); line fits have "k" (slope) and
@@ -176,7 +179,7 @@ void BindFit(py::module_& m) {
         return LineFit(m, MakeLineData(x, y, u_x, u_y), outlier_threshold);
       },
       py::arg("x"), py::arg("y"), py::arg("u_x") = py::none(), py::arg("u_y") = py::none(), py::kw_only(),
-      py::arg("method") = kDefaultFitXyMethod, py::arg("outlier_threshold") = 3.0,
+      py::arg("method") = kDefaultFitXyMethod, py::arg("outlier_threshold") = kOutlierThreshold,
       R"(The line fit of `uphill fit --xy FILE --method METHOD` (app/fit_xy.hpp): method "ols" (the default,
 as the command's), "wls", "york" or "robust" (Huber's loss, its default scale); x, y, u_x, u_y
 one-dimensional float64 arrays, each
@@ -189,7 +192,7 @@ report.to_json() is the command's --json output. Returns a FitReport.)");
         return LineFit(FitMethod::kOrdinaryLeastSquares, MakeLineData(x, y, u_x, u_y), outlier_threshold);
       },
       py::arg("x"), py::arg("y"), py::arg("u_x") = py::none(), py::arg("u_y") = py::none(), py::kw_only(),
-      py::arg("outlier_threshold") = 3.0,
+      py::arg("outlier_threshold") = kOutlierThreshold,
       R"(Ordinary least squares Y = k·X + c (the paper's fit; fit/least_squares_line.hpp), with Ceres.
 x, y: one-dimensional float64 arrays in any one unit each (u_x, u_y, if given, are ignored, and a
 note says so). Standard errors: the usual, scaled by sqrt(chi2/dof). Accuracy: NIST StRD Norris to
@@ -201,7 +204,7 @@ note says so). Standard errors: the usual, scaled by sqrt(chi2/dof). Accuracy: N
         return LineFit(FitMethod::kWeightedLeastSquares, MakeLineData(x, y, u_x, u_y), outlier_threshold);
       },
       py::arg("x"), py::arg("y"), py::arg("u_y"), py::kw_only(), py::arg("u_x") = py::none(),
-      py::arg("outlier_threshold") = 3.0,
+      py::arg("outlier_threshold") = kOutlierThreshold,
       R"(Weighted least squares with the standard uncertainties u_y (> 0, Y's units); standard errors
 unscaled (the stated uncertainties propagated), scaled also given. u_x, if given, is ignored (a
 note says so). Returns a FitReport.)");
@@ -210,7 +213,7 @@ note says so). Returns a FitReport.)");
       [](const py::object& x, const py::object& y, const py::object& u_x, const py::object& u_y, const py::object& outlier_threshold) {
         return LineFit(FitMethod::kErrorsInVariables, MakeLineData(x, y, u_x, u_y), outlier_threshold);
       },
-      py::arg("x"), py::arg("y"), py::arg("u_x"), py::arg("u_y"), py::kw_only(), py::arg("outlier_threshold") = 3.0,
+      py::arg("x"), py::arg("y"), py::arg("u_x"), py::arg("u_y"), py::kw_only(), py::arg("outlier_threshold") = kOutlierThreshold,
       R"(Errors in both variables: the maximum-likelihood line of York et al. (2004)
 (fit/york_line.hpp). u_x >= 0 and u_y > 0 are standard uncertainties in X's and Y's units.
 Standard errors unscaled (York's), scaled also given. Returns a FitReport.)");
@@ -226,7 +229,7 @@ Standard errors unscaled (York's), scaled also given. Returns a FitReport.)");
       },
       py::arg("x"), py::arg("y"), py::arg("u_y") = py::none(), py::kw_only(), py::arg("u_x") = py::none(),
       py::arg("loss") = "huber",
-      py::arg("loss_scale") = 0.0, py::arg("outlier_threshold") = 3.0,
+      py::arg("loss_scale") = 0.0, py::arg("outlier_threshold") = kOutlierThreshold,
       R"(A robust line (fit/robust_line.hpp): Huber's or Cauchy's loss with Ceres; sigma from u_y
 when given, else a robust scale (1.4826·MAD). loss_scale in units of sigma (0: the loss's default,
 95 % efficiency). FitReport.downweighted names the rows it trusts less. Returns a FitReport.)");
@@ -251,7 +254,7 @@ when given, else a robust scale (1.4826·MAD). loss_scale in units of sigma (0: 
         return Run([&] { return FitFriction(d, o); });
       },
       py::arg("scenes"), py::arg("y"), py::arg("u_y") = py::none(), py::kw_only(), py::arg("u_model") = py::none(),
-      py::arg("fit_scale") = false, py::arg("outlier_threshold") = 3.0,
+      py::arg("fit_scale") = false, py::arg("outlier_threshold") = kOutlierThreshold,
       R"(The rolling-resistance model fitted to measured farthest rest positions (fit/friction_fit.hpp):
 Y_i = s·x_rest,i(mu), mu >= 0 (and s with fit_scale=True). scenes: one uphill.Scene per row; y, u_y,
 u_model: float64 arrays in m (u_model: the model value's own standard uncertainty, needs u_y).

@@ -151,10 +151,9 @@ TEST(RowCheck, TheJsonOfThePageAndPython) {
   EXPECT_NEAR(mm["residual"].get<double>(), 270 - ClosedFormX(906, 165), 1e-9);
   EXPECT_EQ(mm["flags"][0]["code"], "y_below_x");
   EXPECT_EQ(mm["flags"][0]["severity"], "warning");
-  EXPECT_EQ(mm["flags"][0]["message"], c.flags[0].message);
+  EXPECT_NE(mm["flags"][0]["message"].get<std::string>().find("Y − X = -4.907 mm"), std::string::npos);
   EXPECT_NEAR(RowCheckJson(c, "m")["x"].get<double>(), ClosedFormX(906, 165) / 1e3, 1e-12);
   EXPECT_THROW(RowCheckJson(c, "furlong"), InputError);
-  EXPECT_EQ(UncertaintyDisagreement().code, "u_disagrees");
 }
 
 }  // namespace

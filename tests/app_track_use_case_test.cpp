@@ -1,7 +1,8 @@
 // TrackVideoFile (app/track_video_file.hpp) called through its three front ends on the same clip:
 // the program (`uphill track`), the page's HTTP API (POST /api/rows/<id>/track, a video trial of
-// the folder it serves: app/video_trials.hpp) and the Python module (uphill.track). Each must find
-// the ball at the same pixels in the same frames, and refuse a double cone in the same words.
+// the folder it serves: app/video_trials.hpp; and the upload of a video) and the Python module
+// (uphill.track). Each must find the ball at the same pixels in the same frames, and refuse a
+// double cone and a still picture named .mp4 in the same words.
 // Truth: agreement of the fronts to the track CSV's printed precision (4 decimals of a pixel),
 // which a front with other checks, other calibration or other tracker settings would not reach;
 // the clip's ball is tracked against its rendered truth elsewhere (vision_track_test).
@@ -9,6 +10,7 @@
 
 #include <cmath>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
 
 #include "app/track_video_file.hpp"
 #include "file_test_support.hpp"
@@ -119,13 +121,17 @@ TEST_F(TrackUseCase, AFolderWithTheClipIsAnalysedAlikeThroughEveryFront) {
   Stop();
   std::ofstream(dir_ / "measurements.csv") << "trial,Y_mm,video\na,,clip.mp4\nb,390,\nc,394,\n";
   Start();
+  // Each front tracks the clip itself: the cache one front fills is removed before the next.
+  const auto without_cache = [&] { fs::remove_all(dir_ / ".uphill-cache"); };
   const CommandResult cli = RunUphill("fit " + dir_.string() + " --json --quiet --mc-trials 1000");
-  ASSERT_FALSE(cli.out.empty()) << cli.err;
+  ASSERT_EQ(cli.status, 0) << cli.err;
   const json from_cli = WithoutTimes(json::parse(cli.out));
+  without_cache();
   const json from_python = WithoutTimes(PythonJson(dir_, "import json, uphill\n"
                                                          "a = uphill.analyse_experiment('" + dir_.string() +
                                                              "', mc_trials=1000)\n"
                                                          "print(json.dumps(a.to_json()))\n"));
+  without_cache();
   const auto [status, answer] = Send("POST", "/api/report", json::object());  // the fixture's 1000 trials
   ASSERT_EQ(status, 200) << answer.dump();
   const json from_http = WithoutTimes(json::parse(ReadBytes(dir_ / "report" / "fit.json")));
@@ -147,6 +153,25 @@ TEST_F(TrackUseCase, ADoubleConeIsRefusedInTheSameWords) {
   const auto [status, http] = Send("POST", "/api/rows/" + std::to_string(RowId()) + "/track", json::object());
   EXPECT_EQ(status, 422);
   EXPECT_EQ(http.value("error", ""), "video: trial 'a' (clip.mp4): " + refusal) << http.dump();
+}
+
+// A PNG named .mp4 opens in FFmpeg as a video of one frame: it is refused as a still picture by
+// the program (exit 2), by Python, and at the page's upload (422, nothing kept). Truth: the rule
+// of app/video_frames.hpp (a recording has at least kMinVideoFrames frames) and a file that has one.
+TEST_F(TrackUseCase, AStillPictureIsRefusedInTheSameWords) {
+  const fs::path png = dir_ / "still.png", still = dir_ / "clip.mp4";
+  ASSERT_TRUE(cv::imwrite(png.string(), cv::Mat(360, 480, CV_8UC3, cv::Scalar(90, 120, 150))));
+  fs::rename(png, still);  // in place of the clip: the same flags and the same Python call
+  const std::string rule = ": is a still picture, not a video: it holds 1 frame (a recording has at least 2)";
+  const CommandResult cli = RunUphill(TrackFlags(kSphere));
+  EXPECT_EQ(cli.status, 2);
+  EXPECT_EQ(cli.err, "uphill: " + still.string() + rule + "\n");
+  EXPECT_EQ(PythonJson(dir_, PythonTrack("uphill.Body.sphere('25.4 mm')")), still.string() + rule);
+  auto upload = client_->Put("/api/videos/still.mp4", ReadBytes(still), "application/octet-stream");
+  ASSERT_TRUE(upload);
+  EXPECT_EQ(upload->status, 422);
+  EXPECT_EQ(json::parse(upload->body).value("error", ""), "still.mp4" + rule) << upload->body;
+  EXPECT_FALSE(fs::exists(dir_ / "videos" / "still.mp4"));
 }
 
 }  // namespace

@@ -118,7 +118,7 @@ TEST_F(ExperimentFolderUseCase, TheSampleExperimentGivesTheSameAnalysisThroughEv
   ASSERT_EQ(cli.status, 0) << cli.err;
   const json from_cli = WithoutTimes(json::parse(cli.out));
   const json from_python =
-      WithoutTimes(PythonJson(fs::temp_directory_path(), "import json, uphill\n"
+      WithoutTimes(PythonJson(dir_, "import json, uphill\n"
                                             "a = uphill.analyse_experiment('" + folder + "', mc_trials=" +
                                                 std::to_string(kTrials) + ")\n"
                                             "print(json.dumps(a.to_json()))\n"));

@@ -99,13 +99,16 @@ TargetPng ChessboardTargetPng(const ChessboardTarget& target, double dpi) {
 }
 
 std::string WriteChessboardTarget(const std::string& path, const ChessboardTarget& t, double dpi) {
-  OutputPaths::CreateFolders(std::filesystem::path(path).parent_path().string());
+  const std::string folder = std::filesystem::path(path).parent_path().string();
   if (std::filesystem::path(path).extension() == ".svg") {
-    WriteFileAtomically(path, ChessboardTargetSvg(t));
+    const std::string svg = ChessboardTargetSvg(t);
+    OutputPaths::CreateFolders(folder);
+    WriteFileAtomically(path, svg);
     return "print at 100 % (no \"fit to page\"), then measure a square: it must be " + Num(t.square * 1000) +
            " mm (give the measured value to --square)";
   }
-  const TargetPng png = ChessboardTargetPng(t, dpi);
+  const TargetPng png = ChessboardTargetPng(t, dpi);  // refuses a dpi out of range before any folder is made
+  OutputPaths::CreateFolders(folder);
   WriteFileAtomically(path, png.bytes);
   return std::to_string(png.width) + " × " + std::to_string(png.height) + " px, " + std::to_string(png.pixels_per_square) +
          " px per square; print at " + Num(dpi) + " dpi so that a square measures " + Num(t.square * 1000) +

@@ -22,7 +22,7 @@ ExperimentFolderAnalysis AnalyseLoadedExperiment(Experiment experiment, const Ex
     out.analysis = AnalyseExperiment(*out.experiment, options.analysis);
     return out;
   }
-  OneDecodeThreadPerVideo();
+  if (options.one_decode_thread_per_video) OneDecodeThreadPerVideo();
   const std::vector<VideoTrial> trials =
       TrackExperimentVideos(*out.experiment, options.jobs, progress, options.trial_done);
   for (const VideoTrial& t : trials) {

@@ -10,8 +10,9 @@
 // model/input_ranges.hpp's range, and when no row is usable. A video that cannot be analysed is
 // not an error of the whole: it is named in trial_errors, and its row (when its Y was to come from
 // it) in analysis.row_errors; the other trials and rows are analysed.
-// Threads: the videos are decoded one thread each (OneDecodeThreadPerVideo, process-wide), which
-// this sets when the folder has videos. The callbacks are serialised.
+// Threads: `jobs` videos at once. A program that does nothing else sets
+// one_decode_thread_per_video (OneDecodeThreadPerVideo: process-wide, so the server and the Python
+// module leave it unset and keep OpenCV's and FFmpeg's own threads). The callbacks are serialised.
 #pragma once
 
 #include <memory>
@@ -29,6 +30,7 @@ struct ExperimentFolderOptions {
   AnalysisOptions analysis;  // the defaults: app/analysis_defaults.hpp
   unsigned jobs = 0;                   // videos tracked at once; 0: one per core
   VideoTrialDoneCallback trial_done;   // each video trial as soon as it is finished (the report's figures)
+  bool one_decode_thread_per_video = false;  // see "Threads" above
 };
 
 struct ExperimentFolderAnalysis {

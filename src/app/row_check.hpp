@@ -1,9 +1,9 @@
-// The row check as a use case (issue 34, "CheckRow"): the one check of a row that the page
+// The row check as a use case (CheckRow): the one check of a row that the page
 // (src/server), `uphill fit`, `uphill report` and Python (uphill.check_row) all show.
 //
 // The rules themselves — every flag, its rule, its threshold and why — are in
 // report/row_check.hpp: the report's analysis attaches them to each analysed row, and report
-// may not see app (model ← io, fit, motion ← report ← app), so they live there once and this
+// may not see app (model ← io, fit, motion, vision ← report ← app), so they live there once and this
 // header offers them to the front ends with the one serialisation they share.
 #pragma once
 

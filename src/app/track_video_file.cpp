@@ -17,7 +17,7 @@ TrackResult TrackVideoFile(const std::string& video, const std::string& camera_f
                            const FrameProgressCallback& progress) {
   if (scene.body().kind == BodyKind::kDoubleCone) throw InputError("body", kDoubleConeRefusal);
   const SceneCalibration calibration = ReadTrackingCalibration(camera_file, scene_file);
-  CheckVideoPixels(video, options.video_label.empty() ? video : options.video_label);
+  ProbeVideo(video, options.video_label.empty() ? video : options.video_label);  // a video, within the pixel limit
   TrackVideoOptions track;
   track.calibration_name = options.scene_label.empty() ? scene_file : options.scene_label;
   track.overlay_path = options.overlay_path;

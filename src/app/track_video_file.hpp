@@ -9,8 +9,9 @@
 //      sphere or a spheroid);
 //   2. the calibration (app/tracking_inputs.hpp): the scene file must have been calibrated with
 //      the camera file's camera;
-//   3. the video's frame size against the decode limit (app/video_frames.hpp, CheckVideoPixels).
-// Then TrackVideo throws InputError for a file that is not a video or holds no ball, and
+//   3. the file (app/video_frames.hpp, ProbeVideo): a video FFmpeg decodes, not a still picture
+//      (at least two frames), whose frame size is within the decode limit.
+// Then TrackVideo throws InputError for a video that holds no ball, and
 // EnvironmentError when the overlay cannot be written.
 //
 // Units: SI (m, s); pixels are raw pixels of the video's frames.
@@ -26,9 +27,6 @@
 #include "vision/video_tracking.hpp"
 
 namespace uphill {
-
-// The one wording of the refusal, with the quantity "body".
-inline constexpr const char* kDoubleConeRefusal = "tracking supports a sphere or a spheroid, not a double cone";
 
 // The camera's settings and the outputs of a tracking run. The defaults are every front end's.
 struct TrackVideoFileOptions {

@@ -54,12 +54,25 @@ VideoProbe ProbeOf(cv::VideoCapture& capture) {
 
 VideoProbe ProbeVideo(const std::string& path, const std::string& label) {
   cv::VideoCapture capture = Open(path, label);
-  return ProbeOf(capture);
+  const VideoProbe probe = ProbeOf(capture);
+  long frames = probe.frames;
+  if (frames < kMinVideoFrames) {  // unknown or too few: count what decodes
+    frames = 0;
+    cv::Mat frame;
+    try {
+      while (frames < kMinVideoFrames && capture.read(frame)) ++frames;
+    } catch (const cv::Exception&) {
+    }
+  }
+  RequireVideoFrames(frames, label);
+  return probe;
 }
 
-void CheckVideoPixels(const std::string& path, const std::string& label) {
-  cv::VideoCapture capture = OpenCapture(path);
-  if (Readable(capture)) CheckFrameSize(capture, label);
+void RequireVideoFrames(long frames, const std::string& label) {
+  if (frames < kMinVideoFrames)
+    throw InputError(label, "is a still picture, not a video: it holds " + std::to_string(frames) + " frame" +
+                                (frames == 1 ? "" : "s") + " (a recording has at least " +
+                                std::to_string(kMinVideoFrames) + ")");
 }
 
 std::size_t FrameDecodeBytes(const VideoProbe& video) {

@@ -17,14 +17,17 @@ struct VideoProbe {
 };
 
 // Opens the video with OpenCV's FFmpeg backend. Throws InputError(label, "is not a video ...")
-// for a file OpenCV cannot decode (an image, a text file, a cut-off upload), and InputError(label)
+// for a file OpenCV cannot decode (an image, a text file, a cut-off upload), InputError(label)
 // for frames of more pixels than uphill decodes (vision/decode_limits.hpp), read from the
-// container before any frame is decoded.
+// container before any frame is decoded, and RequireVideoFrames's error for a still picture
+// (where the container does not state its frame count, the first two frames are decoded).
 VideoProbe ProbeVideo(const std::string& path, const std::string& label);
 
-// Only the pixel limit of ProbeVideo: throws InputError(label) when the video opens and its frames
-// are larger than the limit; a file that does not open is left to its reader to refuse.
-void CheckVideoPixels(const std::string& path, const std::string& label);
+// A recording has at least two frames. FFmpeg opens a still picture (a PNG or JPEG, whatever its
+// name) as a video of one frame, which would be tracked as a "video" of one position: throws
+// InputError(label, "is a still picture, not a video: ...") for fewer than kMinVideoFrames.
+inline constexpr long kMinVideoFrames = 2;
+void RequireVideoFrames(long frames, const std::string& label);
 
 struct EncodedFrame {
   std::string bytes;         // the image file

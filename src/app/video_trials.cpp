@@ -282,6 +282,7 @@ VideoTrial TrackTrial(const Experiment& experiment, const ExperimentRow& row, st
   try {
     if (!row.configuration) throw InputError("row " + std::to_string(row.row), "has no usable apparatus values");
     const Scene scene = row.configuration->MakeScene();
+    if (scene.body().kind == BodyKind::kDoubleCone) throw InputError("body", kDoubleConeRefusal);  // before any file is read
     const ContainedDirectory root = ContainedDirectory::Open(experiment.directory);
     const std::string scene_file = experiment.scenes.at(row.scene);
     const auto camera_bytes = root.ReadFile(experiment.camera, kMaxCalibrationBytes);

@@ -4,11 +4,10 @@
 // every keystroke can ask), x_max and the crossbar distance, and flags for the mistakes
 // technicians make.
 //
-// Why here (report) and not in app: the report's analysis (analysis.hpp) carries each row's
-// flags, and every front end that analyses an experiment (fit, report, the page's report, Python)
-// reaches the analysis without passing through app; report may not see app (the layer order is
-// model ← io, fit, motion ← report ← app). So the rules live once, here, and app/row_check.hpp
-// offers them as the use case to the page and Python.
+// Why here (report) and not in app: the report's analysis (AnalyseExperiment, analysis.hpp)
+// attaches each row's flags, and report may not see app (the layer order is model ← io, fit,
+// motion, vision ← report ← app). So the rules live once, here, and app/row_check.hpp offers them
+// as the use case to the page and Python.
 //
 // Flags: code, field (the measurements.csv quantity to mark, or ""), message, severity. Every
 // length in a message is in the experiment's unit (the Y column's, else mm). u below is the

@@ -530,13 +530,15 @@ struct Server::Impl {
     ExperimentFolderOptions analysis_options;
     analysis_options.analysis.mc_trials = options.report_mc_trials;
     Experiment experiment = LoadExperiment(store.directory());
+    const std::string report_folder = (fs::path(store.directory()) / "report").string();
+    CheckReportOutputs(experiment, report_folder, "report");  // 422 before any work: never over an input
     ClaimFolder();
     ContainedDirectory staging = folder->MakeStagingDirectory(internal::kReportStagingPrefix);
     std::vector<std::string> names;
+    ExperimentFolderAnalysis written;
     try {
-      // Written into a staging folder, then moved into EXP/report (checked against the inputs: 422).
-      WriteExperimentReport(std::move(experiment), {staging.path(), (fs::path(store.directory()) / "report").string(), "report"},
-                            analysis_options);
+      // Written into a staging folder, then moved into EXP/report.
+      written = WriteExperimentReport(std::move(experiment), {staging.path(), report_folder, "report"}, analysis_options);
       const ContainedDirectory target = folder->Subdirectory("report", true);
       for (const std::string& name : staging.RegularFiles()) {
         if (!ValidReportName(name)) continue;
@@ -550,7 +552,8 @@ struct Server::Impl {
     ContainedDirectory::RemoveStaging(*folder, std::move(staging));
     ordered_json files = ordered_json::array();
     for (const auto& n : names) files.push_back(n);
-    SendJson(res, 200, {{"url", "/report/report.html"}, {"files", files}});
+    SendJson(res, 200, {{"url", "/report/report.html"}, {"files", files}, {"trial_errors", written.trial_errors},
+                        {"notes", written.notes}});
   }
 };
 

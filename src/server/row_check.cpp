@@ -4,8 +4,8 @@
 #include <cmath>
 #include <utility>
 
+#include "app/fit_xy.hpp"
 #include "app/row_check.hpp"
-#include "fit/least_squares_line.hpp"
 #include "io/configuration.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
@@ -120,7 +120,7 @@ ordered_json CheckAll(const ExperimentState& state) {
   ordered_json fit = {{"n", data.size()}};
   try {
     if (data.size() < 2) throw InputError("fit", "needs at least 2 rows with X and Y");
-    const FitReport r = FitOrdinaryLeastSquares(data);
+    const FitReport r = FitXy(FitMethod::kOrdinaryLeastSquares, data);
     fit["slope"] = r.slope();
     fit["intercept"] = r.intercept();
     fit["u_slope"] = Number(r.StandardError("k", ErrorScaling::kScaled));

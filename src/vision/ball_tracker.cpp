@@ -17,7 +17,7 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
   ValidateIntrinsics(calibration.camera, "camera");
   const Body& body = scene.body();
   if (body.kind == BodyKind::kDoubleCone)
-    throw InputError("--body", "tracking supports a sphere or a spheroid, not a double cone");
+    throw InputError("body", kDoubleConeRefusal);
   if (options.rays < 16 || options.rays > 1024) throw InputError("rays", "must be in 16..1024");
   if (!(options.search_half_width_px >= 2 && options.search_half_width_px <= 200))
     throw InputError("search_half_width_px", "must be in [2, 200] px");

@@ -95,6 +95,10 @@
 
 namespace uphill {
 
+// The one wording of the refusal of a double cone, whose outline the tracker does not fit (the
+// quantity is "body"): the tracker, and before it every front end's use case, say it.
+inline constexpr const char* kDoubleConeRefusal = "tracking supports a sphere or a spheroid, not a double cone";
+
 enum class VideoTransfer { kSrgb, kLinear };
 
 struct TrackerOptions {
@@ -129,7 +133,8 @@ struct BallObservation {
 
 class BallTracker {
  public:
-  // Throws InputError for a double cone or unusable intrinsics or options.
+  // Throws InputError for a double cone (quantity "body", kDoubleConeRefusal) or unusable
+  // intrinsics or options.
   BallTracker(const Scene& scene, const SceneCalibration& calibration, const TrackerOptions& options = {});
   ~BallTracker();
   BallTracker(BallTracker&&) noexcept;

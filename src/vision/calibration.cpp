@@ -104,9 +104,9 @@ std::vector<Eigen::Vector2d> FindChessboardCorners(const cv::Mat& image, const C
   ValidateTarget(target);
   const cv::Mat grey = Grey(image);
   const cv::Size pattern(target.cols, target.rows);
-  // The sector-based detector (findChessboardCornersSB): the classic findChessboardCorners took
-  // 139 s on a 1280×720 view when --cols/--rows were one too small (its quad linking explodes),
-  // SB takes < 1 s for any image. It first runs at half resolution (4× faster), then at full
+  // The sector-based detector (findChessboardCornersSB): the classic findChessboardCorners can take
+  // minutes on a view when --cols/--rows are one too small (its quad linking explodes), while
+  // SB takes under a second on any image. It first runs at half resolution (4× faster), then at full
   // resolution for boards too small to be found there. cornerSubPix refines at full resolution.
   std::vector<cv::Point2f> corners;
   bool found = false;

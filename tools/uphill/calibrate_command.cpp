@@ -121,8 +121,9 @@ void RunScene(const CalibrateFlags& f) {
   if (!f.board_image.empty()) {
     if (!f.points.empty()) throw InputError("--points/--board-image", "give one of them, not both");
     if (f.board_origin.empty()) throw InputError("--board-origin", "is required with --board-image");
-    r = CalibrateSceneFromBoardFile(camera, f.board_image, Target(f.target), Point(f.board_origin, "--board-origin"),
-                                    Axis(f.board_x_axis, "--board-x-axis"), Axis(f.board_y_axis, "--board-y-axis"));
+    const Eigen::Vector3d x = Axis(f.board_x_axis, "--board-x-axis"), y = Axis(f.board_y_axis, "--board-y-axis");
+    const Eigen::Vector3d origin = Point(f.board_origin, "--board-origin");
+    r = CalibrateSceneFromBoardFile(camera, f.board_image, Target(f.target), origin, x, y);
   } else {
     if (f.points.empty()) throw InputError("--points", "is required (or --board-image)");
     r = CalibrateSceneFromPointsFile(camera, f.camera, f.points, f.frame);

@@ -77,6 +77,7 @@ ExperimentFolderAnalysis Analyse(const FitFlags& f, Experiment experiment, const
   ExperimentFolderOptions options;
   options.analysis.mc_trials = static_cast<std::uint64_t>(f.mc_trials);
   options.jobs = f.jobs;
+  options.one_decode_thread_per_video = true;  // this process only tracks: the cores go across videos
   std::vector<std::string> labels;
   for (const ExperimentRow* r : VideoRows(experiment)) labels.push_back(r->trial + "  " + r->video);
   std::optional<VideoProgressDisplay> display;

@@ -1,8 +1,8 @@
 // Two programs, one command line. OpenCV's video and image libraries bring ~250 shared libraries
 // that the dynamic loader maps and relocates at every start (Debian builds them with immediate
 // binding): 0.1 s of CPU and ~70 MB resident before a command runs. So `uphill` does not link
-// them: the commands that need them - track, calibrate, analyse-track and bench track - run in
-// the sibling program `uphill-vision`, built from the same command definitions (flags, help, man
+// them: the commands that need them - track, calibrate, analyse-track, fit and report of an
+// experiment folder (its videos), serve, bench track and bench report - run in the sibling program `uphill-vision`, built from the same command definitions (flags, help, man
 // pages and completion come from `uphill` alone) plus src/vision.
 //
 // In `uphill` such a command's definition parses and checks its flags as usual and then calls

@@ -18,8 +18,8 @@
 // What it assumes, and the tracker checks before trusting it (ball_tracker.cpp, "fast path"):
 // the body differs from its surroundings in luminance all round, the motion blur is short
 // against the radius, the body has no inner edges near its outline, the shutter is global. Where
-// these hold it is about 0.02–0.1 px RMS on the synthetic and ray-traced clips of `uphill bench
-// track` at a cost of one small solve (3 parameters, ≤ 97 residuals) per frame; where they do
+// these hold it is within about 0.1 px RMS (docs/benchmarks.md, `uphill bench track`), at a
+// cost of one small solve (3 parameters, ≤ 97 residuals) per frame; where they do
 // not, its edges are wrong (a painted band's edge, a body as bright as its table).
 #pragma once
 

@@ -11,9 +11,9 @@
 // from it than `near` (the first frames of a clip are fitted at a global shutter's 0), and takes
 // the mean again: one round of refits of the far frames only.
 //
-// Accuracy: on the ray-traced phone clip of docs/track.md (readout 25 ms, 15 frames) 26.5 ms with
-// the renderer's camera and 26.9 ms with the user's calibration, standard errors about 2.0 and
-// 2.2 ms; the standard error is from the frames' scatter where it exceeds their formal
+// Accuracy: on ray-traced rolling-shutter footage (readout 25 ms, 15 frames) within about one
+// standard error (≈ 2 ms) of the true readout, with the renderer's camera and with a calibrated
+// one; the standard error is from the frames' scatter where it exceeds their formal
 // errors (tests/vision_rolling_shutter_test.cpp). It does not hold the smear model's errors,
 // which shift every frame alike: the tracker adds a systematic term (ball_tracker.cpp).
 #pragma once
