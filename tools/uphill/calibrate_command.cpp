@@ -15,7 +15,6 @@
 #include "vision_program.hpp"
 #if UPHILL_VISION_PROGRAM
 #include <Eigen/Geometry>
-#include <filesystem>
 #include <iostream>
 #include <sstream>
 

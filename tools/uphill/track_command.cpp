@@ -16,7 +16,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <sstream>
 
 #include "app/track_analysis_output.hpp"
 #include "app/track_video_file.hpp"

@@ -30,9 +30,8 @@ void RunInVisionProgram() {
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
   const fs::path sibling = self.parent_path() / "uphill-vision";
   if (ec || !fs::exists(sibling, ec))
-    throw InputError(sibling.string(), "is missing: the video commands (track, calibrate, analyse-track, fit and "
-                                       "report of an experiment, serve, bench track and report) run in uphill-vision, "
-                                       "installed next to uphill");
+    throw InputError(sibling.string(), "is missing: the video commands (track, calibrate, analyse-track, fit/report of "
+                                       "an experiment, serve, bench track/report) run in it, installed next to uphill");
   std::vector<char*> argv = Arguments();
   const std::string path = sibling.string();
   if (argv.empty()) argv.push_back(const_cast<char*>(path.c_str()));
