@@ -139,10 +139,20 @@ void BallTracker::Finish() {
   m.SettleReadout();
   m.FitAgain(true);
   if (m.unconfirmed && m.frame_index > m.unconfirmed->frame) m.Withdraw();
+  m.RecoverOpening();
 }
 const std::vector<long>& BallTracker::ExposureChanges() const { return impl_->exposure_changes; }
 
-BallObservation BallTracker::Track(const cv::Mat& input) { return impl_->Track(input); }
+BallObservation BallTracker::Track(const cv::Mat& input) {
+  Impl& m = *impl_;
+  const BallObservation o = m.Track(input);
+  if (!m.opening_closed && !m.scene_changed_at) {
+    cv::Mat bgr;
+    if (input.channels() == 1) cv::cvtColor(input, bgr, cv::COLOR_GRAY2BGR);
+    m.KeepOpening(m.frame_index, m.frame_index / m.options.fps, input.channels() == 1 ? bgr : input, o);
+  }
+  return o;
+}
 
 BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
   Impl& m = *this;

@@ -21,6 +21,17 @@
 // time). When a fit fails it re-acquires at once, in the same frame: along the path near the
 // prediction, then along the whole path.
 //
+// The opening: a body at rest from the first frame hides the background under it, so the first
+// frames are measured without it, and a mirror ball's reflections, a print or the table's grain
+// can mislead them. The tracker keeps those frames (the band's bounding box, up to 256 MiB)
+// until five frames in a row are found where the background confirms the body (inside the
+// outline the pixels differ from it, just outside they match it). Finish() measures the opening
+// again once the clip has shown the background: backwards from the first confirmed run to the
+// first frame, each frame predicted from the two after it, and forwards over the frames after
+// the run the background does not confirm. A frame found there but not confirmed, and not found
+// again, is withdrawn (a revision that says not found): the tracker does not report a position
+// the pixels do not support.
+//
 // How it measures: the outline, smeared over the exposure. Under perspective a sphere of radius
 // R centred at C projects to the boundary of the cone of rays at the angle asin(R/|C − O|) about
 // the direction of C − O (O the camera centre); the spheroid (symmetry axis along y) is the same

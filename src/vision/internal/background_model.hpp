@@ -55,6 +55,8 @@ class BackgroundModel {
   }
   // Only where Known(x, y).
   cv::Vec3f At(double x, double y) const { return SampleFloat(background_, x - box_.x, y - box_.y); }
+  // The band's bounding box, frame pixels: all a later look at the background needs of a frame.
+  const cv::Rect& box() const { return box_; }
   bool InBand(double x, double y) const {
     return band_.at<std::uint8_t>(static_cast<int>(y), static_cast<int>(x)) != 0;
   }

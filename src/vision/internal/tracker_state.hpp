@@ -7,6 +7,8 @@
 //                             good prediction), their observations, and the candidates along the path
 //   tracker_refit.cpp         assess and revise: frames kept for a refit once the background and
 //                             the motion are known, the readout settled at the end, a body withdrawn
+//   tracker_opening.cpp       the clip's opening: its frames measured again at the end, backwards
+//                             from the first ones the background confirms
 // Thresholds: tracker_thresholds.hpp.
 #pragma once
 
@@ -117,6 +119,24 @@ struct BallTracker::Impl : internal::TrackerThresholds {
     bool needs_model_before;
   };
   std::optional<Unconfirmed> unconfirmed;
+  // The clip's opening: each frame (the band's bounding box) from the first until the body has
+  // been found in kOpeningAnchorFrames frames in a row that the background confirms
+  // (SilhouetteConfirms). A body at rest from the first frame hides the background under it, so
+  // those frames are measured without it and may lock onto the body's reflections, its print or
+  // the table; once the body has moved away the background is known, and Finish() measures the
+  // opening again, backwards from that run (RecoverOpening).
+  struct OpeningFrame {
+    long frame;
+    double t, gain;
+    cv::Mat window;
+    cv::Point origin;
+    BallObservation observed;  // as reported so far (revisions applied)
+  };
+  std::vector<OpeningFrame> opening;
+  size_t opening_bytes = 0;
+  bool opening_closed = false;
+  int opening_confirmed_run = 0;
+
   // The whole-path search's candidates fitted and rejected since the body was last found, with
   // their pixels (see rejected_windows.hpp).
   internal::RejectedWindows rejected;
@@ -251,6 +271,20 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   void FitAgain(bool all);
 
   void Withdraw();
+
+  // Whether the pixels inside the body's outline centred at `centre` differ from the background
+  // (known there) as a body's must: false when the background is unknown under too much of it,
+  // or when the inside looks like the background (a fit on the table's texture or on a reflection).
+  // `smear_px`: the body's smear over the exposure, along the path (BallObservation::smear_px).
+  bool SilhouetteConfirms(const internal::FrameView& view, const Vector2d& centre, double smear_px) const;
+  // The smear of frame f's observation, px: fitted, or (the fast path fits none) the step to a
+  // neighbouring frame's centre over the exposure.
+  double SmearOf(long f, const BallObservation& o) const;
+  // Keeps this frame for the opening while it lasts (after Track measured it as `o`).
+  void KeepOpening(long f, double t, const cv::Mat& frame, const BallObservation& o);
+  // At Finish(): the opening measured again, backwards from its first confirmed run; each frame
+  // whose observation changes (found, moved, or withdrawn) becomes a revision.
+  void RecoverOpening();
 
   // Scene residual and gain bookkeeping (SceneChangedAt, ExposureChanges).
   void WatchScene(long f);

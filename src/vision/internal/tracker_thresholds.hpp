@@ -73,6 +73,25 @@ struct TrackerThresholds {
   // a median of five resists one bad frame, and more frames add little once the systematic
   // part dominates.
   static constexpr std::size_t kReadoutFrames = 15, kReadoutMinFrames = 5;
+  // The opening (tracker_state.hpp): frames in a row found and confirmed by the background before
+  // the body counts as tracked (one frame can be a coincidence of texture; five in a row at a
+  // ball's speeds are its motion); the memory its frames may take (a 720p clip's band keeps about
+  // 300 frames, five seconds at 60 fps, of a body at rest).
+  static constexpr int kOpeningAnchorFrames = 5;
+  static constexpr std::size_t kOpeningBytes = 256u << 20;
+  // SilhouetteConfirms: a sample inside the outline is the body's when it differs from the
+  // background by this many noise levels (and at least kSilhouetteMinContrast, linear light) in a
+  // channel; the inside is a body's when this share of its samples are (a mirror ball shows the
+  // table near its limb, a print may match the cloth in places: most of the inside still differs);
+  // the ring just outside is the background's where this share of its samples match it (the
+  // shadow and the rails' reflections cost some); and the background must be known under this
+  // share of each ring's samples to decide at all.
+  static constexpr double kSilhouetteNoiseLevels = 5, kSilhouetteMinContrast = 0.02;
+  static constexpr double kSilhouetteMinBodyShare = 0.6, kSilhouetteMinBackgroundShare = 0.75;
+  static constexpr double kSilhouetteMinKnownShare = 0.7;
+  // Backwards through the opening: frames in a row the body may be missed (the near rail, a
+  // highlight) before the search stops.
+  static constexpr int kOpeningMaxMisses = 3;
 };
 
 }  // namespace uphill::internal
