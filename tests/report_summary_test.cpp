@@ -310,6 +310,7 @@ TEST(TrackFigures, ABallAtRestIsDrawnAsRestAndPromisesNoLine) {
   EXPECT_EQ(x.caption.find("the line is"), std::string::npos) << x.caption;
   EXPECT_NE(x.caption.find("no model line"), std::string::npos) << x.caption;
   EXPECT_EQ(x.plot.find("fitted model"), std::string::npos);
+  EXPECT_EQ(x.title.find("fitted model"), std::string::npos) << x.title;
   EXPECT_NE(x.plot.find("set yrange [297.5:302.5]"), std::string::npos) << x.plot;
   // A motion over tens of millimetres keeps gnuplot's own range.
   TrackFigureData moving = rest;

@@ -70,7 +70,7 @@ std::vector<GnuplotFigure> TrackFigures(const TrackFigureData& a, const std::str
   std::vector<GnuplotFigure> figures;
   GnuplotFigure x;
   x.name = stem + kXVsT;
-  x.title = "Measured x(t) against the fitted model" + title_suffix;
+  x.title = (a.curve.empty() ? "Measured x(t), no motion fitted" : "Measured x(t) against the fitted model") + title_suffix;
   x.caption = "Each point is one video frame where the ball was found (x of its centre in the apparatus frame); " +
               (a.curve.empty() ? std::string("no model line: no motion was fitted (a ball at rest, or the fit was "
                                              "not available).")
