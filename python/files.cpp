@@ -20,6 +20,7 @@
 #include "model/number_text.hpp"
 #include "report/analysis.hpp"
 #include "report/fit_json.hpp"
+#include "report/report_summary.hpp"
 
 namespace uphill::python {
 namespace {
@@ -253,12 +254,14 @@ Rows that cannot be used keep their error (file, row, column, rule); the others 
               d["Y"] = r.Y.value, d["u_Y"] = r.Y.u;
               d["configuration"] = r.configuration ? py::object(ConfigurationToPython(*r.configuration)) : py::none();
               d["error"] = r.error.empty() ? py::object(py::none()) : py::object(py::str(r.error));
+              d["excluded"] = r.excluded.empty() ? py::object(py::none()) : py::object(py::str(r.excluded));
               rows.append(d);
             }
             return rows;
           },
           "One dict per row of measurements.csv: row (spreadsheet row, header = 1), trial, series, note, Y and u_Y "
-          "(m), configuration (values and standard uncertainties in SI) or error (file, row, column, rule).")
+          "(m), configuration (values and standard uncertainties in SI) or error (file, row, column, rule), excluded "
+          "(why the row is left out of the fits, or None).")
       .def_property_readonly(
           "scenes",
           [](const LoadedExperiment& e) {
@@ -283,7 +286,7 @@ Rows that cannot be used keep their error (file, row, column, rule); the others 
 
   py::class_<Analysis>(m, "Analysis", R"(The analysis of an experiment, as `uphill fit EXP` prints it (report/analysis.hpp).
 
-Per usable row (NumPy arrays, file order): theta, alpha (rad), x_eq (X) with u_x_eq (first order)
+Per fitted row (NumPy arrays, file order; rows excluded from the fit are in `excluded`): theta, alpha (rad), x_eq (X) with u_x_eq (first order)
 and u_x_eq_mc (Monte Carlo), x_max, y and u_y (m); flags: per row a list of dicts (code, field,
 message, severity), the row check's (uphill.check_row) and the Monte Carlo's u_disagrees. fits: dict method -> FitReport ("ols", "wls",
 "york", "robust", "friction"), unavailable: dict method -> reason. friction_vs_line: dict
@@ -334,6 +337,31 @@ message, severity), the row check's (uphill.check_row) and the Monte Carlo's u_d
                                d["verdict"] = c.verdict;
                                return d;
                              })
+      .def_property_readonly("excluded",
+                             [](const Analysis& a) {
+                               py::list out;
+                               for (const AnalysedRow& r : a.analysis.excluded_rows) {
+                                 py::dict d;
+                                 d["trial"] = r.source->trial, d["row"] = r.source->row, d["reason"] = r.source->excluded;
+                                 d["x_eq"] = r.x_eq, d["u_x_eq"] = r.u_x_eq, d["y"] = r.y, d["u_y"] = r.u_y;
+                                 d["flags"] = ToPython(FlagsJson(r.flags));
+                                 out.append(d);
+                               }
+                               return out;
+                             },
+                             "The rows excluded from the fits (measurements.csv's excluded column), one dict each: "
+                             "trial, row, reason, x_eq, u_x_eq, y, u_y (m), flags. They are in no array above and "
+                             "in no fit.")
+      .def_property_readonly("summary",
+                             [](const Analysis& a) {
+                               const ReportSummary s = SummariseAnalysis(a.analysis);
+                               py::dict d;
+                               d["preferred"] = s.preferred, d["quote"] = s.quote, d["why"] = s.why;
+                               d["flagged"] = s.flagged, d["excluded"] = s.excluded;
+                               return d;
+                             },
+                             "The report's summary (report/report_summary.hpp): preferred model, the numbers to "
+                             "quote, why, flagged rows still fitted, excluded rows.")
       .def_property_readonly("row_errors", [](const Analysis& a) { return a.analysis.row_errors; })
       .def_property_readonly("trial_errors", [](const Analysis& a) { return a.trial_errors; },
                              "The videos that could not be analysed, one line each (trial, file, why).")

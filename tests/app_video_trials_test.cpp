@@ -258,7 +258,7 @@ TEST_F(VideoTrials, TheReportUsesTheVideoYAndComparesTypedOnes) {
   const std::string text = RenderText(FitDocument(a, false));
   EXPECT_NE(text.find("Rest positions from the videos"), std::string::npos);
   EXPECT_NE(text.find("Motion fits"), std::string::npos);
-  EXPECT_NE(text.find("mu from the motions: "), std::string::npos);
+  EXPECT_NE(text.find("μ from the motions: "), std::string::npos);
   const auto json = AnalysisToJson(a);
   ASSERT_TRUE(json.contains("video_trials"));
   EXPECT_EQ(json.at("video_trials").size(), 3u);

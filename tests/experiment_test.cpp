@@ -51,6 +51,25 @@ TEST(Experiment, PerRowUncertaintiesOverrideTheDefaults) {
   EXPECT_DOUBLE_EQ(e.rows[1].Y.u, 0.0015);  // empty cell: the default
 }
 
+// The `excluded` column (data/README.md): optional, text, its trimmed cell the reason; blank
+// means fitted. Truth: the format's rules as data/README.md states them.
+TEST(Experiment, TheExcludedColumnKeepsEachRowsReason) {
+  const Experiment e = LoadExperiment(MakeExperiment(
+      "excluded", kJson,
+      "trial,L_mm,D_mm,Y_mm,excluded\nt1,1165,150,390,\nt2,1165,150,39.1,\"  Y typed in cm, 1 row  \"\nt3,1165,150,391,   \n"));
+  ASSERT_TRUE(e.Errors().empty()) << e.Errors().front();
+  EXPECT_EQ(e.rows[0].excluded, "");
+  EXPECT_EQ(e.rows[1].excluded, "Y typed in cm, 1 row");
+  EXPECT_EQ(e.rows[2].excluded, "");  // blanks only: fitted
+  EXPECT_EQ(e.UsableRows().size(), 3u);  // excluded rows are still analysed (shown, not fitted)
+  // In a version-1 folder too, and without the column nothing is excluded (the samples).
+  for (const ExperimentRow& r : LoadExperiment(kSamples + "/series2-fixed-L").rows) EXPECT_EQ(r.excluded, "");
+  // A text column: a unit in its header is refused, naming it.
+  EXPECT_NE(LoadError(MakeExperiment("excluded-unit", kJson, "trial,L_mm,D_mm,Y_mm,excluded_mm\nt1,1165,150,390,x\n"))
+                .find("column excluded_mm: 'excluded' is text: its header has no unit"),
+            std::string::npos);
+}
+
 TEST(Experiment, BadRowsAreNamedAndTheOthersKept) {
   const std::string dir = MakeExperiment("badrows", kJson,
                                          "trial,L_mm,D_mm,Y_mm,note\n"

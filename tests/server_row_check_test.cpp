@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "file_test_support.hpp"
 #include "io/experiment.hpp"
 #include "server/row_check.hpp"
 // Last: it includes <httplib.h>, which includes <resolv.h>, whose `_res` macro breaks Eigen.
@@ -51,6 +52,41 @@ TEST_F(ServerRowCheckTest, FlagsRowsAsTheReportDoes) {
   EXPECT_NEAR(state["rows"][0]["check"]["x"].get<double>(), x, 1e-9);
   EXPECT_NE(state["rows"][0]["check"]["flags"][0]["message"].get<std::string>().find("the body cannot rest there"),
             std::string::npos);
+}
+
+// The page's toggle writes a row's `excluded` reason (an ordinary PUT of the row): the row stays,
+// checked and flagged, the live fit leaves it out and equals the fit before the row was added (the
+// truth: a row not there), measurements.csv carries the reason as `uphill fit` reads it, and Undo
+// takes it back, column and all.
+TEST_F(ServerRowCheckTest, AnExcludedRowStaysShownButLeavesTheLiveFitUntilUndone) {
+  const json three = CreateWithThreeRows();
+  const json slip = Row("t4", 200, 29.3);  // Y typed in cm
+  const json four = Add(slip);
+  ASSERT_EQ(four["fit"]["n"], 4);
+  EXPECT_EQ(four["fit"]["excluded"], 0);
+  const json stored = four["rows"][3];
+  json row = slip;
+  row["excluded"] = "  Y typed in cm  ";
+  auto [status, excluded] = Send("PUT", "/api/rows/" + std::to_string(stored["id"].get<int>()),
+                                 {{"version", four["version"]}, {"row", row}});
+  ASSERT_EQ(status, 200) << excluded.dump();
+  EXPECT_EQ(excluded["rows"].size(), 4u);
+  EXPECT_EQ(excluded["rows"][3]["excluded"], "Y typed in cm");
+  EXPECT_EQ(FlagCodes(excluded["rows"][3]["check"]), std::vector<std::string>{"unit_mixup"});
+  EXPECT_EQ(excluded["fit"]["n"], 3);
+  EXPECT_EQ(excluded["fit"]["excluded"], 1);
+  EXPECT_EQ(excluded["fit"]["slope"], three["fit"]["slope"]);
+  EXPECT_EQ(excluded["fit"]["intercept"], three["fit"]["intercept"]);
+  const Experiment written = LoadExperiment(dir_.string());
+  ASSERT_EQ(written.rows.size(), 4u);
+  EXPECT_EQ(written.rows[3].excluded, "Y typed in cm");
+  EXPECT_EQ(written.rows[2].excluded, "");
+
+  auto [undo_status, undone] = Send("POST", "/api/undo", {{"version", excluded["version"]}});
+  ASSERT_EQ(undo_status, 200) << undone.dump();
+  EXPECT_FALSE(undone["rows"][3].contains("excluded"));
+  EXPECT_EQ(undone["fit"]["n"], 4);
+  EXPECT_EQ(ReadBytes(dir_ / "measurements.csv").find("excluded"), std::string::npos);
 }
 
 }  // namespace

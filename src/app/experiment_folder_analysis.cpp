@@ -36,7 +36,7 @@ ExperimentFolderAnalysis AnalyseLoadedExperiment(Experiment experiment, const Ex
 ExperimentFolderAnalysis WriteExperimentReport(Experiment experiment, const ExperimentReportTarget& target,
                                                const ExperimentFolderOptions& options,
                                                const VideoProgressCallback& progress) {
-  CheckReportOutputs(experiment, target.checked.empty() ? target.output : target.checked, target.flag);
+  CheckReportOutputs(experiment, target.checked.empty() ? target.output : target.checked, target.flag, target.latex);
   FigurePool figures(options.jobs);  // drawing while the videos are tracked, one gnuplot per core
   ExperimentFolderOptions drawing = options;
   drawing.trial_done = [&, folder_made = false](std::size_t index, const VideoTrial& trial) mutable {
@@ -48,7 +48,7 @@ ExperimentFolderAnalysis WriteExperimentReport(Experiment experiment, const Expe
     if (options.trial_done) options.trial_done(index, trial);
   };
   ExperimentFolderAnalysis a = AnalyseLoadedExperiment(std::move(experiment), drawing, progress);
-  WriteFitReport(a.analysis, target.output, &figures);
+  WriteFitReport(a.analysis, target.output, &figures, target.latex);
   return a;
 }
 

@@ -63,6 +63,7 @@ struct ExperimentReportTarget {
   std::string output;   // where the files are written
   std::string checked;  // the report folder checked against the inputs ("" : output)
   std::string flag;     // names the folder in an error ("-o", "report")
+  bool latex = false;   // also the LaTeX tables and the figures as PDF (report/latex_report.hpp)
 };
 ExperimentFolderAnalysis WriteExperimentReport(Experiment experiment, const ExperimentReportTarget& target,
                                                const ExperimentFolderOptions& options = {},

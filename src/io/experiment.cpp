@@ -23,7 +23,12 @@ bool Contains(const std::vector<std::string>& list, const std::string& name) {
 
 bool IsColumn(const std::string& name) {
   return Contains(MeasurementLabelColumns(), name) || Contains(MeasurementVideoColumns(), name) ||
-         Contains(MeasurementQuantities(), name);
+         Contains(MeasurementQuantities(), name) || name == MeasurementExclusionColumn();
+}
+
+std::string Trim(const std::string& s) {
+  const auto first = s.find_first_not_of(" \t");
+  return first == std::string::npos ? "" : s.substr(first, s.find_last_not_of(" \t") - first + 1);
 }
 
 std::string NeedsVersion2() { return std::string("needs format ") + kExperimentFormat2; }
@@ -218,7 +223,7 @@ Experiment ParseExperiment(ExperimentFolder folder, const CsvTable& table) {
     const std::string where = CellContext(table, 1, table.header[i]);
     if (!IsColumn(base)) throw InputError(where, "unknown column (see data/README.md)");
     if (e.format_version == 1 && Contains(MeasurementVideoColumns(), base)) throw InputError(where, NeedsVersion2());
-    if (Contains(MeasurementVideoColumns(), base) && base != table.header[i])
+    if ((Contains(MeasurementVideoColumns(), base) || base == MeasurementExclusionColumn()) && base != table.header[i])
       throw InputError(where, "'" + base + "' is text: its header has no unit");
     if (!column.emplace(base, static_cast<int>(i)).second)
       throw InputError(where, "gives '" + base + "' a second time");
@@ -257,6 +262,7 @@ Experiment ParseExperiment(ExperimentFolder folder, const CsvTable& table) {
       row.trial = cell("trial");
       row.series = cell("series");
       row.note = cell("note");
+      row.excluded = Trim(cell(MeasurementExclusionColumn()));
       if (row.trial.empty())
         throw InputError(CellContext(table, row.row, table.header[column.at("trial")]), "is empty");
       if (!trials.insert(row.trial).second)

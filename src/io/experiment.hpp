@@ -8,7 +8,8 @@
 //   EXP/measurements.csv   one row per trial: trial label, series, L, H (when it varies), D, Y,
 //                          optional per-row uncertainties u_L, u_H, u_D, u_Y, a note; version 2:
 //                          the trial's recording (`video`) and its scene's name (`scene`); Y may
-//                          then be empty (it comes from the video's rest position)
+//                          then be empty (it comes from the video's rest position); in either
+//                          version, `excluded`: why the row is left out of the fits (blank: fitted)
 //
 // Paths in the folder (camera, scenes, videos) are relative '/'-separated paths that stay inside
 // it (no "..", no absolute path: io/contained_directory.hpp); whether the file is there, and not
@@ -45,6 +46,10 @@ struct ExperimentRow {
   bool y_typed = true;
   std::string video;  // version 2: the recording, relative to the folder ("" none)
   std::string scene;  // version 2: the name of its scene in Experiment::scenes ("" when no video)
+  // Why the row is left out of the fits (its `excluded` cell, trimmed), or "" when it is fitted.
+  // An excluded row is still checked, converted (X ± u(X)) and shown; only the fits skip it, so
+  // excluding a row changes every fit exactly as deleting it would (report/analysis.hpp).
+  std::string excluded;
   std::string error;  // one line: file, row, column, rule
   // The column the error is about (its quantity or label: "D", "Y", "trial", "video"…), or ""
   // when it names experiment.json or the whole record: where a page puts the mark.
@@ -75,7 +80,7 @@ struct Experiment {
   std::map<std::string, std::string> column_units;
   std::vector<ExperimentRow> rows;
 
-  // Rows without an error and with a Y (typed, or filled in from the video).
+  // Rows without an error and with a Y (typed, or filled in from the video), excluded or not.
   std::vector<const ExperimentRow*> UsableRows() const;
   // The rows' errors, and for a row whose Y is to come from its video but has not, why not.
   std::vector<std::string> Errors() const;

@@ -45,6 +45,11 @@ const std::vector<std::string>& MeasurementLabelColumns() {
   return columns;
 }
 
+const std::string& MeasurementExclusionColumn() {
+  static const std::string column = "excluded";
+  return column;
+}
+
 const std::vector<std::string>& MeasurementVideoColumns() {
   static const std::vector<std::string> columns = {"video", "scene"};
   return columns;

@@ -48,6 +48,9 @@ const std::set<std::string>& VideoAnalysisKeys(); // fit u_x g
 // in the header, `L_mm`, or in every cell), in the order the server writes them.
 const std::vector<std::string>& MeasurementLabelColumns();  // trial series note
 const std::vector<std::string>& MeasurementVideoColumns();  // video scene (version 2: text cells)
+// "excluded" (either version, optional): a text cell; non-blank leaves the row out of the fits,
+// its text being the reason (data/README.md).
+const std::string& MeasurementExclusionColumn();
 const std::vector<std::string>& MeasurementQuantities();    // L H D Y u_L u_H u_D u_Y
 
 struct ExperimentFolder {

@@ -66,13 +66,14 @@ ExperimentAnalysis AnalyseExperiment(const Experiment& experiment, const Analysi
   const std::vector<RowCheck> checks = CheckRows(experiment);
   for (const ExperimentRow* row : experiment.UsableRows()) {
     try {
-      a.rows.push_back(AnalyseRow(*row, checks[static_cast<std::size_t>(row - experiment.rows.data())], options));
+      AnalysedRow analysed = AnalyseRow(*row, checks[static_cast<std::size_t>(row - experiment.rows.data())], options);
+      (row->excluded.empty() ? a.rows : a.excluded_rows).push_back(std::move(analysed));
     } catch (const InputError& e) {
       a.row_errors.push_back(experiment.directory + "/measurements.csv, row " + std::to_string(row->row) +
                              ": " + e.what());
     }
   }
-  if (a.rows.empty()) {
+  if (a.rows.empty() && a.excluded_rows.empty()) {
     // Say what is broken, not only how often: the first row's error names the file, row, column
     // and rule (often one cause for all, e.g. a dimension in experiment.json without its unit).
     if (a.row_errors.empty()) throw InputError(experiment.directory, "has no rows in measurements.csv to analyse");
@@ -118,11 +119,13 @@ ExperimentAnalysis AnalyseExperiment(const Experiment& experiment, const Analysi
   friction_options.fit = fit_options;
   try {
     const FrictionVersusLine both = CompareFrictionWithLine(friction, friction_options);
-    a.fits.push_back(FitOutcome{"friction", "Friction model Y = x_rest(mu)", both.friction, ""});
+    a.fits.push_back(FitOutcome{"friction", "Rolling-resistance (friction) model Y = x_rest(μ)", both.friction, ""});
     a.friction_vs_line = both.comparison;
   } catch (const InputError& e) {
-    a.fits.push_back(FitOutcome{"friction", "Friction model Y = x_rest(mu)", std::nullopt, e.what()});
+    a.fits.push_back(FitOutcome{"friction", "Rolling-resistance (friction) model Y = x_rest(μ)", std::nullopt, e.what()});
   }
+  if (a.rows.empty())
+    a.notes.push_back("Every usable row is excluded from the fit (measurements.csv's excluded column): nothing is fitted.");
   if (!all_u_x) a.notes.push_back("Some rows have u(X) = 0 (no input uncertainties): the York fit needs u(X) > 0.");
   if (a.friction_vs_line) a.notes.push_back(a.friction_vs_line->verdict);
   return a;

@@ -7,6 +7,12 @@
 // a robust Huber fit, and the physical friction model Y = x_rest(μ) compared with the straight
 // line by χ², AIC and BIC. A fit that cannot be made (too few rows, all X equal, missing
 // uncertainties) is kept with the reason instead of its report.
+//
+// Excluded rows (measurements.csv's `excluded` cell, io/experiment.hpp) are analysed like the
+// others (θ, α, X ± u(X), the row check's flags) and kept apart in `excluded_rows`; the fits see
+// only `rows`, so every fit, comparison and residual is exactly what it would be with the
+// excluded rows deleted from the file. A flagged row is never excluded by the analysis: that is
+// the technician's decision (the report's summary warns about flagged rows still fitted).
 #pragma once
 
 #include <optional>
@@ -49,7 +55,8 @@ struct FitOutcome {
 
 struct ExperimentAnalysis {
   const Experiment* experiment = nullptr;
-  std::vector<AnalysedRow> rows;            // the usable rows, in file order
+  std::vector<AnalysedRow> rows;            // the usable rows that are fitted, in file order
+  std::vector<AnalysedRow> excluded_rows;   // the usable rows left out of the fits (reason: source->excluded)
   std::vector<std::string> row_errors;      // rows left out, with file, row, column, rule
   std::vector<FitOutcome> fits;             // ols, wls, york, robust, friction, in this order
   std::optional<ModelComparison> friction_vs_line;
@@ -61,7 +68,8 @@ struct ExperimentAnalysis {
   const FitOutcome* Fit(const std::string& method) const;
 };
 
-// Throws InputError when no row is usable (nothing to analyse).
+// Throws InputError when no row is usable (nothing to analyse). When every usable row is excluded
+// the fits are unavailable, each with the reason.
 ExperimentAnalysis AnalyseExperiment(const Experiment& experiment, const AnalysisOptions& options = {});
 
 }  // namespace uphill

@@ -25,10 +25,13 @@ void WriteFitReport(const ExperimentAnalysis& analysis, const std::string& direc
 // The same with the caller's pool, which may already be drawing some of the figures (a video
 // trial's, submitted as soon as the trial was tracked: VideoTrialFigures(trial, index)); those
 // are not drawn twice.
-void WriteFitReport(const ExperimentAnalysis& analysis, const std::string& directory, FigurePool* figures);
+// With `latex` also the LaTeX tables, the standalone document and the figures as PDF
+// (latex_report.hpp: `uphill report --latex`).
+void WriteFitReport(const ExperimentAnalysis& analysis, const std::string& directory, FigurePool* figures,
+                    bool latex = false);
 // Creates the report folder (and its parents) if needed; throws EnvironmentError.
 void CreateReportFolder(const std::string& directory);
-// The names of the files WriteFitReport writes into its folder.
-std::vector<std::string> FitReportFiles();
+// The names of the files WriteFitReport writes into its folder (with `latex`, those too).
+std::vector<std::string> FitReportFiles(bool latex = false);
 
 }  // namespace uphill

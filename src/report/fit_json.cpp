@@ -1,4 +1,5 @@
 #include "report/fit_json.hpp"
+#include "report/report_summary.hpp"
 #include "report/video_report.hpp"
 
 #include <charconv>
@@ -164,13 +165,15 @@ ordered_json AnalysisToJson(const ExperimentAnalysis& a) {
   const Experiment& e = *a.experiment;
   j["experiment"] = {{"directory", e.directory}, {"title", e.title}, {"operator", e.operator_name},
                      {"date", e.date}, {"notes", e.notes}, {"metadata", e.metadata}};
-  ordered_json rows = ordered_json::array();
-  for (size_t i = 0; i < a.rows.size(); ++i) {
-    const AnalysedRow& r = a.rows[i];
-    ordered_json row = {{"trial", r.source->trial}, {"series", r.source->series}, {"csv_row", r.source->row},
+  const auto row_json = [](const AnalysedRow& r) {
+    return ordered_json{{"trial", r.source->trial}, {"series", r.source->series}, {"csv_row", r.source->row},
                         {"theta", r.theta}, {"alpha", r.alpha}, {"x_eq", r.x_eq}, {"u_x_eq", r.u_x_eq},
                         {"u_mc_x_eq", r.u_x_eq_mc}, {"x_max", r.x_max}, {"y", r.y}, {"u_y", r.u_y},
                         {"flags", FlagsJson(r.flags)}};
+  };
+  ordered_json rows = ordered_json::array();
+  for (size_t i = 0; i < a.rows.size(); ++i) {
+    ordered_json row = row_json(a.rows[i]);
     ordered_json residuals = ordered_json::object();
     for (const FitOutcome& f : a.fits)
       if (f.report && i < f.report->rows.size())
@@ -181,6 +184,13 @@ ordered_json AnalysisToJson(const ExperimentAnalysis& a) {
     rows.push_back(row);
   }
   j["rows"] = rows;
+  ordered_json excluded = ordered_json::array();
+  for (const AnalysedRow& r : a.excluded_rows) {
+    ordered_json row = row_json(r);
+    row["excluded"] = r.source->excluded;
+    excluded.push_back(row);
+  }
+  j["excluded_rows"] = excluded;
   j["row_errors"] = a.row_errors;
   ordered_json fits = ordered_json::object();
   for (const FitOutcome& f : a.fits) {
@@ -196,6 +206,9 @@ ordered_json AnalysisToJson(const ExperimentAnalysis& a) {
                              {"delta_aic", c.delta_aic}, {"delta_bic", c.delta_bic},
                              {"akaike_weight_second", c.akaike_weight_second}, {"verdict", c.verdict}};
   }
+  const ReportSummary summary = SummariseAnalysis(a);
+  j["summary"] = {{"preferred", summary.preferred}, {"quote", summary.quote}, {"why", summary.why},
+                  {"flagged", summary.flagged}, {"excluded", summary.excluded}};
   AddVideoJson(a, &j);
   j["notes"] = a.notes;
   return j;

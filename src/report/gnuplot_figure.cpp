@@ -38,6 +38,12 @@ bool CompleteSvg(const std::string& s) {
   return end != std::string::npos && end >= 5 && s.compare(end - 5, 6, "</svg>") == 0;
 }
 
+// A PDF file ends with its end-of-file marker (ISO 32000-1, 7.5.5), then at most a line end.
+bool CompletePdf(const std::string& s) {
+  const auto end = s.find_last_not_of(" \t\r\n");
+  return s.rfind("%PDF-", 0) == 0 && end != std::string::npos && end >= 4 && s.compare(end - 4, 5, "%%EOF") == 0;
+}
+
 bool CompletePng(const std::string& s) {
   static const std::string signature("\x89PNG\r\n\x1a\n", 8);
   static const std::string iend("\0\0\0\0IEND\xae\x42\x60\x82", 12);
@@ -116,14 +122,17 @@ class RenderFolder {
 // and whole images made after them. gnuplot would draw the same images again, so a second report
 // of an unchanged experiment reuses them. The images must be newer than the script and the data:
 // a run stopped between writing those and renaming its images leaves older images, redrawn here.
-bool UpToDate(const fs::path& dir, const std::string& name, const std::string& data, const std::string& script) {
+bool UpToDate(const fs::path& dir, const std::string& name, const std::string& data, const std::string& script,
+              bool pdf) {
   const fs::path dat = dir / (name + ".dat"), gp = dir / (name + ".gp");
-  const fs::path svg = dir / (name + ".svg"), png = dir / (name + ".png");
+  const fs::path svg = dir / (name + ".svg"), png = dir / (name + ".png"), pdf_file = dir / (name + ".pdf");
   std::error_code e;
   for (const fs::path& p : {dat, gp, svg, png})
     if (!fs::is_regular_file(fs::symlink_status(p, e))) return false;
+  if (pdf && !fs::is_regular_file(fs::symlink_status(pdf_file, e))) return false;
   const auto inputs = std::max(fs::last_write_time(dat, e), fs::last_write_time(gp, e));
   if (e || fs::last_write_time(svg, e) < inputs || fs::last_write_time(png, e) < inputs || e) return false;
+  if (pdf && (fs::last_write_time(pdf_file, e) < inputs || e || !CompletePdf(Slurp(pdf_file)))) return false;
   return Slurp(dat) == data && Slurp(gp) == script && CompleteSvg(Slurp(svg)) && CompletePng(Slurp(png));
 }
 
@@ -139,8 +148,8 @@ void RenderFigure(const GnuplotFigure& f, const std::string& directory) {
     ~Closer() { ::close(fd); }
   } closer{dir_fd};
   // Anything but a regular file where an output goes is refused before anything is written.
-  for (const char* ext : {".dat", ".gp", ".svg", ".png"}) {
-    const fs::path target = dir / (f.name + ext);
+  for (const std::string& file : FigureFiles(f.name, f.pdf)) {
+    const fs::path target = dir / file;
     const fs::file_status st = fs::symlink_status(target);
     if (fs::exists(st) && !fs::is_regular_file(st))
       throw EnvironmentError(target.string() + ": is " + (fs::is_directory(st) ? "a folder" : "not a regular file") +
@@ -152,38 +161,49 @@ void RenderFigure(const GnuplotFigure& f, const std::string& directory) {
          << "# Lengths in mm.\n"
          << "if (!exists(\"svg_out\")) svg_out = '" << f.name << ".svg'\n"
          << "if (!exists(\"png_out\")) png_out = '" << f.name << ".png'\n"
+         << (f.pdf ? "if (!exists(\"pdf_out\")) pdf_out = '" + f.name + ".pdf'\n" : "")
          << "set encoding utf8\n"
          << "set terminal svg size 900,600 dynamic enhanced font 'DejaVu Sans,15' background rgb 'white'\n"
          << "set output svg_out\n"
          << "set grid lc rgb '#dddddd'\n"
-         << "set key top left box opaque\n"
+         // Below the plot: a key inside the axes covered points (the sample's Y − X figure).
+         << "set key below height 1\n"
          << "set border lw 1.2\n"
          << f.plot << "\n"
          << "set terminal pngcairo size 1350,900 enhanced font 'DejaVu Sans,15' background rgb 'white'\n"
          << "set output png_out\n"
-         << "replot\n"
-         << "unset output\n";
-  if (UpToDate(dir, f.name, f.data, script.str())) return;
+         << "replot\n";
+  if (f.pdf)
+    script << "set terminal pdfcairo size 15cm,10cm enhanced font 'DejaVu Sans,9' background rgb 'white'\n"
+           << "set output pdf_out\n"
+           << "replot\n";
+  script << "unset output\n";
+  if (UpToDate(dir, f.name, f.data, script.str(), f.pdf)) return;
   WriteFileAtomically((dir / (f.name + ".dat")).string(), f.data);
   WriteFileAtomically((dir / (f.name + ".gp")).string(), script.str());
 
   const RenderFolder render(dir, f.name);
   const std::string folder = render.path().filename().string();  // our own characters only
   const fs::path svg = render.path() / (f.name + ".svg"), png = render.path() / (f.name + ".png");
+  const fs::path pdf = render.path() / (f.name + ".pdf");
   const fs::path log = render.path() / "gnuplot.log";
   const std::string script_file = (dir / (f.name + ".gp")).string();
-  RunGnuplot(dir, "svg_out='" + folder + "/" + f.name + ".svg'; png_out='" + folder + "/" + f.name + ".png'",
+  RunGnuplot(dir,
+             "svg_out='" + folder + "/" + f.name + ".svg'; png_out='" + folder + "/" + f.name + ".png'" +
+                 (f.pdf ? "; pdf_out='" + folder + "/" + f.name + ".pdf'" : ""),
              f.name + ".gp", log, "figure " + f.name + " (" + script_file + ")");
-  if (!CompleteSvg(Slurp(svg)) || !CompletePng(Slurp(png)))
+  if (!CompleteSvg(Slurp(svg)) || !CompletePng(Slurp(png)) || (f.pdf && !CompletePdf(Slurp(pdf))))
     throw EnvironmentError("figure " + f.name + " (" + script_file + "): gnuplot left an incomplete image (is the disk full?) in " +
                            dir.string() + "; the previous images, if any, are unchanged");
   SyncFile(svg, f.name);
   SyncFile(png, f.name);
+  if (f.pdf) SyncFile(pdf, f.name);
   const int render_fd = ::open(render.path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (render_fd < 0) throw EnvironmentError(render.path().string() + ": cannot be opened: " + std::strerror(errno));
   try {
     RenameIntoPlaceAt(render_fd, f.name + ".svg", dir_fd, dir.string(), f.name + ".svg");
     RenameIntoPlaceAt(render_fd, f.name + ".png", dir_fd, dir.string(), f.name + ".png");
+    if (f.pdf) RenameIntoPlaceAt(render_fd, f.name + ".pdf", dir_fd, dir.string(), f.name + ".pdf");
   } catch (...) {
     ::close(render_fd);
     throw;
@@ -191,8 +211,10 @@ void RenderFigure(const GnuplotFigure& f, const std::string& directory) {
   ::close(render_fd);
 }
 
-std::vector<std::string> FigureFiles(const std::string& name) {
-  return {name + ".dat", name + ".gp", name + ".svg", name + ".png"};
+std::vector<std::string> FigureFiles(const std::string& name, bool pdf) {
+  std::vector<std::string> files = {name + ".dat", name + ".gp", name + ".svg", name + ".png"};
+  if (pdf) files.push_back(name + ".pdf");
+  return files;
 }
 
 }  // namespace uphill

@@ -2,7 +2,7 @@
 // restyle it for a paper (`gnuplot NAME.gp` in the output folder rewrites NAME.svg and NAME.png).
 //
 // Files: NAME.dat (the numbers, whitespace-separated blocks, units in the comments), NAME.gp (the
-// script), NAME.svg and NAME.png. Every file is replaced atomically or not at all: the data and
+// script), NAME.svg and NAME.png (and NAME.pdf when asked; a PDF is whole when it ends with %%EOF). Every file is replaced atomically or not at all: the data and
 // script by WriteFileAtomically, the images by letting gnuplot write into a private temporary
 // folder beside them, then checking that each image is whole (gnuplot exits 0 on a full disk and
 // leaves a truncated file: an SVG must end with </svg>, a PNG with its IEND chunk), fsyncing it,
@@ -24,6 +24,9 @@ struct GnuplotFigure {
   std::string caption;  // what it shows, in plain words
   std::string data;     // content of NAME.dat
   std::string plot;     // gnuplot commands after the preamble (set …; plot 'NAME.dat' …)
+  // Also NAME.pdf (gnuplot's pdfcairo terminal, 15 × 10 cm, fonts embedded), for a LaTeX document
+  // to \includegraphics as it is (latex_report.hpp).
+  bool pdf = false;
 };
 
 // Writes the four files into `directory`. Throws EnvironmentError naming the figure and gnuplot's
@@ -31,7 +34,8 @@ struct GnuplotFigure {
 // out incomplete, or when something is in the way.
 void RenderFigure(const GnuplotFigure& figure, const std::string& directory);
 
-// The four files RenderFigure writes for the figure `name`: NAME.dat, NAME.gp, NAME.svg, NAME.png.
-std::vector<std::string> FigureFiles(const std::string& name);
+// The files RenderFigure writes for the figure `name`: NAME.dat, NAME.gp, NAME.svg, NAME.png, and
+// NAME.pdf with `pdf`.
+std::vector<std::string> FigureFiles(const std::string& name, bool pdf = false);
 
 }  // namespace uphill

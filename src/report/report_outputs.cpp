@@ -10,7 +10,8 @@
 
 namespace uphill {
 
-void CheckReportOutputs(const Experiment& experiment, const std::string& directory, const std::string& flag) {
+void CheckReportOutputs(const Experiment& experiment, const std::string& directory, const std::string& flag,
+                        bool latex) {
   namespace fs = std::filesystem;
   const fs::path root(experiment.directory);
   OutputPaths outputs;
@@ -19,7 +20,7 @@ void CheckReportOutputs(const Experiment& experiment, const std::string& directo
   if (!experiment.camera.empty()) outputs.AddInput((root / experiment.camera).string(), "the experiment's camera file");
   for (const auto& [name, file] : experiment.scenes)
     outputs.AddInput((root / file).string(), "the experiment's scene file '" + name + "'");
-  std::vector<std::string> files = FitReportFiles();
+  std::vector<std::string> files = FitReportFiles(latex);
   std::size_t video_index = 0;
   for (const ExperimentRow& row : experiment.rows) {
     if (row.video.empty()) continue;

@@ -18,6 +18,8 @@ namespace uphill {
 // Throws InputError naming `flag`, the output file and the input it would replace ("-o
 // EXP/fit.json: is the experiment's camera file EXP/fit.json (the same file) …"), or an output
 // folder that cannot be written.
-void CheckReportOutputs(const Experiment& experiment, const std::string& directory, const std::string& flag);
+// `latex`: the report writes its LaTeX files too (FitReportFiles(true)).
+void CheckReportOutputs(const Experiment& experiment, const std::string& directory, const std::string& flag,
+                        bool latex = false);
 
 }  // namespace uphill

@@ -18,7 +18,7 @@ std::string SecondsU(const std::optional<Estimate>& v) {
 }
 std::string FitText(const VideoTrial& t) {
   if (!t.fit_available || !t.fit_value) return "-";
-  const std::string name = t.fitted == "mu" ? "mu = " : "g_eff = ";
+  const std::string name = t.fitted == "mu" ? "μ = " : "g_eff = ";
   const char* format = t.fitted == "mu" ? "%.5f" : "%.4f";
   return name + Printf(format, t.fit_value->value) + (t.fit_value->u ? " ± " + Printf("%.2g", *t.fit_value->u) : "") +
          (t.fitted == "mu" ? "" : " m/s2");
@@ -43,7 +43,7 @@ void AddVideoSections(const ExperimentAnalysis& a, bool with_figures, Document* 
   d->Paragraph("Each trial's recording is tracked and its track analysed (docs/analyse-track.md); the final rest "
                "of the body is a measured Y. Where Y was typed too, the typed Y is the one fitted and the two are "
                "compared: a difference beyond 3 combined standard uncertainties is flagged.");
-  Table rest{{"trial", "video", "Y typed (mm)", "Y from video (mm)", "typed - video (sigma)", "flag"}, {}};
+  Table rest{{"trial", "video", "Y typed (mm)", "Y from video (mm)", "typed − video (σ)", "flag"}, {}};
   int flagged = 0;
   for (const VideoTrial& t : a.video_trials) {
     const ExperimentRow* row = RowOf(a, t.row);
@@ -54,7 +54,7 @@ void AddVideoSections(const ExperimentAnalysis& a, bool with_figures, Document* 
     if (typed && t.error.empty() && t.rest && t.rest->u) {
       const YComparison c = CompareY(row->Y.value, row->Y.u, t.rest->value, *t.rest->u);
       cells.push_back(c.sigma > 0 ? Printf("%+.2f", c.difference / c.sigma) : Printf("%+.3f mm", c.difference * 1e3));
-      cells.push_back(c.flagged ? "differ beyond 3 sigma" : "");
+      cells.push_back(c.flagged ? "differ beyond 3σ" : "");
       flagged += c.flagged;
     } else {
       cells.push_back("-");
@@ -64,15 +64,15 @@ void AddVideoSections(const ExperimentAnalysis& a, bool with_figures, Document* 
   }
   d->AddTable(rest);
   if (flagged > 0)
-    d->Paragraph(std::to_string(flagged) + " trial(s) have a typed Y and a video Y that differ by more than 3 sigma: "
+    d->Paragraph(std::to_string(flagged) + " trial(s) have a typed Y and a video Y that differ by more than 3σ: "
                  "check the typed value, the scene calibration, or whether the body was disturbed.");
 
   d->Heading("Motion fits");
   d->Paragraph("The model motion released from rest at x0 at time t0 fitted to each track's x(t) (vision's "
-               "analyse-track): with fit = mu the rolling resistance at the stated g, with fit = g an effective g "
-               "(mu = 0). Uncertainties are analyse-track's u: the residuals' scatter and the tracker's systematic "
+               "analyse-track): with fit = mu the rolling-resistance coefficient μ at the stated g, with fit = g an "
+               "effective g (μ = 0). Uncertainties are analyse-track's u: the residuals' scatter and the tracker's systematic "
                "error added in quadrature (docs/analyse-track.md, \"Accuracy\").");
-  Table fits{{"trial", "x0 (mm)", "t0 (s)", "fit", "chi2/dof", "frames (found)", "events", "notes"}, {}};
+  Table fits{{"trial", "x0 (mm)", "t0 (s)", "fit", "χ²/ν", "frames (found)", "events", "notes"}, {}};
   for (const VideoTrial& t : a.video_trials) {
     if (!t.error.empty()) continue;
     std::string events;
@@ -91,23 +91,23 @@ void AddVideoSections(const ExperimentAnalysis& a, bool with_figures, Document* 
   const FitOutcome* friction = a.Fit("friction");
   std::string text;
   if (motion) {
-    text = "mu from the motions: " + Printf("%.5f", motion->mu) + Printf(" ± %.2g", motion->u) + " (weighted mean of " +
+    text = "Rolling-resistance coefficient μ from the motions: " + Printf("%.5f", motion->mu) + Printf(" ± %.2g", motion->u) + " (weighted mean of " +
            std::to_string(motion->trials) + " trials";
-    text += motion->reduced_chi2 ? Printf(", chi2/dof %.2f). ", *motion->reduced_chi2) : std::string("). ");
+    text += motion->reduced_chi2 ? Printf(", χ²/ν %.2f). ", *motion->reduced_chi2) : std::string("). ");
   } else {
-    text = "No trial's motion fit gives mu (set \"video_analysis\": {\"fit\": \"mu\"} in experiment.json to fit it). ";
+    text = "No trial's motion fit gives μ (set \"video_analysis\": {\"fit\": \"mu\"} in experiment.json to fit it). ";
   }
   if (friction && friction->report) {
     const FitReport& r = *friction->report;
     const double mu = r.Parameter("mu").value;
     const auto se = r.StandardError("mu", r.primary_scaling);
-    text += "mu from the rest positions (the friction fit of Y against the settings): " + Printf("%.5f", mu) +
+    text += "μ from the rest positions (the friction fit of Y against the settings): " + Printf("%.5f", mu) +
             (se ? " ± " + Printf("%.2g", *se) : "") + ". ";
     if (motion && se) {
       const double sigma = std::hypot(motion->u, *se);
       text += Printf("They differ by %.2f combined standard uncertainties", (motion->mu - mu) / sigma) +
               (std::abs(motion->mu - mu) > 3 * sigma ? std::string(": the friction model does not describe both the "
-                                                                   "motion and the rest (beyond 3 sigma).")
+                                                                   "motion and the rest (beyond 3σ).")
                                                      : std::string(": consistent."));
     }
   } else {

@@ -1,5 +1,6 @@
 #include "report/video_trials.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -11,6 +12,19 @@ namespace uphill {
 namespace {
 
 std::string Num(double v) { return Printf("%.10g", v); }
+
+// A ball at rest moves by the tracker's noise (hundredths of a mm): drawn on gnuplot's own range
+// that noise would fill the figure as if it were motion. So the x axis spans at least
+// kMinimumSpanMm, centred on the positions (and the model curve).
+constexpr double kMinimumSpanMm = 5.0;
+std::string MinimumXRange(const TrackFigureData& a) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto* points : {&a.measured, &a.curve})
+    for (const auto& [t, x] : *points) lo = std::min(lo, x * 1e3), hi = std::max(hi, x * 1e3);
+  if (!(hi >= lo) || hi - lo >= kMinimumSpanMm) return "";
+  const double mid = 0.5 * (lo + hi);
+  return "set yrange [" + Num(mid - kMinimumSpanMm / 2) + ":" + Num(mid + kMinimumSpanMm / 2) + "]\n";
+}
 
 }  // namespace
 
@@ -56,10 +70,12 @@ std::vector<GnuplotFigure> TrackFigures(const TrackFigureData& a, const std::str
   std::vector<GnuplotFigure> figures;
   GnuplotFigure x;
   x.name = stem + kXVsT;
-  x.title = "Measured x(t) against the fitted model" + title_suffix;
-  x.caption = "Each point is one video frame where the ball was found (x of its centre in the apparatus frame); "
-              "the line is the model motion fitted to them (x0, t0 and " +
-              (a.fitted.empty() ? std::string("g or mu") : a.fitted) + ").";
+  x.title = (a.curve.empty() ? "Measured x(t), no motion fitted" : "Measured x(t) against the fitted model") + title_suffix;
+  x.caption = "Each point is one video frame where the ball was found (x of its centre in the apparatus frame); " +
+              (a.curve.empty() ? std::string("no model line: no motion was fitted (a ball at rest, or the fit was "
+                                             "not available).")
+                               : "the line is the model motion fitted to them (x0, t0 and " +
+                                     (a.fitted == "mu" ? std::string("μ") : a.fitted.empty() ? "g or μ" : a.fitted) + ").");
   std::ostringstream data;
   data << "# t_s x_mm (every frame with the ball)\n";
   for (const auto& [t, xv] : a.measured) data << Num(t) << " " << Num(xv * 1e3) << "\n";
@@ -68,7 +84,7 @@ std::vector<GnuplotFigure> TrackFigures(const TrackFigureData& a, const std::str
   x.data = data.str();
   std::ostringstream plot;
   plot << "set xlabel 't (s)'\nset ylabel 'x, centre (mm)'\nset offsets graph 0.02, graph 0.02, graph 0.05, graph 0.05\n"
-       << "plot '" << x.name << ".dat' index 0 using 1:2 with points pt 7 ps 0.5 lc rgb '#1f4e79' title 'measured'";
+       << MinimumXRange(a) << "plot '" << x.name << ".dat' index 0 using 1:2 with points pt 7 ps 0.5 lc rgb '#1f4e79' title 'measured'";
   if (!a.curve.empty())
     plot << ", \\\n  '" << x.name << ".dat' index 1 using 1:2 with lines lw 2 lc rgb '#d62728' title 'fitted model'";
   x.plot = plot.str();

@@ -171,14 +171,18 @@ std::string ExperimentState::MeasurementsCsv() const {
   for (const std::string& c : columns) out.append(",").append(c).append("_").append(unit);
   const bool video = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.video.empty(); });
   const bool scene = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.scene.empty(); });
+  // The exclusion column only once a row is excluded: a folder that never used it stays as it was.
+  const bool excluded = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.excluded.empty(); });
   if (video) out += ",video";
   if (scene) out += ",scene";
+  if (excluded) out.append(",").append(MeasurementExclusionColumn());
   out += ",note\n";
   for (const Row& r : rows) {
     out.append(CsvCell(r.trial)).append(",").append(CsvCell(r.series));
     for (const std::string& c : columns) out.append(",").append(CsvCell(r.Value(c)));
     if (video) out.append(",").append(CsvCell(r.video));
     if (scene) out.append(",").append(CsvCell(r.scene));
+    if (excluded) out.append(",").append(CsvCell(r.excluded));
     out.append(",").append(CsvCell(r.note)).append("\n");
   }
   return out;
@@ -193,6 +197,7 @@ ordered_json ToJson(const Row& row) {
     if (!row.Value(q).empty()) j[q] = row.Value(q);
   if (!row.video.empty()) j["video"] = row.video;
   if (!row.scene.empty()) j["scene"] = row.scene;
+  if (!row.excluded.empty()) j["excluded"] = row.excluded;
   j["note"] = row.note;
   return j;
 }
@@ -221,6 +226,7 @@ Row RowFromJournal(const json& j) {
   r.note = j.value("note", "");
   r.video = j.value("video", "");
   r.scene = j.value("scene", "");
+  r.excluded = j.value("excluded", "");
   for (const std::string& q : RowQuantities())
     if (j.contains(q)) r.values[q] = j.at(q).get<std::string>();
   return r;
@@ -251,7 +257,7 @@ void ValidateUnit(const std::string& unit) {
 Row ValidateRow(const json& j, const ExperimentState& state) {
   if (!j.is_object()) throw InputError("row", "must be a JSON object");
   Row r;
-  std::set<std::string> allowed = {"id", "trial", "series", "note", "video", "scene"};
+  std::set<std::string> allowed = {"id", "trial", "series", "note", "video", "scene", "excluded"};
   for (const std::string& q : RowQuantities()) allowed.insert(q);
   for (const auto& [key, value] : j.items())
     if (!allowed.count(key)) throw InputError("row." + key.substr(0, 32), "unknown field");
@@ -259,6 +265,8 @@ Row ValidateRow(const json& j, const ExperimentState& state) {
   if (r.trial.empty()) throw InputError("row.trial", "is empty: every trial needs a label");
   r.series = Trim(CheckText(j.value("series", json("")), "row.series", kMaxLabelLength));
   r.note = CheckText(j.value("note", json("")), "row.note", kMaxNoteLength);
+  // Why the row is left out of the fits ("" : fitted).
+  r.excluded = Trim(CheckText(j.value("excluded", json("")), "row.excluded", kMaxNoteLength));
   r.video = Trim(CheckText(j.value("video", json("")), "row.video", kMaxPathLength));
   if (!r.video.empty()) CheckRelativePath(r.video, "row.video");
   r.scene = Trim(CheckText(j.value("scene", json("")), "row.scene", kMaxLabelLength));
@@ -527,6 +535,7 @@ ExperimentState StateFromFolder(const ExperimentFolder& folder, const std::optio
       else if (base == "note") r.note = cell;
       else if (base == "video") r.video = Trim(cell);
       else if (base == "scene") r.scene = Trim(cell);
+      else if (base == MeasurementExclusionColumn()) r.excluded = Trim(cell);
       else if (std::find(RowQuantities().begin(), RowQuantities().end(), base) != RowQuantities().end()) {
         const std::string text = Trim(cell);
         if (text.empty()) continue;

@@ -53,6 +53,7 @@ struct Row {
   std::int64_t id = 0;  // assigned by the store, stable across edits; never reused
   std::string trial, series, note;
   std::string video, scene;  // the trial's recording (a path in the folder) and its scene's name
+  std::string excluded;      // why the row is left out of the fits ("" : fitted), measurements.csv's `excluded`
   std::map<std::string, std::string> values;  // quantity -> plain number text in `unit`
 
   // The value as typed, or "" when absent.

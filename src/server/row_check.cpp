@@ -112,12 +112,13 @@ ordered_json CheckAll(const ExperimentState& state) {
     const ordered_json check = ToJson(c, state.unit);
     for (const auto& [k, v] : check.items()) j[k] = v;
     out["checks"].push_back(j);
-    if (c.x_eq && c.y) {
+    if (c.x_eq && c.y && state.rows[i].excluded.empty()) {  // an excluded row is shown, never fitted
       data.x.push_back(*c.x_eq * to_unit);
       data.y.push_back(*c.y * to_unit);
     }
   }
-  ordered_json fit = {{"n", data.size()}};
+  const auto excluded = std::count_if(state.rows.begin(), state.rows.end(), [](const Row& r) { return !r.excluded.empty(); });
+  ordered_json fit = {{"n", data.size()}, {"excluded", excluded}};
   try {
     if (data.size() < 2) throw InputError("fit", "needs at least 2 rows with X and Y");
     const FitReport r = FitXy(FitMethod::kOrdinaryLeastSquares, data);

@@ -6,7 +6,8 @@
 // row and column ("measurements.csv, row 3, column D_mm: …").
 //
 // The fit summary is the ordinary least-squares line Y = k·X + c (fit/least_squares_line.hpp)
-// over the rows whose X and Y are known, with the usual (scaled) standard errors.
+// over the rows whose X and Y are known and that are not excluded (a row's `excluded` reason:
+// shown and checked, never fitted, as in `uphill fit`), with the usual (scaled) standard errors.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -35,8 +36,9 @@ RowCheck CheckRow(const ExperimentState& state, const Row& row);
 nlohmann::ordered_json ToJson(const RowCheck& check, const std::string& unit);
 
 // Every row's check (keyed by row id, in row order) and the OLS fit of the rows with X and Y:
-//   {"checks":[{"id":..,<ToJson>}...],"fit":{"n","slope","intercept","u_slope","u_intercept",
-//    "r_squared","residual_sd"} or {"n","unavailable":reason}}; fit lengths in `unit`.
+//   {"checks":[{"id":..,<ToJson>}...],"fit":{"n","excluded","slope","intercept","u_slope",
+//    "u_intercept","r_squared","residual_sd"} or {"n","excluded","unavailable":reason}}; fit lengths
+//   in `unit`; n the rows fitted, excluded the rows left out by their `excluded` reason.
 nlohmann::ordered_json CheckAll(const ExperimentState& state);
 
 }  // namespace uphill

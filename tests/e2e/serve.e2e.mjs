@@ -126,11 +126,23 @@ try {
   await page.keyboard.press('Control+z');
   await page.waitForFunction(() => document.querySelectorAll('#body tr').length === 4);
 
+  // Exclude a row from the fit with its reason: it stays in the table and the plot (hollow), the
+  // live fit leaves it out, and the report lists it; Ctrl+Z takes it back.
+  page.once('dialog', (dialog) => dialog.accept('bumped the rail'));
+  await page.click('#body tr:nth-child(2) td.fit-toggle input');
+  await page.waitForSelector('#plot circle.point.excluded');
+  assert.match(await page.textContent('#fit'), /3 \(1 excluded\)/);
+  assert.equal(await page.locator('#body tr').count(), 4);
+
   // The report button writes the report and links to it.
   await page.click('#report-button');
   await page.waitForSelector('#report-link:not([hidden])', { timeout: 60000 });
   const report = await page.request.get(url + 'report/report.html');
   assert.equal(report.status(), 200);
+  assert.match(await report.text(), /trial t2 \(row 3\): bumped the rail/);
+  await page.focus('#body tr:nth-child(1)');
+  await page.keyboard.press('Control+z');
+  await page.waitForFunction(() => !document.querySelector('#plot circle.point.excluded'));
 
   // Reload: everything is still there (and the half-typed draft too).
   await page.reload();
@@ -147,7 +159,7 @@ try {
   assert.equal(csv.length, 5);
   assert.ok(fs.existsSync(path.join(dir, 'journal.jsonl')));
   assert.deepEqual(problems, []);
-  console.log('serve e2e: ok (4 rows typed, flags, plot, edit, delete/undo, report, reload, CSV)');
+  console.log('serve e2e: ok (4 rows typed, flags, plot, edit, delete/undo, exclude/undo, report, reload, CSV)');
 } catch (e) {
   failed = true;
   console.error(e);

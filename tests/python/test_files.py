@@ -48,6 +48,43 @@ def test_a_bad_row_is_kept_with_its_error(tmp_path):
     assert len(analysis.y) == len(lines) - 2 and analysis.row_errors
 
 
+def test_an_excluded_row_is_analysed_but_fitted_as_if_deleted(tmp_path):
+    """measurements.csv's `excluded` column (data/README.md): the row keeps its reason and its
+    X, and every fit equals the fit of the file without that row (the truth: the row deleted);
+    `uphill fit --json` agrees."""
+    source = SOURCE / "data" / "series2-fixed-L"
+    lines = (source / "measurements.csv").read_text().splitlines()
+    folders = {}
+    for name in ("excluded", "deleted"):
+        folders[name] = tmp_path / name
+        folders[name].mkdir()
+        (folders[name] / "experiment.json").write_text((source / "experiment.json").read_text())
+    slip = "s2-5,s2,1165.1,130.1,45.24,"  # Y typed in cm
+    rows = [slip if line.startswith("s2-5,") else line for line in lines]
+    marked = [rows[0] + ",excluded"] + [r + (",Y typed in cm" if r == slip else ",") for r in rows[1:]]
+    (folders["excluded"] / "measurements.csv").write_text("\n".join(marked) + "\n")
+    (folders["deleted"] / "measurements.csv").write_text(
+        "\n".join(line for line in lines if not line.startswith("s2-5,")) + "\n")
+    exp = uphill.read_experiment(str(folders["excluded"]))
+    assert [r["excluded"] for r in exp.rows if r["excluded"]] == ["Y typed in cm"]
+    excluded = uphill.analyse_experiment(exp, mc_trials=1000)
+    deleted = uphill.analyse_experiment(str(folders["deleted"]), mc_trials=1000)
+    assert [e["trial"] for e in excluded.excluded] == ["s2-5"]
+    assert excluded.excluded[0]["reason"] == "Y typed in cm" and excluded.excluded[0]["y"] == pytest.approx(0.04524)
+    assert "s2-5" not in excluded.trials and len(excluded.y) == len(deleted.y) == 23
+    for method, fit in deleted.fits.items():
+        assert [(p.name, p.value, p.se_unscaled) for p in excluded.fits[method].parameters] == \
+            [(p.name, p.value, p.se_unscaled) for p in fit.parameters], method
+        assert excluded.fits[method].chi2 == fit.chi2, method
+    assert excluded.summary["excluded"] == ["trial s2-5 (row 6): Y typed in cm"]
+    assert excluded.summary["preferred"] == deleted.summary["preferred"] == "friction"
+    status, out, err = run_cli("fit", folders["excluded"], "--json", "--mc-trials", "1000")
+    assert status == 0, err
+    result = json.loads(out)
+    assert [r["trial"] for r in result["excluded_rows"]] == ["s2-5"]
+    assert result["fits"]["york"]["slope"] == deleted.fits["york"].slope
+
+
 ROW_CHECK_JSON = {"format": "uphill-experiment/1",
                   "body": {"type": "spheroid", "a": "15.875 mm", "b": "25.4 mm"},
                   "apparatus": {"H": "300 mm", "L_convention": "horizontal"},

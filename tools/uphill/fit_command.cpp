@@ -1,7 +1,8 @@
 // `uphill fit`: fits of measured Y against theoretical X.
 //   uphill fit EXP [--json]                       an experiment folder (data/README.md)
 //   uphill fit --xy FILE.csv [--method M] [--json]  arbitrary X-Y data, header X,Y[,uX,uY]
-// `uphill report EXP -o DIR`: the full report (HTML, Markdown, fit.json, figures).
+// `uphill report EXP -o DIR [--latex]`: the full report (HTML, Markdown, fit.json, figures; with
+// --latex also LaTeX tables and PDF figures, report/latex_report.hpp).
 // The work is the app's: FitXy (app/fit_xy.hpp) for --xy data, AnalyseExperimentFolder
 // (app/experiment_folder_analysis.hpp) for a folder, which tracks its videos when it has any
 // (OpenCV). So an experiment is always analysed in `uphill-vision` (vision_program.hpp): one path
@@ -41,6 +42,7 @@ struct FitFlags {
   std::string output;
   unsigned jobs = 0;  // videos tracked at once; 0: one per core
   bool quiet = false;
+  bool latex = false;  // report: also fits.tex, trials.tex, the figures as PDF, report-standalone.tex
 };
 
 
@@ -85,7 +87,8 @@ ExperimentFolderAnalysis Analyse(const FitFlags& f, Experiment experiment, const
   const auto progress = [&](const VideoProgress& p) { if (display) display->Update(p); };
   ExperimentFolderAnalysis a = output.empty()
                                    ? AnalyseLoadedExperiment(std::move(experiment), options, progress)
-                                   : WriteExperimentReport(std::move(experiment), {output, "", "-o"}, options, progress);
+                                   : WriteExperimentReport(std::move(experiment), {output, "", "-o", f.latex}, options,
+                                                           progress);
   if (display) display->Finish();
   for (const std::string& note : a.notes) std::cerr << "uphill: note: " << note << "\n";
   for (const std::string& e : a.trial_errors) std::cerr << "uphill: " << e << " (video left out)\n";
@@ -109,6 +112,9 @@ void RunReport(const FitFlags& f) {
             << "fit_y_vs_x, fit_offset, fit_residuals";
   if (!a.analysis.video_trials.empty()) std::cout << ", and each video's video_<n>_x_vs_t, video_<n>_residuals";
   std::cout << " (.svg, .png, .gp script, .dat data)\n";
+  if (f.latex)
+    std::cout << "wrote " << f.output << "/fits.tex, trials.tex, report-standalone.tex and the figures as .pdf "
+              << "(\\input and \\includegraphics them; pdflatex report-standalone.tex in the folder)\n";
 }
 
 #else  // uphill: an experiment is analysed in uphill-vision, which tracks its videos (OpenCV)
@@ -152,6 +158,8 @@ void AddFitCommand(CLI::App& app) {
   report->add_option("experiment", flags->experiment, "experiment folder")->required();
   report->add_option("-o,--output", flags->output, "output folder (created if needed)")->required();
   report->add_option("--mc-trials", flags->mc_trials, "Monte Carlo trials per row for u(X)")->capture_default_str();
+  report->add_flag("--latex", flags->latex,
+                    "also write LaTeX: fits.tex, trials.tex (siunitx), the figures as PDF, report-standalone.tex");
   AddVideoFlags(report, flags.get());
   report->callback([flags] { RunReport(*flags); });
 }

@@ -219,7 +219,7 @@ function renderHead() {
   for (const q of rowColumns()) head.append(el('th', { class: 'num' }, `${q} (${u})`));
   head.append(el('th', {}, 'note'), el('th', { class: 'num' }, 'θ (°)'), el('th', { class: 'num' }, 'α (°)'),
     el('th', { class: 'num' }, `X ± u(X) (${u})`), el('th', { class: 'num' }, `Y − X (${u})`),
-    el('th', {}, 'flags'), el('th', {}, ''));
+    el('th', {}, 'flags'), el('th', {}, 'fit'), el('th', {}, ''));
 }
 
 function computedCells(tr, check) {
@@ -257,6 +257,7 @@ function renderRows() {
     for (const q of rowColumns()) tr.append(el('td', { class: 'num ' + fieldClass(row.check, q) }, row[q] ?? ''));
     tr.append(el('td', { class: 'note' }, row.note));
     computedCells(tr, row.check);
+    tr.append(typeof excludedCell === 'function' ? excludedCell(row) : el('td'));  // fit_toggle.js
     const actions = el('td', { class: 'actions' });
     const edit = el('button', { type: 'button', title: 'Edit this row (Enter)' }, 'Edit');
     edit.addEventListener('click', () => startEdit(row.id));
@@ -292,6 +293,7 @@ function inputRow(values, kind) {
   for (const q of rowColumns()) tr.append(input(q, 'num', values[q]));
   tr.append(input('note', 'note', values.note));
   computedCells(tr, kind === 'edit' ? values.check : null);
+  tr.append(el('td', { class: 'fit-toggle' }, kind === 'edit' && values.excluded ? 'excluded' : ''));
   const actions = el('td', { class: 'actions' });
   const save = el('button', { type: 'button', class: 'primary' }, kind === 'edit' ? 'Save' : 'Add');
   save.addEventListener('click', () => submitRow(tr));
@@ -319,7 +321,7 @@ function rowFromInputs(tr) {
   if (tr.dataset.kind === 'edit') {
     row.id = editingId;
     const stored = S.rows.find((r) => r.id === editingId) || {};
-    for (const q of ['u_L', 'u_H', 'u_D', 'u_Y', 'video', 'scene']) if (stored[q]) row[q] = stored[q];  // kept as they were
+    for (const q of ['u_L', 'u_H', 'u_D', 'u_Y', 'video', 'scene', 'excluded']) if (stored[q]) row[q] = stored[q];  // kept as they were
   }
   return row;
 }
@@ -495,7 +497,7 @@ function renderPlot(draftCheck) {
   if (!S) return;
   const W = 640, H = 420, m = { l: 64, r: 16, t: 16, b: 48 };
   const pts = S.rows.filter((r) => r.check && r.check.x !== null && r.check.y !== null)
-    .map((r) => ({ x: r.check.x, y: r.check.y, u: r.check.u_x, flagged: r.check.flags.length > 0, label: r.trial }));
+    .map((r) => ({ x: r.check.x, y: r.check.y, u: r.check.u_x, flagged: r.check.flags.length > 0, label: r.trial, excluded: !!r.excluded }));
   const draft = lastDraftCheck && lastDraftCheck.x !== null && lastDraftCheck.y !== null ? lastDraftCheck : null;
   const all = pts.concat(draft ? [{ x: draft.x, y: draft.y }] : []);
   if (all.length === 0) {
@@ -531,8 +533,9 @@ function renderPlot(draftCheck) {
   }
   for (const p of pts) {
     if (p.u > 0) area.append(svg('line', { x1: sx(p.x - p.u), x2: sx(p.x + p.u), y1: sy(p.y), y2: sy(p.y), class: 'errbar' }));
-    const dot = svg('circle', { cx: sx(p.x), cy: sy(p.y), r: 4.5, class: 'point' + (p.flagged ? ' flagged' : '') });
-    dot.append(svg('title', {}, `${p.label}: X = ${fmt(p.x, d)}, Y = ${fmt(p.y, d)}`));
+    const dot = svg('circle', { cx: sx(p.x), cy: sy(p.y), r: 4.5, class: 'point' + (p.flagged ? ' flagged' : '') + (p.excluded ? ' excluded' : '') });
+    if (p.excluded) { dot.style.fill = 'none'; dot.style.stroke = '#999'; }  // hollow grey: shown, not fitted
+    dot.append(svg('title', {}, `${p.label}: X = ${fmt(p.x, d)}, Y = ${fmt(p.y, d)}${p.excluded ? ' (excluded from the fit)' : ''}`));
     area.append(dot);
   }
   if (draft) area.append(svg('circle', { cx: sx(draft.x), cy: sy(draft.y), r: 6, class: 'point draft' }));
@@ -544,7 +547,7 @@ function renderFit() {
   if (!S) return;
   const f = S.fit || {}, d = lengthDecimals();
   const add = (k, v) => dl.append(el('dt', {}, k), el('dd', {}, v));
-  add('rows used', String(f.n ?? 0));
+  add('rows used', String(f.n ?? 0) + (f.excluded ? ` (${f.excluded} excluded)` : ''));
   if (f.unavailable) { add('fit', f.unavailable.replace(/^fit: /, '')); return; }
   add('slope k', `${fmt(f.slope, 4)} ± ${f.u_slope === null ? '—' : fmt(f.u_slope, 4)}`);
   add(`intercept c (${S.unit})`, `${fmt(f.intercept, d)} ± ${f.u_intercept === null ? '—' : fmt(f.u_intercept, d)}`);
