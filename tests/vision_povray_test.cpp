@@ -1,4 +1,4 @@
-// The POV-Ray footage generator (src/vision/footage_clip.hpp): its geometry against OpenCV, and
+// The POV-Ray footage generator (src/footage/footage_clip.hpp): its geometry against OpenCV, and
 // the user's whole path (calibrate camera -> calibrate scene -> track) on a small rendered clip.
 //
 // Where the truth comes from: POV-Ray, an independent ray tracer, renders points of known
@@ -24,12 +24,12 @@
 #include "cli_test_support.hpp"
 #include "io/csv_table.hpp"
 #include "motion/motion.hpp"
-#include "vision/footage_clip.hpp"
-#include "vision/footage_conditions.hpp"
-#include "vision/lens_remap.hpp"
-#include "vision/povray_render.hpp"
-#include "vision/povray_scene.hpp"
-#include "vision/sensor_model.hpp"
+#include "footage/footage_clip.hpp"
+#include "footage/footage_conditions.hpp"
+#include "footage/lens_remap.hpp"
+#include "footage/povray_render.hpp"
+#include "footage/povray_scene.hpp"
+#include "footage/sensor_model.hpp"
 
 namespace uphill::testing {
 namespace {
@@ -145,7 +145,7 @@ class PovrayTest : public ::testing::Test {
 // lands on cv::projectPoints' pixel (no distortion, so no remap is involved).
 // The footage cache is keyed on the generator's code, not on a version constant someone must
 // remember to bump. Truth: coreutils' sha256sum over the generator's files (the list CMake hashes,
-// UPHILL_FOOTAGE_GENERATOR_SOURCES), combined as src/vision/CMakeLists.txt states; the clip's
+// UPHILL_FOOTAGE_GENERATOR_SOURCES), combined as src/footage/CMakeLists.txt states; the clip's
 // description (hence its cache key) and the chessboard views' must carry that digest.
 TEST(FootageCache, KeyHoldsTheDigestOfTheGeneratorsCode) {
   std::string command = "for f in";

@@ -1,4 +1,4 @@
-#include "vision/povray_scene.hpp"
+#include "footage/povray_scene.hpp"
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -200,7 +200,7 @@ void CheckShot(const PovrayShot& shot) {
 }
 
 const char* kPreamble =
-    "// uphill footage: the rolling-uphill apparatus (src/vision/povray_scene.hpp). Units: mm.\n"
+    "// uphill footage: the rolling-uphill apparatus (src/footage/povray_scene.hpp). Units: mm.\n"
     "#version 3.7;\n"
     "global_settings { assumed_gamma 1.0 max_trace_level 6 adc_bailout 0.002 }\n"
     "#default { finish { ambient 0 diffuse 1 } }\n";

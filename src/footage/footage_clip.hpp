@@ -45,7 +45,7 @@
 // Caching: a clip lives in <cache root>/<key>/ (FootageCacheRoot: ${XDG_CACHE_HOME:-~/.cache}/
 // uphill/clips), the key a 64-bit FNV-1a hash of the condition's description (DescribeFootage,
 // kept as condition.json beside the clip with the rendering time), which holds a digest of the
-// generator's own code ("generator", src/vision/CMakeLists.txt); it is written under a private
+// generator's own code ("generator", src/footage/CMakeLists.txt); it is written under a private
 // name and renamed into place when complete. RenderFootage reuses it unless asked for a fresh
 // render. POV-Ray's pictures are cached too, in <cache root>/pictures/, keyed by their scene
 // text: clips with the same camera, scene and motion (baseline, h265, flicker, ae-drift, the
@@ -62,11 +62,11 @@
 #include "vision/apparatus_points.hpp"
 #include "vision/camera.hpp"
 #include "vision/chessboard_render.hpp"
-#include "vision/povray_render.hpp"
-#include "vision/povray_scene.hpp"
-#include "vision/sensor_model.hpp"
-#include "vision/synthetic_clip.hpp"
-#include "vision/video_encoder.hpp"
+#include "footage/povray_render.hpp"
+#include "footage/povray_scene.hpp"
+#include "footage/sensor_model.hpp"
+#include "footage/synthetic_clip.hpp"
+#include "footage/video_encoder.hpp"
 
 namespace uphill {
 

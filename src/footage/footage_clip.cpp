@@ -1,4 +1,4 @@
-#include "vision/footage_clip.hpp"
+#include "footage/footage_clip.hpp"
 
 #include <unistd.h>
 
@@ -27,7 +27,7 @@
 #include "model/input_error.hpp"
 #include "motion/motion.hpp"
 #include "internal/content_key.hpp"
-#include "vision/lens_remap.hpp"
+#include "footage/lens_remap.hpp"
 #include "internal/footage_renderer.hpp"
 
 namespace uphill {
@@ -40,7 +40,7 @@ using ordered_json = nlohmann::ordered_json;
 using internal::FootageRenderer;
 using internal::PovrayWork;
 
-// A digest of the generator's code (src/vision/CMakeLists.txt): what the same condition's pixels
+// A digest of the generator's code (src/footage/CMakeLists.txt): what the same condition's pixels
 // and truth are depends on it, so it is part of every cache key.
 constexpr const char* kGeneratorDigest = UPHILL_FOOTAGE_GENERATOR_DIGEST;
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -306,7 +306,7 @@ FootageFiles RenderFootage(const FootageCondition& condition, const std::string&
   }
   WriteFileAtomically((partial / "points.csv").string(), points.str());
   CalibrationSummary summary;
-  summary.method = "the true camera of the POV-Ray footage (src/vision/footage_clip.hpp)";
+  summary.method = "the true camera of the POV-Ray footage (src/footage/footage_clip.hpp)";
   summary.verdict = "exact";
   summary.reasons = {"the camera that rendered the clip: no calibration error"};
   WriteCameraFile((partial / "camera_truth.json").string(), k, summary);
