@@ -147,14 +147,33 @@ ordered_json DescribeFootage(const FootageCondition& c) {
                     {"post_radius_m", a.post_radius}, {"rail_overhang_m", a.rail_overhang},
                     {"table_z_m", a.table_z},        {"wall_y_m", a.wall_y},
                     {"marks_m", a.marks}};
-  j["look"] = {{"table", c.look.table == TableCover::kWood ? "wood" : "cloth"},
-               {"body_rgb", {c.look.body_rgb.x(), c.look.body_rgb.y(), c.look.body_rgb.z()}},
-               {"band_rgb", {c.look.band_rgb.x(), c.look.band_rgb.y(), c.look.band_rgb.z()}},
+  const auto rgb = [](const Eigen::Vector3d& v) { return ordered_json::array({v.x(), v.y(), v.z()}); };
+  static const char* const kTables[] = {"wood", "cloth", "paper", "tiles"};
+  static const char* const kFinishes[] = {"satin", "matte", "glossy", "chrome"};
+  static const char* const kPatterns[] = {"plain", "two-tone", "stripes", "dots"};
+  ordered_json lamps = ordered_json::array();
+  for (const FootageLamp& lamp : c.look.lamps)
+    lamps.push_back({{"position_m", rgb(lamp.position)}, {"intensity", lamp.intensity}});
+  j["look"] = {{"table", kTables[static_cast<int>(c.look.table)]},
+               {"body_rgb", rgb(c.look.body_rgb)},
+               {"band_rgb", rgb(c.look.band_rgb)},
                {"band_half_width_m", c.look.band_half_width},
-               {"light", c.look.light}};
+               {"light", c.look.light},
+               {"finish", kFinishes[static_cast<int>(c.look.finish)]},
+               {"pattern", kPatterns[static_cast<int>(c.look.pattern)]},
+               {"pattern_scale_m", c.look.pattern_scale},
+               {"pattern_turn_deg", rgb(c.look.pattern_turn)},
+               {"rod_rgb", c.look.rod_rgb ? rgb(*c.look.rod_rgb) : ordered_json()},
+               {"lamps", lamps}};
   j["camera"] = DescribeCamera(c.camera.camera);
   j["pose"] = DescribePose(c.camera.pose);
-  j["motion"] = {{"x0_m", c.x0}, {"release_time_s", c.release_time}};
+  j["motion"] = {{"x0_m", c.x0},
+                 {"release_time_s", c.release_time},
+                 {"v0_m_per_s", c.motion.v0},
+                 {"g_m_per_s2", c.motion.g},
+                 {"mu", c.motion.mu},
+                 {"ode", c.motion.method == MotionMethod::kOde},
+                 {"tolerance", c.motion.tolerance}};
   j["frames"] = c.frames;
   j["shutter"] = {{"fps", c.shutter.fps}, {"exposure_s", c.shutter.exposure}, {"readout_s", c.shutter.readout},
                   {"t0_s", c.shutter.t0}};
