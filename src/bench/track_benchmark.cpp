@@ -16,6 +16,7 @@
 #include "bench/results_document.hpp"
 #include "bench/support.hpp"
 #include "bench/track_matrix.hpp"
+#include "bench/track_random.hpp"
 #include "vision/ball_tracker.hpp"
 #include "footage/synthetic_clip.hpp"
 #include "vision/video_tracking.hpp"
@@ -176,6 +177,15 @@ void RunTrackBenchmark(const TrackBenchmarkOptions& f, std::ostream& out) {
   // process clock (OPENCV_FFMPEG_CAPTURE_OPTIONS reaches only the demuxer in OpenCV 4.6).
   setenv("OPENCV_FFMPEG_CAPTURE_OPTIONS", "threads;1", 1);
   cv::setNumThreads(1);
+  if (f.random > 0) {
+    TrackRandomOptions random;
+    random.draws = f.random;
+    random.seed = f.seed;
+    random.cache = f.random_cache;
+    random.fresh = f.fresh;
+    random.json = f.json;
+    return RunTrackRandom(random, out);
+  }
   std::unique_ptr<TrackMatrixRecord> matrix;
   if (f.only_matrix) return RunMatrix(f, section, matrix, out);
   const fs::path cache = fs::path(f.cache) / kClipVersion;
