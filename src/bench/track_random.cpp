@@ -217,8 +217,10 @@ void RunTrackRandom(const TrackRandomOptions& o, std::ostream& out) {
     if (tty) std::fprintf(stderr, "\r%80s\r", "");
     const std::vector<ClipTruth> truth = ReadFootageTruth(d.files.truth_csv);
     const Motion motion(c.scene, c.x0, c.motion);
+    const fs::path work = root / "tracks" / d.scene.id;
+    fs::create_directories(work);
     DecodedClip clip{d.files.video, Decode(d.files.video), c.scene, c.camera, c.shutter.fps,
-                     c.shutter.readout > 0, d.files.folder};
+                     c.shutter.readout > 0, work.string()};
     d.core = ScoreOf(o.core(clip), truth, motion, c.release_time);
     d.baseline = ScoreOf(o.baseline(clip), truth, motion, c.release_time);
     if (k == 0) table.Start(out);
