@@ -1,5 +1,5 @@
 // The uncertainty of `uphill analyse-track` on footage the tracker was not tuned on: small
-// POV-Ray clips (src/vision/footage_clip.hpp) of a ball released from rest, tracked by
+// POV-Ray clips (src/footage/footage_clip.hpp) of a ball released from rest, tracked by
 // `uphill track` with the renderer's camera, analysed by `uphill analyse-track`.
 //
 // Where the truth comes from: the renderer's own parameters: the release position x0 and time t0
@@ -16,9 +16,9 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_test_support.hpp"
-#include "vision/footage_clip.hpp"
-#include "vision/footage_conditions.hpp"
-#include "vision/povray_render.hpp"
+#include "footage/footage_clip.hpp"
+#include "footage/footage_conditions.hpp"
+#include "footage/povray_render.hpp"
 
 namespace uphill::testing {
 namespace {

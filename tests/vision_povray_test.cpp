@@ -1,4 +1,4 @@
-// The POV-Ray footage generator (src/vision/footage_clip.hpp): its geometry against OpenCV, and
+// The POV-Ray footage generator (src/footage/footage_clip.hpp): its geometry against OpenCV, and
 // the user's whole path (calibrate camera -> calibrate scene -> track) on a small rendered clip.
 //
 // Where the truth comes from: POV-Ray, an independent ray tracer, renders points of known
@@ -24,12 +24,12 @@
 #include "cli_test_support.hpp"
 #include "io/csv_table.hpp"
 #include "motion/motion.hpp"
-#include "vision/footage_clip.hpp"
-#include "vision/footage_conditions.hpp"
-#include "vision/lens_remap.hpp"
-#include "vision/povray_render.hpp"
-#include "vision/povray_scene.hpp"
-#include "vision/sensor_model.hpp"
+#include "footage/footage_clip.hpp"
+#include "footage/footage_conditions.hpp"
+#include "footage/lens_remap.hpp"
+#include "footage/povray_render.hpp"
+#include "footage/povray_scene.hpp"
+#include "footage/sensor_model.hpp"
 
 namespace uphill::testing {
 namespace {
@@ -145,7 +145,7 @@ class PovrayTest : public ::testing::Test {
 // lands on cv::projectPoints' pixel (no distortion, so no remap is involved).
 // The footage cache is keyed on the generator's code, not on a version constant someone must
 // remember to bump. Truth: coreutils' sha256sum over the generator's files (the list CMake hashes,
-// UPHILL_FOOTAGE_GENERATOR_SOURCES), combined as src/vision/CMakeLists.txt states; the clip's
+// UPHILL_FOOTAGE_GENERATOR_SOURCES), combined as src/footage/CMakeLists.txt states; the clip's
 // description (hence its cache key) and the chessboard views' must carry that digest.
 TEST(FootageCache, KeyHoldsTheDigestOfTheGeneratorsCode) {
   std::string command = "for f in";
@@ -210,6 +210,69 @@ TEST_F(PovrayTest, CropWindowIsTheFullPictureRegion) {
   double largest;
   cv::minMaxLoc(diff.reshape(1), nullptr, &largest);
   EXPECT_LT(largest, 2.0 / 65535) << "the crop differs from the full picture beyond 16-bit rounding";
+  fs::remove_all(dir);
+}
+
+// Every table cover, body finish and pattern (the random benchmark draws them all) is valid
+// scene text that POV-Ray renders, and each draws what it says. Truth: POV-Ray's own pictures of
+// the same shot without the body, and with the plain body of the same finish.
+TEST_F(PovrayTest, EveryTableFinishAndPatternRenders) {
+  NamedFootage tiny = FootageByName("tiny");
+  const FootageCondition& c = tiny.condition;
+  const LensRemap lens(c.camera.camera);
+  PovrayShot shot;
+  shot.camera = {lens.pinhole(), c.camera.pose};
+  const Vector3d centre(c.x0, 0, c.scene.At(c.x0).z);
+  const Vector2d pixel = ProjectApparatusPoint(lens.pinhole(), c.camera.pose, centre);
+  const double radius = lens.pinhole().fx * c.scene.body().across / (CameraCentre(c.camera.pose) - centre).norm();
+  ASSERT_GT(radius, 8);
+  shot.crop = cv::Rect(static_cast<int>(pixel.x()) - 24, static_cast<int>(pixel.y()) - 24, 48, 48);
+  shot.bodies = {BodyPose{centre.x(), centre.z(), 0.7}, std::nullopt};
+  const cv::Point disc(static_cast<int>(pixel.x()) - shot.crop.x, static_cast<int>(pixel.y()) - shot.crop.y);
+  const cv::Rect inside(disc.x - 4, disc.y - 4, 9, 9);  // within the body's disc
+  const auto mean_difference = [&](const cv::Mat& a, const cv::Mat& b) {
+    cv::Mat diff;
+    cv::absdiff(a(inside), b(inside), diff);
+    const cv::Scalar m = cv::mean(diff);
+    return (m[0] + m[1] + m[2]) / 3;
+  };
+  struct Case {
+    TableCover table;
+    BodyFinish finish;
+    BodyPattern pattern;
+  };
+  const fs::path dir = TempDir("looks");
+  int k = 0;
+  for (const Case& look_case : {Case{TableCover::kWood, BodyFinish::kMatte, BodyPattern::kStripes},
+                                Case{TableCover::kCloth, BodyFinish::kGlossy, BodyPattern::kDots},
+                                Case{TableCover::kPaper, BodyFinish::kChrome, BodyPattern::kTwoTone},
+                                Case{TableCover::kTiles, BodyFinish::kSatin, BodyPattern::kPlain}}) {
+    SCOPED_TRACE("look " + std::to_string(k));
+    FootageLook look = c.look;
+    look.table = look_case.table;
+    look.finish = look_case.finish;
+    look.pattern = look_case.pattern;
+    look.pattern_scale = 0.4 * c.scene.body().across;
+    look.pattern_turn = Vector3d(20, 40, 60);
+    look.band_rgb = Vector3d(0.6, 0.5, 0.05);
+    look.rod_rgb = Vector3d(0.5, 0.1, 0.1);
+    look.lamps = {{Vector3d(0.2, -0.5, 0.8), 0.3}};
+    const PovrayRun run = RunPovray(PovraySceneText(c.scene, c.apparatus, look, shot), shot.crop.size(), 2,
+                                    (dir / std::to_string(k)).string());
+    ASSERT_EQ(run.pictures.size(), 2u);
+    EXPECT_TRUE(cv::checkRange(run.pictures[0]) && cv::checkRange(run.pictures[1]));
+    EXPECT_GT(mean_difference(run.pictures[0], run.pictures[1]), 0.01) << "no body drawn";
+    if (look.pattern != BodyPattern::kPlain) {
+      FootageLook plain = look;
+      plain.pattern = BodyPattern::kPlain;
+      PovrayShot one = shot;
+      one.bodies = {shot.bodies[0]};
+      const PovrayRun base = RunPovray(PovraySceneText(c.scene, c.apparatus, plain, one), one.crop.size(), 1,
+                                       (dir / (std::to_string(k) + "-plain")).string());
+      EXPECT_GT(mean_difference(run.pictures[0], base.pictures[0]), 0.005) << "the pattern is not drawn";
+    }
+    ++k;
+  }
   fs::remove_all(dir);
 }
 

@@ -1,4 +1,4 @@
-// The ball tracker on synthetic clips rendered at test time (src/vision/synthetic_clip.hpp):
+// The ball tracker on synthetic clips rendered at test time (src/footage/synthetic_clip.hpp):
 // accuracy against the exact ground truth, lost frames, partial and bad input.
 #include <gtest/gtest.h>
 
@@ -13,8 +13,8 @@
 #include <opencv2/videoio.hpp>
 
 #include "model/input_error.hpp"
+#include "footage/synthetic_clip.hpp"
 #include "vision/camera.hpp"
-#include "vision/synthetic_clip.hpp"
 #include "vision/video_tracking.hpp"
 
 namespace uphill::testing {

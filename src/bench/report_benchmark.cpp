@@ -16,7 +16,7 @@
 #include "model/input_error.hpp"
 #include "motion/motion.hpp"
 #include "vision/camera.hpp"
-#include "vision/synthetic_clip.hpp"
+#include "footage/synthetic_clip.hpp"
 
 namespace uphill::bench {
 namespace {
@@ -28,7 +28,7 @@ constexpr const char* kExperimentVersion = "v1";  // bump when the rendered expe
 
 constexpr const char* kMethod =
     "An experiment folder of format uphill-experiment/2 whose N trials are videos rendered once with exact ground "
-    "truth (src/vision/synthetic_clip.hpp, TrialClipSetup: a 2-inch ball on 8 mm rods, L = 1 m, H = 0.1 m, D from "
+    "truth (src/footage/synthetic_clip.hpp, TrialClipSetup: a 2-inch ball on 8 mm rods, L = 1 m, H = 0.1 m, D from "
     "120 to 180 mm, rolling resistance mu = 0.05; H.264, noise sigma 1): half the trials are placed just inside the "
     "far edge of the rest band and stay (Y from the video), half are released beyond it after 8 s at rest and roll "
     "up and fall off (mu from the motion). \"report\": the `uphill report EXP -o OUT` program run as a user runs "

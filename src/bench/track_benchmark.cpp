@@ -16,8 +16,9 @@
 #include "bench/results_document.hpp"
 #include "bench/support.hpp"
 #include "bench/track_matrix.hpp"
+#include "bench/track_random.hpp"
 #include "vision/ball_tracker.hpp"
-#include "vision/synthetic_clip.hpp"
+#include "footage/synthetic_clip.hpp"
 #include "vision/video_tracking.hpp"
 
 namespace uphill::bench {
@@ -126,7 +127,7 @@ struct PeerRow {
 //   720p-h264      1280×720, motion blur (1/60 s exposure, 6 sub-frames), noise σ = 2, flicker 1 %, H.264
 //   1080p-h264     1920×1080, the same degradations
 constexpr const char* kMethod =
-    "Synthetic clips with exact ground truth (src/vision/synthetic_clip.hpp): the default apparatus (a 2-inch "
+    "Synthetic clips with exact ground truth (src/footage/synthetic_clip.hpp): the default apparatus (a 2-inch "
     "ball on 8 mm rods, 1 m, side view, k1 = -0.1), 120 frames at 30 fps, at rest for 1.8 s, then rolling; "
     "720p-clean (sharp, lossless FFV1), 720p-h264 and 1080p-h264 (motion blur over 1/60 s, noise sigma 2, "
     "flicker 1 %, H.264). Speed: frames per CPU-second of the whole process (one core's work; best of 3; "
@@ -176,6 +177,15 @@ void RunTrackBenchmark(const TrackBenchmarkOptions& f, std::ostream& out) {
   // process clock (OPENCV_FFMPEG_CAPTURE_OPTIONS reaches only the demuxer in OpenCV 4.6).
   setenv("OPENCV_FFMPEG_CAPTURE_OPTIONS", "threads;1", 1);
   cv::setNumThreads(1);
+  if (f.random > 0) {
+    TrackRandomOptions random;
+    random.draws = f.random;
+    random.seed = f.seed;
+    random.cache = f.random_cache;
+    random.fresh = f.fresh;
+    random.json = f.json;
+    return RunTrackRandom(random, out);
+  }
   std::unique_ptr<TrackMatrixRecord> matrix;
   if (f.only_matrix) return RunMatrix(f, section, matrix, out);
   const fs::path cache = fs::path(f.cache) / kClipVersion;

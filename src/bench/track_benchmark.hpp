@@ -4,6 +4,8 @@
 // docs/benchmarks.md.
 #pragma once
 
+#include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -23,6 +25,11 @@ struct TrackBenchmarkOptions {
   std::vector<std::string> conditions;  // empty: the whole matrix
   std::string footage_cache;            // "": vision::FootageCacheRoot()
   std::string positions;                // "": no per-frame files (TrackMatrixOptions::positions)
+  // --random N: only the random scenes (bench/track_random.hpp), nothing recorded in the doc.
+  int random = 0;
+  std::optional<std::uint64_t> seed;    // unset: a new seed each run (printed)
+  std::string random_cache = "/tmp/uphill-bench-random";
+  std::string json;                     // --json FILE: the random scenes' results
 };
 
 void RunTrackBenchmark(const TrackBenchmarkOptions& options, std::ostream& out);

@@ -16,7 +16,7 @@
 #include "model/input_error.hpp"
 #include "vision/ball_tracker.hpp"
 #include "vision/calibration.hpp"
-#include "vision/footage_conditions.hpp"
+#include "footage/footage_conditions.hpp"
 #include "vision/video_tracking.hpp"
 
 namespace uphill::bench {
@@ -148,7 +148,7 @@ struct Run {
 }  // namespace
 
 const char* const kTrackMatrixMethod =
-    "Robustness: ray-traced clips (POV-Ray, src/vision/footage_conditions.hpp) that differ from a baseline in one "
+    "Robustness: ray-traced clips (POV-Ray, src/footage/footage_conditions.hpp) that differ from a baseline in one "
     "respect each: contrast only in colour, wood or cloth, 8 mm rods or 1 mm wires, the ball or the paper's banded "
     "spheroid, 180/360 degree shutter at 30/60 fps (blur up to 3 radii), 720p/1080p, flicker, auto-exposure drift, "
     "rolling shutter, a body leaving the frame; lens distortion, vignetting, sensor noise and H.264/H.265 at a "

@@ -1,5 +1,5 @@
 // The robustness table of `uphill bench track`: the tracker on the ray-traced footage
-// of src/vision/footage_conditions.hpp, one row per condition, against OpenCV's CSRT, KCF and
+// of src/footage/footage_conditions.hpp, one row per condition, against OpenCV's CSRT, KCF and
 // HoughCircles on the same clips (tools/bench/track_peers.py).
 //
 // Each clip goes the user's way: `calibrate camera` on its chessboard views (CalibrateCamera),

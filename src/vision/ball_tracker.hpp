@@ -116,7 +116,6 @@ struct TrackerOptions {
   std::optional<Eigen::Vector2d> init_uv;  // raw pixel near the centre in the first frame
   int rays = 64;                           // rays across the outline per frame
   double search_half_width_px = 6;         // uncertainty of the prediction along each ray
-  double min_inlier_fraction = 0.35;       // of the rays; below: not accepted
   double rail_radius = 0.003;              // m: drawn width of line rails (scene without rods)
   double min_contrast = 0.03;              // body against background, linear light (0..1 per channel)
   // The camera (settings; see "Time" above).

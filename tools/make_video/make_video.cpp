@@ -29,7 +29,7 @@
 #include "model/input_error.hpp"
 #include "vision/apparatus_points.hpp"
 #include "vision/chessboard_render.hpp"
-#include "vision/synthetic_clip.hpp"
+#include "footage/synthetic_clip.hpp"
 
 namespace {
 

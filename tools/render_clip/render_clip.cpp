@@ -1,4 +1,4 @@
-// render_clip: renders one condition of the POV-Ray test footage (src/vision/footage_clip.hpp,
+// render_clip: renders one condition of the POV-Ray test footage (src/footage/footage_clip.hpp,
 // footage_conditions.hpp) into the clip cache, or finds it there, and prints where its files are
 // and the commands of the user's path: calibrate the camera from the chessboard views, calibrate
 // the scene from the apparatus points, track.
@@ -16,7 +16,7 @@
 #include <unistd.h>
 
 #include "model/input_error.hpp"
-#include "vision/footage_conditions.hpp"
+#include "footage/footage_conditions.hpp"
 
 namespace {
 

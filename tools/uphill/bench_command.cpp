@@ -124,6 +124,15 @@ void AddTrack(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& 
   cmd->add_option("--footage-cache", o->footage_cache, "ray-traced clips (default ~/.cache/uphill/clips)");
   cmd->add_option("--positions", o->positions,
                   "folder to write each ray-traced clip's frames in, tracked against the truth (<condition>.csv)");
+  CLI::Option* random =
+      cmd->add_option("--random", o->random,
+                      "only N freshly drawn ray-traced scenes, the tracker beside the baseline (docs/bench.md)")
+          ->check(CLI::Range(1, 100000));
+  cmd->add_option("--seed", o->seed, "seed of the random scenes (default: a new one, printed)")->needs(random);
+  cmd->add_option("--random-cache", o->random_cache, "folder of the random scenes' clips (<seed>/ inside)")
+      ->capture_default_str()
+      ->needs(random);
+  cmd->add_option("--json", o->json, "file for the random scenes' results (JSON)")->needs(random);
   RunsWith(cmd, o, argv, RunTrackBenchmark);
 }
 

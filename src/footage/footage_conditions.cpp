@@ -1,4 +1,4 @@
-#include "vision/footage_conditions.hpp"
+#include "footage/footage_conditions.hpp"
 
 #include <Eigen/Geometry>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "vision/povray_render.hpp"
+#include "footage/povray_render.hpp"
 
 #include <unistd.h>
 

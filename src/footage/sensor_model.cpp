@@ -1,4 +1,4 @@
-#include "vision/sensor_model.hpp"
+#include "footage/sensor_model.hpp"
 
 #include <Random123/boxmuller.hpp>
 #include <Random123/philox.h>

@@ -1,4 +1,4 @@
-#include "vision/footage_clip.hpp"
+#include "footage/footage_clip.hpp"
 
 #include <unistd.h>
 
@@ -27,7 +27,7 @@
 #include "model/input_error.hpp"
 #include "motion/motion.hpp"
 #include "internal/content_key.hpp"
-#include "vision/lens_remap.hpp"
+#include "footage/lens_remap.hpp"
 #include "internal/footage_renderer.hpp"
 
 namespace uphill {
@@ -40,7 +40,7 @@ using ordered_json = nlohmann::ordered_json;
 using internal::FootageRenderer;
 using internal::PovrayWork;
 
-// A digest of the generator's code (src/vision/CMakeLists.txt): what the same condition's pixels
+// A digest of the generator's code (src/footage/CMakeLists.txt): what the same condition's pixels
 // and truth are depends on it, so it is part of every cache key.
 constexpr const char* kGeneratorDigest = UPHILL_FOOTAGE_GENERATOR_DIGEST;
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -147,14 +147,33 @@ ordered_json DescribeFootage(const FootageCondition& c) {
                     {"post_radius_m", a.post_radius}, {"rail_overhang_m", a.rail_overhang},
                     {"table_z_m", a.table_z},        {"wall_y_m", a.wall_y},
                     {"marks_m", a.marks}};
-  j["look"] = {{"table", c.look.table == TableCover::kWood ? "wood" : "cloth"},
-               {"body_rgb", {c.look.body_rgb.x(), c.look.body_rgb.y(), c.look.body_rgb.z()}},
-               {"band_rgb", {c.look.band_rgb.x(), c.look.band_rgb.y(), c.look.band_rgb.z()}},
+  const auto rgb = [](const Eigen::Vector3d& v) { return ordered_json::array({v.x(), v.y(), v.z()}); };
+  static const char* const kTables[] = {"wood", "cloth", "paper", "tiles"};
+  static const char* const kFinishes[] = {"satin", "matte", "glossy", "chrome"};
+  static const char* const kPatterns[] = {"plain", "two-tone", "stripes", "dots"};
+  ordered_json lamps = ordered_json::array();
+  for (const FootageLamp& lamp : c.look.lamps)
+    lamps.push_back({{"position_m", rgb(lamp.position)}, {"intensity", lamp.intensity}});
+  j["look"] = {{"table", kTables[static_cast<int>(c.look.table)]},
+               {"body_rgb", rgb(c.look.body_rgb)},
+               {"band_rgb", rgb(c.look.band_rgb)},
                {"band_half_width_m", c.look.band_half_width},
-               {"light", c.look.light}};
+               {"light", c.look.light},
+               {"finish", kFinishes[static_cast<int>(c.look.finish)]},
+               {"pattern", kPatterns[static_cast<int>(c.look.pattern)]},
+               {"pattern_scale_m", c.look.pattern_scale},
+               {"pattern_turn_deg", rgb(c.look.pattern_turn)},
+               {"rod_rgb", c.look.rod_rgb ? rgb(*c.look.rod_rgb) : ordered_json()},
+               {"lamps", lamps}};
   j["camera"] = DescribeCamera(c.camera.camera);
   j["pose"] = DescribePose(c.camera.pose);
-  j["motion"] = {{"x0_m", c.x0}, {"release_time_s", c.release_time}};
+  j["motion"] = {{"x0_m", c.x0},
+                 {"release_time_s", c.release_time},
+                 {"v0_m_per_s", c.motion.v0},
+                 {"g_m_per_s2", c.motion.g},
+                 {"mu", c.motion.mu},
+                 {"ode", c.motion.method == MotionMethod::kOde},
+                 {"tolerance", c.motion.tolerance}};
   j["frames"] = c.frames;
   j["shutter"] = {{"fps", c.shutter.fps}, {"exposure_s", c.shutter.exposure}, {"readout_s", c.shutter.readout},
                   {"t0_s", c.shutter.t0}};
@@ -306,7 +325,7 @@ FootageFiles RenderFootage(const FootageCondition& condition, const std::string&
   }
   WriteFileAtomically((partial / "points.csv").string(), points.str());
   CalibrationSummary summary;
-  summary.method = "the true camera of the POV-Ray footage (src/vision/footage_clip.hpp)";
+  summary.method = "the true camera of the POV-Ray footage (src/footage/footage_clip.hpp)";
   summary.verdict = "exact";
   summary.reasons = {"the camera that rendered the clip: no calibration error"};
   WriteCameraFile((partial / "camera_truth.json").string(), k, summary);

@@ -90,7 +90,7 @@ std::vector<Vector2d> ProjectOrOutside(const CameraIntrinsics& camera, const Cam
 }  // namespace
 
 FootageRenderer::FootageRenderer(const FootageCondition& c, const fs::path& work, const fs::path& pictures)
-    : c_(c), work_(work), pictures_(pictures), lens_(c.camera.camera), motion_(c.scene, c.x0) {
+    : c_(c), work_(work), pictures_(pictures), lens_(c.camera.camera), motion_(c.scene, c.x0, c.motion) {
   timing_ = c.shutter;
   timing_.height = c.camera.camera.height;
   vignetting_ = lens_.Vignetting(c.vignetting);
@@ -316,7 +316,8 @@ FootageRenderer::FramePlan FootageRenderer::Plan(int f) const {
     const BodyPose a = *BodyAt(ta), b = *BodyAt(tb);
     const Vector3d cc = poses_[pi].rotation * Vector3d(b.x, 0, b.z) + poses_[pi].translation;
     const double px_per_m = c_.camera.camera.fx / cc.z();
-    const double spin = c_.look.band_half_width > 0 ? a_ * px_per_m * std::abs(b.angle - a.angle) : 0;
+    const bool painted = c_.look.band_half_width > 0 || c_.look.pattern != BodyPattern::kPlain;
+    const double spin = painted ? a_ * px_per_m * std::abs(b.angle - a.angle) : 0;
     speed = std::max(speed, ((Project(b, pi) - Project(a, pi)).norm() + spin) / (tb - ta));
     shadow_speed = std::max(shadow_speed, (ShadowCentre(b, pi) - ShadowCentre(a, pi)).norm() / (tb - ta));
     const SoftBox light = FootageSoftBox(c_.apparatus);

@@ -38,7 +38,7 @@
 #include <string>
 #include <vector>
 
-#include "vision/footage_clip.hpp"
+#include "footage/footage_clip.hpp"
 
 namespace uphill {
 

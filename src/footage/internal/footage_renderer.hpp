@@ -13,11 +13,11 @@
 #include <vector>
 
 #include "motion/motion.hpp"
-#include "vision/footage_clip.hpp"
-#include "vision/lens_remap.hpp"
-#include "vision/povray_render.hpp"
-#include "vision/povray_scene.hpp"
-#include "vision/sensor_model.hpp"
+#include "footage/footage_clip.hpp"
+#include "footage/lens_remap.hpp"
+#include "footage/povray_render.hpp"
+#include "footage/povray_scene.hpp"
+#include "footage/sensor_model.hpp"
 
 namespace uphill::internal {
 

@@ -1,4 +1,4 @@
-#include "vision/lens_remap.hpp"
+#include "footage/lens_remap.hpp"
 
 #include <algorithm>
 #include <cmath>

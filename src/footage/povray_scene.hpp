@@ -6,21 +6,21 @@
 // meeting point, x along the centre line, y across, z up), in millimetres (POV-Ray's intersection tolerances are absolute,
 // ~1e-6 units: metres would bring them near the size of a pixel's footprint on a rod):
 //  - the table: the plane z = table_z as a slab, wood (POV-Ray's `wood` rings along x with
-//    turbulence, fine grain noise, a satin finish with a faint reflection) or cloth (a woven
-//    gingham: crossing stripes, a fibre bump map, matte);
+//    turbulence, fine grain noise, a satin finish with a faint reflection), cloth (a woven
+//    gingham: crossing stripes, a fibre bump map, matte), paper or tiles (TableCover);
 //  - a painted wall behind the apparatus (plane y = wall_y);
 //  - the rails: round rods whose axes are the rail lines (the Scene's rod radius: 8 mm rods, or
-//    wires of ≤ 1 mm), polished steel with mirror reflection, from O to a little beyond the
+//    wires of ≤ 1 mm), polished steel with mirror reflection (or painted: rod_rgb), from O to a little beyond the
 //    crossbar, with black tape marks at the positions of FootageApparatus::marks; the crossbar (a
 //    horizontal bar along y under the rails at x = L) on two posts standing on the table under
 //    the rails;
 //  - the body: a sphere or the spheroid (semi-axes a in x and z, b along the rolling axis y),
-//    painted plastic, optionally with a painted band: the slab |z'| < band half width of the
-//    body's own frame, which contains the rolling axis, so the band turns with the body (its inner
-//    edges move across the disc as it rolls). Placed at (x, 0, z) and turned by the rolling angle
-//    about +y (right-handed: MotionSample::angle);
+//    painted plastic (BodyFinish), optionally with a painted band: the slab |z'| < band half width
+//    of the body's own frame, which contains the rolling axis, so the band turns with the body (its
+//    inner edges move across the disc as it rolls), and a pattern (BodyPattern). Placed at
+//    (x, 0, z) and turned by the rolling angle about +y (right-handed: MotionSample::angle);
 //  - lights: a square area light (soft box, 0.5 m) 1 m above the table, which casts soft
-//    shadows beside the body, and a dim shadowless fill from the camera's side;
+//    shadows beside the body, a dim shadowless fill from the camera's side, and any lamps;
 //  - for the camera calibration: a chessboard target (white board, black squares) at a pose.
 //
 // The camera: a pinhole (POV-Ray `perspective`) whose rays are exactly those of the OpenCV
@@ -47,7 +47,27 @@
 
 namespace uphill {
 
-enum class TableCover { kWood, kCloth };
+// The table's cover: wood and cloth as above; paper (a matte off-white sheet with a faint fibre
+// mottle) and tiles (glazed ceramic squares of 100 mm with dark grout, satin, no mirror image).
+enum class TableCover { kWood, kCloth, kPaper, kTiles };
+
+// The body's finish: satin paint (the default: a soft highlight and a faint reflection), matte
+// paint, glossy lacquer (a sharp highlight, 15 % reflection) or chrome (a mirror: it shows the
+// room, its own colour hardly at all).
+enum class BodyFinish { kSatin, kMatte, kGlossy, kChrome };
+
+// A pattern in band_rgb over body_rgb, fixed to the body (it turns with it), in addition to the
+// band: two-tone (one half of the body each side of a plane through its centre), stripes
+// (parallel stripes of period pattern_scale) or dots (round spots of about pattern_scale).
+// pattern_turn turns the pattern in the body's frame (POV-Ray `rotate`, degrees about x, y, z).
+enum class BodyPattern { kPlain, kTwoTone, kStripes, kDots };
+
+// A shadowless lamp (a room's light that adds highlights and shading, but no shadow the renderer
+// would have to follow): apparatus frame, m; intensity as the scene's light scale.
+struct FootageLamp {
+  Eigen::Vector3d position;
+  double intensity = 0.3;
+};
 
 // What the apparatus and the room look like (linear reflectances, 0..1, in R, G, B order).
 struct FootageLook {
@@ -56,6 +76,12 @@ struct FootageLook {
   Eigen::Vector3d band_rgb{0.02, 0.02, 0.02};
   double band_half_width = 0;                   // m; 0: a plain body
   double light = 1;                             // scale of all lights
+  BodyFinish finish = BodyFinish::kSatin;
+  BodyPattern pattern = BodyPattern::kPlain;
+  double pattern_scale = 0;                     // m: stripe period, dot size
+  Eigen::Vector3d pattern_turn{0, 0, 0};        // degrees
+  std::optional<Eigen::Vector3d> rod_rgb;       // painted rods; unset: polished steel
+  std::vector<FootageLamp> lamps;               // besides the soft box and the fill
 };
 
 // The drawn apparatus beyond the Scene's rails and body.

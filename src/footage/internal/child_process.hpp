@@ -1,6 +1,6 @@
 // Child processes of the footage generator (povray, ffmpeg), started without a shell
 // (posix_spawnp: arguments are passed as they are, no quoting), with their output going to a log
-// file. Private to the vision layer.
+// file. Private to the footage layer.
 #pragma once
 
 #include <cstddef>

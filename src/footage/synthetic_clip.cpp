@@ -1,4 +1,4 @@
-#include "vision/synthetic_clip.hpp"
+#include "footage/synthetic_clip.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -11,7 +11,7 @@
 
 #include "io/atomic_file.hpp"
 #include "model/input_error.hpp"
-#include "vision/sensor_model.hpp"
+#include "footage/sensor_model.hpp"
 
 namespace uphill {
 namespace {

@@ -19,8 +19,9 @@
 //  4. the sensor: gain, shot and read noise (Philox, seeded), clipping, sRGB, 8 bits;
 //  5. compression: H.264, H.265 or lossless FFV1 through ffmpeg (video_encoder.hpp).
 //
-// Motion: uphill::Motion of the scene released from rest at x0 at `release_time` (at rest before
-// it), centre (x, 0, z(x)) and rolling angle about +y (povray_scene.hpp turns the body by it).
+// Motion: uphill::Motion of the scene from x0 at `release_time` (at rest before it; released from
+// rest, or pushed with FootageCondition::motion's v0, with its rolling resistance μ), centre
+// (x, 0, z(x)) and rolling angle about +y (povray_scene.hpp turns the body by it).
 // Once the motion has ended (fall-off, or the contact reaches O) the body is gone; a frame whose
 // exposure contains the end shows no body.
 //
@@ -45,7 +46,7 @@
 // Caching: a clip lives in <cache root>/<key>/ (FootageCacheRoot: ${XDG_CACHE_HOME:-~/.cache}/
 // uphill/clips), the key a 64-bit FNV-1a hash of the condition's description (DescribeFootage,
 // kept as condition.json beside the clip with the rendering time), which holds a digest of the
-// generator's own code ("generator", src/vision/CMakeLists.txt); it is written under a private
+// generator's own code ("generator", src/footage/CMakeLists.txt); it is written under a private
 // name and renamed into place when complete. RenderFootage reuses it unless asked for a fresh
 // render. POV-Ray's pictures are cached too, in <cache root>/pictures/, keyed by their scene
 // text: clips with the same camera, scene and motion (baseline, h265, flicker, ae-drift, the
@@ -59,14 +60,15 @@
 #include <vector>
 
 #include "model/scene.hpp"
+#include "motion/motion.hpp"
 #include "vision/apparatus_points.hpp"
 #include "vision/camera.hpp"
 #include "vision/chessboard_render.hpp"
-#include "vision/povray_render.hpp"
-#include "vision/povray_scene.hpp"
-#include "vision/sensor_model.hpp"
-#include "vision/synthetic_clip.hpp"
-#include "vision/video_encoder.hpp"
+#include "footage/povray_render.hpp"
+#include "footage/povray_scene.hpp"
+#include "footage/sensor_model.hpp"
+#include "footage/synthetic_clip.hpp"
+#include "footage/video_encoder.hpp"
 
 namespace uphill {
 
@@ -88,6 +90,7 @@ struct FootageCondition {
   SceneCalibration camera;        // the true camera: intrinsics with distortion, and its pose
   double x0 = 0.25;               // release position, m
   double release_time = 0.3;      // s, clip time of the release
+  MotionOptions motion;           // v0 (a push), μ (then kOde), g of the motion from x0
   int frames = 60;
   ShutterTiming shutter;          // fps, exposure, readout (height is the camera's)
   LightModel light;

@@ -1,4 +1,4 @@
-#include "vision/povray_scene.hpp"
+#include "footage/povray_scene.hpp"
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -82,6 +82,9 @@ void AppendLights(std::ostringstream& out, const FootageApparatus& apparatus, co
   // Fill light from the camera's side: lifts the shadows as the room's light does.
   const Vector3d fill = CameraCentre(shot.camera.pose) + Vector3d(0, -0.3, 0.6);
   out << "light_source { " << Vec(fill * kMm) << " color rgb " << Num(0.28 * look.light) << " shadowless }\n";
+  for (const FootageLamp& lamp : look.lamps)
+    out << "light_source { " << Vec(lamp.position * kMm) << " color rgb " << Num(lamp.intensity * look.light)
+        << " shadowless }\n";
 }
 
 void AppendRoom(std::ostringstream& out, const FootageApparatus& apparatus, const FootageLook& look) {
@@ -104,6 +107,16 @@ void AppendRoom(std::ostringstream& out, const FootageApparatus& apparatus, cons
            "  texture { pigment { granite color_map { [0 rgbt <0.2, 0.1, 0.05, 0.7>] [0.3 rgbt <0, 0, 0, 1>]"
            " [1 rgbt <0, 0, 0, 1>] }\n"
            "    scale <12, 1.2, 1.2> } finish { diffuse 0.95 } }\n";
+  } else if (look.table == TableCover::kPaper) {
+    // A sheet of matte off-white paper with a faint fibre mottle.
+    out << "  texture { pigment { bozo color_map { [0 rgb <0.70, 0.69, 0.64>] [1 rgb <0.76, 0.75, 0.71>] }"
+           " scale 3 }\n    finish { diffuse 0.95 } }\n";
+  } else if (look.table == TableCover::kTiles) {
+    // Glazed tiles of 100 mm with 3 mm dark grout, satin (no mirror image of the body).
+    out << "  texture { pigment { gradient x color_map { [0 rgb 0.12] [0.03 rgb 0.12] [0.03 rgb <0.55, 0.52, 0.46>]"
+           " [1 rgb <0.55, 0.52, 0.46>] } scale 100 }\n    finish { diffuse 0.85 specular 0.3 roughness 0.02 } }\n"
+           "  texture { pigment { gradient y color_map { [0 rgbt <0.12, 0.12, 0.12, 0>] [0.03 rgbt <0.12, 0.12, 0.12, 0>]"
+           " [0.03 rgbt 1] [1 rgbt 1] } scale 100 }\n    finish { diffuse 0.85 } }\n";
   } else {
     // A woven cloth: a soft grey-green gingham of 24 mm checks with a fibre texture, matte.
     out << "  texture {\n"
@@ -121,7 +134,8 @@ void AppendRoom(std::ostringstream& out, const FootageApparatus& apparatus, cons
   out << "}\n";
 }
 
-void AppendApparatus(std::ostringstream& out, const Scene& scene, const FootageApparatus& apparatus) {
+void AppendApparatus(std::ostringstream& out, const Scene& scene, const FootageApparatus& apparatus,
+                     const FootageLook& look) {
   const double T = scene.rails().tan_half_alpha, B = scene.rails().tan_theta;
   const double r = scene.rod_radius() * kMm;
   const double x_end = apparatus.crossbar_x + apparatus.rail_overhang;
@@ -129,9 +143,14 @@ void AppendApparatus(std::ostringstream& out, const Scene& scene, const FootageA
          "  finish { diffuse 0.3 specular 0.7 roughness 0.004 metallic brilliance 2"
          " reflection { 0.55 metallic } } }\n"
          "#declare Tape = texture { pigment { rgb 0.025 } finish { diffuse 1 specular 0.1 roughness 0.05 } }\n";
+  if (look.rod_rgb)
+    out << "#declare Rod = texture { pigment { " << Rgb(*look.rod_rgb)
+        << " } finish { diffuse 0.9 specular 0.3 roughness 0.02 } }\n";
+  else
+    out << "#declare Rod = texture { Steel }\n";
   for (int side : {-1, 1}) {
     const Vector3d end(x_end, side * x_end * T, x_end * B);
-    out << "cylinder { <0, 0, 0>, " << Vec(end * kMm) << ", " << Num(r) << " texture { Steel } }\n";
+    out << "cylinder { <0, 0, 0>, " << Vec(end * kMm) << ", " << Num(r) << " texture { Rod } }\n";
     const Vector3d e = end.normalized();
     for (double m : apparatus.marks) {
       if (m <= 0 || m >= apparatus.crossbar_x) continue;
@@ -157,6 +176,41 @@ void AppendApparatus(std::ostringstream& out, const Scene& scene, const FootageA
   }
 }
 
+std::string FinishText(BodyFinish finish) {
+  switch (finish) {
+    case BodyFinish::kMatte: return "finish { diffuse 0.95 }";
+    case BodyFinish::kGlossy: return "finish { diffuse 0.8 specular 0.9 roughness 0.002 reflection 0.15 }";
+    case BodyFinish::kChrome: return "finish { diffuse 0.04 specular 0.9 roughness 0.001 metallic reflection { 0.85 metallic } }";
+    case BodyFinish::kSatin: break;
+  }
+  return "finish { diffuse 0.92 specular 0.35 roughness 0.012 reflection 0.035 }";
+}
+
+// The pattern as a second texture layer over the body's: band_rgb where the pattern is, clear
+// elsewhere (in the unit sphere's frame, scaled with the body: lengths over a).
+void AppendPattern(std::ostringstream& out, const FootageLook& look, double a_mm) {
+  if (look.pattern == BodyPattern::kPlain) return;
+  const std::string on = "rgbt <" + Num(look.band_rgb.x()) + ", " + Num(look.band_rgb.y()) + ", " +
+                         Num(look.band_rgb.z()) + ", 0>";
+  const double scale = std::max(1e-3, look.pattern_scale * kMm / a_mm);
+  out << "  texture {\n    pigment { ";
+  switch (look.pattern) {
+    case BodyPattern::kTwoTone:
+      out << "function { z > 0 } color_map { [0 rgbt 1] [0.5 rgbt 1] [0.5 " << on << "] [1 " << on << "] }";
+      break;
+    case BodyPattern::kStripes:
+      out << "gradient z color_map { [0 " << on << "] [0.5 " << on << "] [0.5 rgbt 1] [1 rgbt 1] } scale "
+          << Num(scale);
+      break;
+    case BodyPattern::kDots:
+      out << "leopard color_map { [0 rgbt 1] [0.55 rgbt 1] [0.55 " << on << "] [1 " << on << "] } scale "
+          << Num(scale / 3.14159265358979);
+      break;
+    case BodyPattern::kPlain: break;
+  }
+  out << "\n      rotate " << Vec(look.pattern_turn) << " }\n    " << FinishText(look.finish) << " }\n";
+}
+
 void AppendBody(std::ostringstream& out, const Scene& scene, const FootageLook& look, const BodyPose& pose) {
   const double a = scene.body().across * kMm, b = scene.body().along * kMm;
   const Matrix3d turn = Eigen::AngleAxisd(pose.angle, Vector3d::UnitY()).toRotationMatrix();
@@ -170,8 +224,9 @@ void AppendBody(std::ostringstream& out, const Scene& scene, const FootageLook& 
   } else {
     out << "    pigment { " << Rgb(look.body_rgb) << " }\n";
   }
-  out << "    finish { diffuse 0.92 specular 0.35 roughness 0.012 reflection 0.035 } }\n"
-      << "  scale <" << Num(a) << ", " << Num(b) << ", " << Num(a) << ">\n  "
+  out << "    " << FinishText(look.finish) << " }\n";
+  AppendPattern(out, look, a);
+  out << "  scale <" << Num(a) << ", " << Num(b) << ", " << Num(a) << ">\n  "
       << PovMatrix(turn, Vector3d(pose.x, 0, pose.z) * kMm) << "\n}\n";
 }
 
@@ -200,7 +255,7 @@ void CheckShot(const PovrayShot& shot) {
 }
 
 const char* kPreamble =
-    "// uphill footage: the rolling-uphill apparatus (src/vision/povray_scene.hpp). Units: mm.\n"
+    "// uphill footage: the rolling-uphill apparatus (src/footage/povray_scene.hpp). Units: mm.\n"
     "#version 3.7;\n"
     "global_settings { assumed_gamma 1.0 max_trace_level 6 adc_bailout 0.002 }\n"
     "#default { finish { ambient 0 diffuse 1 } }\n";
@@ -240,7 +295,7 @@ std::string PovraySceneText(const Scene& scene, const FootageApparatus& apparatu
   AppendCamera(out, shot);
   AppendLights(out, apparatus, look, shot);
   AppendRoom(out, apparatus, look);
-  AppendApparatus(out, scene, apparatus);
+  AppendApparatus(out, scene, apparatus, look);
   if (shot.board) AppendBoard(out, shot, *shot.board);
   // One body pose per animation frame (frame_number counts from 1; a single picture is no
   // animation and has its body, if any, unconditionally).

@@ -1,4 +1,4 @@
-#include "vision/video_encoder.hpp"
+#include "footage/video_encoder.hpp"
 
 #include <cmath>
 #include <filesystem>
