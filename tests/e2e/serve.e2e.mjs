@@ -194,6 +194,7 @@ try {
   await pasteAndImport();
   await videoTrialWaitsForItsSetting();
   await uncertaintiesAndMotionFit();
+  await layoutDetails();
   await assertFits('every section');
   await shot('4-paste-import.png');
   assert.deepEqual(problems, []);
@@ -295,6 +296,21 @@ try {
     const experiment = JSON.parse(fs.readFileSync(path.join(dir, 'experiment.json'), 'utf8'));
     assert.equal(experiment.uncertainties, undefined);
     assert.deepEqual(experiment.video_analysis, { fit: 'mu' });
+  }
+
+  // Item 12's details: "Square (mm)" on one line, not "( / mm / )"; file sizes in the units that
+  // fit them (a 15 kB clip is not "0.0 MiB").
+  async function layoutDetails() {
+    await page.click('#camera-details summary');
+    const lines = await page.$eval('#cam-square', (input) => {
+      const span = input.closest('label').querySelector('span');
+      return span.getBoundingClientRect().height / parseFloat(getComputedStyle(span).lineHeight);
+    });
+    assert.ok(lines < 1.5, `"Square (mm)" takes ${lines.toFixed(1)} lines`);
+    assert.equal(await page.textContent('#cam-square >> xpath=..'), 'Square (mm) ');
+    assert.deepEqual(await page.evaluate(() => [812, 9500, 15360, 3.2e6, 2.5e9].map(formatBytes)),
+      ['812 B', '9.5 kB', '15 kB', '3.2 MB', '2.50 GB']);
+    await page.click('#camera-details summary');
   }
 } catch (e) {
   failed = true;
