@@ -30,6 +30,8 @@ try {
   const assertFits = async (what) => {
     const width = await page.evaluate(() => document.documentElement.scrollWidth);
     assert.ok(width <= 1280, `${what}: the page is ${width} px wide in a 1280 px window`);
+    const table = await page.$eval('.table-wrap', (w) => [w.scrollWidth, w.clientWidth]);
+    assert.ok(table[0] <= table[1], `${what}: the table needs ${table[0]} px of its ${table[1]} (columns cut off)`);
   };
   const shot = async (name) => { if (shots) await page.screenshot({ path: path.join(shots, name), fullPage: true }); };
 
