@@ -2,7 +2,8 @@
 // playwright-core; never `npx playwright install`). Started by run.sh, which runs the server:
 //   UPHILL_URL        the page, e.g. http://127.0.0.1:40123/
 //   UPHILL_EXP_DIR    the (new, empty) experiment folder the server writes
-//   UPHILL_E2E_SCREENSHOTS  optional folder for screenshots (empty, rows and flags, plot)
+//   UPHILL_E2E_SCREENSHOTS  optional folder for screenshots (the form, empty, rows and flags, plot,
+//                           paste and import, a conflict)
 // A technician creates an experiment (the form's errors come all at once, named as labelled), types
 // rows with the keyboard, sees X before Y and the flags and the plot update, deletes and undoes,
 // reloads and finds the rows; a second tab's edit meets a conflict and keeps what it typed; rows
@@ -227,6 +228,8 @@ try {
     assert.equal(await tabB.textContent('#body tr.editing .theirs'), 'saved: 281');
     assert.doesNotMatch(await tabB.textContent('#status'), /Saved/);
     assert.equal(await tabB.textContent('#conflict-mine'), 'Re-apply my 282');
+    await tabB.waitForFunction(() => document.querySelector('#body tr.editing td.computed-residual').textContent === '-107.8');
+    if (shots) await tabB.locator('#rows-section').screenshot({ path: path.join(shots, '5-conflict.png') });
     await tabB.click('#conflict-mine');
     await tabB.waitForFunction(() => !document.querySelector('#body tr.editing') &&
       document.querySelector('#body tr:nth-child(4) td:nth-child(6)')?.textContent === '282');

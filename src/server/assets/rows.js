@@ -22,6 +22,8 @@ function editConflict(id, mine) {
   editingId = conflict.theirs ? id : null;
   renderRows();
   renderConflict();
+  const tr = $('body').querySelector('tr.editing');
+  if (tr) scheduleCheck(tr);  // the computed cells of what is typed, not of the saved row
 }
 
 function clearConflict() {
