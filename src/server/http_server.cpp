@@ -253,38 +253,7 @@ struct Server::Impl {
       Mutate(req, res, [this](const json& b) { return store.Undo(VersionOf(b)); });
     });
     http.Post("/api/check", [this](const httplib::Request& req, httplib::Response& res) {
-      try {
-        const json body = ParseBody(req);
-        const StoreSnapshot s = store.Get();
-        const json row_json = body.value("row", json::object());
-        Row row;
-        ordered_json out = {{"complete", true}};
-        try {
-          row = ValidateRow(row_json, s.state);
-        } catch (const InputError& e) {
-          // A draft that is not yet complete: {complete: false, error, field}; with its setting
-          // complete (Y not typed yet) also its check, so the page shows X where to look.
-          out = {{"complete", false}, {"error", e.what()}, {"field", e.quantity()}};
-          try {
-            row = ValidateRow(row_json, s.state, RowStage::kDraft);
-          } catch (const InputError&) {
-            SendJson(res, 200, out);
-            return;
-          }
-        }
-        row.id = row_json.is_object() && row_json.contains("id") && row_json.at("id").is_number_integer()
-                     ? row_json.at("id").get<std::int64_t>()
-                     : 0;
-        const ordered_json check = ToJson(CheckDraft(s.state, row), s.state.unit);
-        for (const auto& [k, v] : check.items()) out[k] = v;
-        SendJson(res, 200, out);
-      } catch (const InputError& e) {
-        SendError(res, 422, e.what(), e.quantity());
-      } catch (const json::exception& e) {
-        SendError(res, 400, std::string("malformed JSON: ") + e.what());
-      } catch (const std::invalid_argument& e) {
-        SendError(res, 400, e.what());
-      }
+      Respond(req, res, [this](const json& b) { return CheckAnswer(store.Get().state, b.value("row", json::object())); });
     });
     http.Post("/api/report", [this](const httplib::Request&, httplib::Response& res) {
       std::lock_guard lock(report_mutex);  // one report at a time; the store stays free meanwhile

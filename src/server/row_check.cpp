@@ -105,6 +105,27 @@ RowCheck CheckDraft(const ExperimentState& state, const Row& row) {
   return check;
 }
 
+ordered_json CheckAnswer(const ExperimentState& state, const json& row_json) {
+  Row row;
+  ordered_json out = {{"complete", true}};
+  try {
+    row = ValidateRow(row_json, state);
+  } catch (const InputError& e) {
+    out = {{"complete", false}, {"error", e.what()}, {"field", e.quantity()}};
+    try {
+      row = ValidateRow(row_json, state, RowStage::kDraft);
+    } catch (const InputError&) {
+      return out;
+    }
+  }
+  row.id = row_json.is_object() && row_json.contains("id") && row_json.at("id").is_number_integer()
+               ? row_json.at("id").get<std::int64_t>()
+               : 0;
+  const ordered_json check = ToJson(CheckDraft(state, row), state.unit);
+  for (const auto& [k, v] : check.items()) out[k] = v;
+  return out;
+}
+
 ordered_json ToJson(const RowCheck& check, const std::string& unit) { return RowCheckJson(check, unit); }
 
 ordered_json CheckAll(const ExperimentState& state) {

@@ -37,6 +37,12 @@ RowCheck CheckRow(const ExperimentState& state, const Row& row);
 // before Y is measured. Nothing of Y is judged then (y, residual and Y's flags are absent).
 RowCheck CheckDraft(const ExperimentState& state, const Row& row);
 
+// The answer of POST /api/check for a row as the page sends it (`id` when editing):
+// {"complete": true, ...ToJson(check)} for a row that could be saved; {"complete": false,
+// "error", "field"} for one that could not (the first rule it breaks), with its CheckDraft's
+// fields too when only Y is missing. Never throws for what the row holds.
+nlohmann::ordered_json CheckAnswer(const ExperimentState& state, const nlohmann::json& row_json);
+
 // RowCheckJson (app/row_check.hpp) in the experiment's unit.
 nlohmann::ordered_json ToJson(const RowCheck& check, const std::string& unit);
 
