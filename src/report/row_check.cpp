@@ -171,6 +171,10 @@ void Model(const ExperimentRow& row, RowCheck& check) {
 
 // The checks of Y against the model: mix-up with X, below X, far from X, beyond the fall-off.
 void CheckY(const std::string& unit, const std::string& y_unit, std::set<std::string>& mixed, RowCheck& check) {
+  const bool setting_suspect = std::any_of(check.flags.begin(), check.flags.end(), [](const RowFlag& f) {
+    return (f.code == "unit_mixup" || f.code == "implausible") && (f.field == "L" || f.field == "H" || f.field == "D");
+  });
+  if (setting_suspect) return;  // X and x_max rest on the suspect cell (header)
   if (check.x_eq) {
     const double residual = *check.y - *check.x_eq;
     const double u = std::hypot(check.u_x_eq.value_or(0), check.u_y.value_or(0));

@@ -43,6 +43,9 @@
 //                      the Monte Carlo (UncertaintyDisagreement below); the page's check is first
 //                      order only.
 // A mix-up in Y explains a Y far from or below X, so y_below_x and y_far are not raised with it.
+// A setting flagged as mistyped (unit_mixup or implausible on L, H or D) makes X and x_max wrong
+// as well: Y is then not judged against them (no Y flag but its own range), so the flag names the
+// one cell to fix and not also the correct Y.
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -14,10 +14,37 @@
 #include "io/units.hpp"
 #include "io/utf8.hpp"
 #include "model/input_error.hpp"
+#include "internal/state_text.hpp"
 
 namespace uphill {
+
+namespace internal {
+
+// The page shows text only via textContent anyway; the rule is for the files' readers.
+std::string CheckText(const nlohmann::json& j, const std::string& field, std::size_t max_length) {
+  if (!j.is_string()) throw InputError(field, "must be a string");
+  const std::string s = j.get<std::string>();
+  if (InvalidUtf8At(s) != std::string_view::npos)
+    throw InputError(field, "is not valid UTF-8 text (byte " + std::to_string(InvalidUtf8At(s) + 1) + ")");
+  if (s.size() > max_length)
+    throw InputError(field, "is longer than " + std::to_string(max_length) + " characters");
+  for (unsigned char c : s)
+    if (c < 0x20 || c == 0x7f) throw InputError(field, "must not contain control characters (e.g. a line break)");
+  return s;
+}
+
+std::string Trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
+}
+
+}  // namespace internal
+
 namespace {
 
+using internal::CheckText;
+using internal::Trim;
 using nlohmann::json;
 using nlohmann::ordered_json;
 
@@ -37,28 +64,6 @@ ordered_json Canonical(const json& j) {
   return out;
 }
 
-bool IsAngle(const std::string& key) { return key == "theta" || key == "alpha"; }
-
-// Text fit for a CSV cell and an HTML page: bounded, no control characters (a newline in a label
-// would split a CSV row for a careless reader; the page shows text only via textContent anyway).
-std::string CheckText(const json& j, const std::string& field, std::size_t max_length) {
-  if (!j.is_string()) throw InputError(field, "must be a string");
-  const std::string s = j.get<std::string>();
-  if (InvalidUtf8At(s) != std::string_view::npos)
-    throw InputError(field, "is not valid UTF-8 text (byte " + std::to_string(InvalidUtf8At(s) + 1) + ")");
-  if (s.size() > max_length)
-    throw InputError(field, "is longer than " + std::to_string(max_length) + " characters");
-  for (unsigned char c : s)
-    if (c < 0x20 || c == 0x7f) throw InputError(field, "must not contain control characters (e.g. a line break)");
-  return s;
-}
-
-std::string Trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
-
 // A plain decimal number (what a technician types into a field whose unit the page shows).
 std::string CheckNumber(const json& j, const std::string& field) {
   if (j.is_number()) {
@@ -76,11 +81,6 @@ std::string CheckNumber(const json& j, const std::string& field) {
       s.find_first_of("nNiI") != std::string::npos)
     throw InputError(field, "must be a plain number in the experiment's unit (got \"" + s + "\")");
   return s;
-}
-
-void CheckQuantity(const json& j, const std::string& field, Dimension dimension) {
-  const std::string s = CheckText(j, field, 64);
-  ParseQuantity(s, dimension, field);  // throws InputError naming the field
 }
 
 // RFC 4180: quote a field that holds a separator, a quote or surrounding spaces.
@@ -146,8 +146,9 @@ std::vector<std::string> ExperimentState::Columns() const {
 
 std::vector<std::string> ExperimentState::RequiredQuantities(const Row* row) const {
   std::vector<std::string> out;
+  if (row && !row->video.empty()) return out;
   for (const std::string& c : Columns())
-    if (c.rfind("u_", 0) != 0 && !(c == "Y" && row && !row->video.empty())) out.push_back(c);
+    if (c.rfind("u_", 0) != 0) out.push_back(c);
   return out;
 }
 
@@ -254,7 +255,7 @@ void ValidateUnit(const std::string& unit) {
     throw InputError("unit", "must be mm, cm, m or in (got \"" + unit.substr(0, 16) + "\")");
 }
 
-Row ValidateRow(const json& j, const ExperimentState& state) {
+Row ValidateRow(const json& j, const ExperimentState& state, RowStage stage) {
   if (!j.is_object()) throw InputError("row", "must be a JSON object");
   Row r;
   std::set<std::string> allowed = {"id", "trial", "series", "note", "video", "scene", "excluded"};
@@ -281,115 +282,25 @@ Row ValidateRow(const json& j, const ExperimentState& state) {
     if (!v.empty()) r.values[q] = v;
   }
   for (const std::string& q : state.RequiredQuantities(&r))
-    if (r.Value(q).empty()) throw InputError("row." + q, "is missing (a number in " + state.unit + ")");
+    if (r.Value(q).empty() && !(q == "Y" && stage == RowStage::kDraft))
+      throw InputError("row." + q, "is missing (a number in " + state.unit + ")");
   return r;
 }
 
-ordered_json ValidateMetadata(const json& j) {
-  if (!j.is_object()) throw InputError("experiment", "must be a JSON object");
-  for (const auto& [key, value] : j.items())
-    if (!ExperimentKeys().count(key))
-      throw InputError("experiment." + key.substr(0, 32), "unknown key");
-  ordered_json out;
-  out["format"] = kExperimentFormat;
-  if (j.contains("format") && j.at("format") != kExperimentFormat && j.at("format") != kExperimentFormat2)
-    throw InputError("experiment.format", std::string("must be \"") + kExperimentFormat + "\" or \"" +
-                                              kExperimentFormat2 + "\"");
-  for (const char* key : {"title", "operator", "date"})
-    if (j.contains(key)) {
-      const std::string s = CheckText(j.at(key), std::string("experiment.") + key, kMaxNoteLength);
-      if (!s.empty()) out[key] = s;
+std::vector<Row> ValidateRows(const json& j, const ExperimentState& state) {
+  if (!j.is_array() || j.empty()) throw InputError("rows", "must be a non-empty list of rows");
+  if (state.rows.size() + j.size() > kMaxRows)
+    throw InputError("rows", "at most " + std::to_string(kMaxRows) + " rows per experiment");
+  std::vector<Row> rows;
+  std::vector<InputError> refused;
+  for (std::size_t i = 0; i < j.size(); ++i) try {
+      rows.push_back(ValidateRow(j[i], state));
+    } catch (const InputError& e) {
+      const std::string field = e.quantity().rfind("row.", 0) == 0 ? e.quantity().substr(4) : e.quantity();
+      refused.emplace_back("rows[" + std::to_string(i) + "]." + field, e.rule());
     }
-  if (j.contains("notes")) {
-    const json& notes = j.at("notes");
-    if (notes.is_string()) {
-      if (!notes.get<std::string>().empty()) out["notes"] = CheckText(notes, "experiment.notes", kMaxNoteLength);
-    } else if (notes.is_array()) {
-      if (notes.size() > 50) throw InputError("experiment.notes", "has more than 50 paragraphs");
-      ordered_json list = ordered_json::array();
-      for (const json& p : notes) {
-        const std::string s = CheckText(p, "experiment.notes", kMaxNoteLength);
-        if (!s.empty()) list.push_back(s);
-      }
-      if (!list.empty()) out["notes"] = list;
-    } else {
-      throw InputError("experiment.notes", "must be a string or a list of strings");
-    }
-  }
-  if (!j.contains("body") || !j.at("body").is_object()) throw InputError("experiment.body", "is missing");
-  const json& body = j.at("body");
-  ordered_json out_body;
-  for (const auto& [key, value] : body.items())
-    if (!BodyKeys().count(key)) throw InputError("experiment.body." + key.substr(0, 32), "unknown key");
-  const std::string type = CheckText(body.value("type", json("")), "experiment.body.type", 32);
-  if (type != "sphere" && type != "spheroid" && type != "double-cone")
-    throw InputError("experiment.body.type", "must be sphere, spheroid or double-cone");
-  out_body["type"] = type;
-  const std::vector<std::string> dims = type == "sphere" ? std::vector<std::string>{"R"}
-                                        : type == "spheroid" ? std::vector<std::string>{"a", "b"}
-                                                             : std::vector<std::string>{"R", "h"};
-  for (const auto& [key, value] : body.items()) {
-    if (key == "type") continue;
-    if (std::find(dims.begin(), dims.end(), key) == dims.end())
-      throw InputError("experiment.body." + key, "does not belong to a " + type);
-  }
-  for (const std::string& d : dims) {
-    if (!body.contains(d)) throw InputError("experiment.body." + d, "is missing (a length with its unit, e.g. \"12.7 mm\")");
-    CheckQuantity(body.at(d), "experiment.body." + d, Dimension::kLength);
-    if (!(ParseQuantity(body.at(d).get<std::string>(), Dimension::kLength, d) > 0))
-      throw InputError("experiment.body." + d, "must be > 0");
-    out_body[d] = Trim(body.at(d).get<std::string>());
-  }
-  out["body"] = out_body;
-  for (const char* section : {"apparatus", "uncertainties"}) {
-    if (!j.contains(section)) continue;
-    const json& s = j.at(section);
-    if (!s.is_object()) throw InputError(std::string("experiment.") + section, "must be a JSON object");
-    const auto& keys = std::string(section) == "apparatus" ? ApparatusKeys() : UncertaintyKeys();
-    ordered_json o = ordered_json::object();
-    for (const auto& [key, value] : s.items()) {
-      const std::string field = std::string("experiment.") + section + "." + key.substr(0, 32);
-      if (!keys.count(key)) throw InputError(field, "unknown key");
-      if (value.is_string() && Trim(value.get<std::string>()).empty()) continue;  // left blank
-      if (key == "L_convention") {
-        const std::string c = CheckText(value, field, 32);
-        if (c != "horizontal" && c != "along-rail") throw InputError(field, "must be horizontal or along-rail");
-        o[key] = c;
-      } else {
-        CheckQuantity(value, field, IsAngle(key) ? Dimension::kAngle : Dimension::kLength);
-        const double v = ParseQuantity(value.get<std::string>(), IsAngle(key) ? Dimension::kAngle
-                                                                                  : Dimension::kLength, field);
-        if (v < 0) throw InputError(field, "must be >= 0");
-        o[key] = Trim(value.get<std::string>());
-      }
-    }
-    if (!o.empty()) out[section] = o;
-  }
-  if (j.contains("camera")) {
-    CheckRelativePath(j.at("camera").is_string() ? j.at("camera").get<std::string>() : "", "experiment.camera");
-    out["camera"] = j.at("camera");
-  }
-  if (j.contains("scenes")) {
-    const json& scenes = j.at("scenes");
-    if (!scenes.is_object()) throw InputError("experiment.scenes", "must be a JSON object (name -> scene file)");
-    if (scenes.size() > 100) throw InputError("experiment.scenes", "has more than 100 scenes");
-    ordered_json o = ordered_json::object();
-    for (const auto& [name, path] : scenes.items()) {
-      const std::string field = "experiment.scenes." + name.substr(0, 32);
-      CheckText(json(name), field, kMaxLabelLength);
-      if (name.empty()) throw InputError("experiment.scenes", "a scene's name is empty");
-      CheckRelativePath(path.is_string() ? path.get<std::string>() : "", field);
-      o[name] = path;
-    }
-    if (!o.empty()) out["scenes"] = o;
-  }
-  if (j.contains("video_analysis")) {
-    const json& v = j.at("video_analysis");
-    if (!v.is_object() || v.size() > 16) throw InputError("experiment.video_analysis", "must be a JSON object");
-    for (const auto& [key, value] : v.items()) CheckText(value, "experiment.video_analysis." + key.substr(0, 32), 64);
-    out["video_analysis"] = v;
-  }
-  return out;
+  if (!refused.empty()) throw FieldErrors(std::move(refused));
+  return rows;
 }
 
 namespace {
@@ -486,6 +397,19 @@ json ApplyOperation(ExperimentState& state, const json& op) {
     }
     state.metadata = Canonical(meta);
     return inverse;
+  }
+  if (type == "batch") {
+    const json& ops = op.at("ops");
+    if (!ops.is_array()) throw InputError("batch", "ops must be a list");
+    ExperimentState next = state;  // all or nothing
+    json inverses = json::array();
+    for (const json& o : ops) {
+      if (o.at("type") == "snapshot" || o.at("type") == "meta" || o.at("type") == "batch")
+        throw InputError("batch", "holds row and file changes only");
+      inverses.insert(inverses.begin(), ApplyOperation(next, o));
+    }
+    state = std::move(next);
+    return {{"type", "batch"}, {"ops", inverses}};
   }
   if (type == "delete") {
     const std::int64_t id = op.at("id").get<std::int64_t>();

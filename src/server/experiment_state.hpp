@@ -11,6 +11,8 @@
 //   {"type":"meta","experiment":{...},"unit":"mm"}     replace experiment.json and the unit
 //   {"type":"put","row":{...},"index":i}               insert (new id) or replace (same id) a row
 //   {"type":"delete","id":n}                           remove a row
+//   {"type":"batch","ops":[op,...]}                    the operations in order, as one change
+//                                                      (rows pasted or imported: one undo)
 //   {"type":"file","role":"scene"|"camera","name":s,"path":p,"content":text|null}
 //                                                      a calibration file of the folder (format
 //                                                      uphill-experiment/2): its text, and its
@@ -28,6 +30,7 @@
 
 #include "io/csv_table.hpp"
 #include "io/experiment_folder.hpp"
+#include "model/input_error.hpp"
 
 namespace uphill {
 
@@ -75,8 +78,9 @@ struct ExperimentState {
   // The measured quantities that are columns (vary per row): L, H, D unless experiment.json's
   // apparatus gives them (or gives θ/α), then Y; then the u_ columns some row uses.
   std::vector<std::string> Columns() const;
-  // The quantities a row must give: Columns() without the u_ ones (and without Y for a row with
-  // a video: Y then comes from the video's rest position).
+  // The quantities a row must give: Columns() without the u_ ones. A row with a video must give
+  // none: its Y comes from the video's rest position, and a trial created from its recording
+  // has no setting yet (the row check flags the empty cells until the technician types them).
   std::vector<std::string> RequiredQuantities(const Row* row = nullptr) const;
   // Index into rows, or -1.
   int IndexOf(std::int64_t id) const;
@@ -90,13 +94,34 @@ nlohmann::ordered_json ToJson(const Row& row);
 nlohmann::ordered_json ToJson(const ExperimentState& state);
 ExperimentState StateFromJson(const nlohmann::json& json);  // of a snapshot; throws InputError
 
+// Several rule violations of one request at once (a form's every wrong field, an import's every
+// refused row), so the page can name and highlight them all: `errors` holds each (field, rule);
+// what() and quantity() are the first one's.
+class FieldErrors : public InputError {
+ public:
+  explicit FieldErrors(std::vector<InputError> errors);
+  const std::vector<InputError>& errors() const { return errors_; }
+
+ private:
+  std::vector<InputError> errors_;
+};
+
+// Whether a row is one to save, or a draft being typed (the page shows X as soon as the setting
+// is complete, before Y is typed).
+enum class RowStage { kSaved, kDraft };
+
 // A row from a request: checks types, lengths, control characters, that every value is a plain
-// finite decimal number, and that the quantities the experiment needs are there. The id is not
-// read. Throws InputError("row.<field>", rule).
-Row ValidateRow(const nlohmann::json& json, const ExperimentState& state);
+// finite decimal number, and that the quantities the experiment needs are there (a draft may
+// leave Y empty). The id is not read. Throws InputError("row.<field>", rule).
+Row ValidateRow(const nlohmann::json& json, const ExperimentState& state, RowStage stage = RowStage::kSaved);
+
+// Rows from a request (pasted or imported): each validated as ValidateRow does. Throws
+// FieldErrors naming every refused row and its field ("rows[3].D"), so nothing is half-added.
+std::vector<Row> ValidateRows(const nlohmann::json& json, const ExperimentState& state);
 
 // experiment.json from a request: known keys only (as LoadExperiment), strings with units
-// that parse, a body type, lengths and counts bounded. Sets "format". Throws InputError.
+// that parse, a body type, lengths and counts bounded. Sets "format". Throws InputError, or
+// FieldErrors when several fields are wrong (every one is named, not just the first).
 nlohmann::ordered_json ValidateMetadata(const nlohmann::json& json);
 // "mm", "cm", "m" or "in". Throws InputError otherwise.
 void ValidateUnit(const std::string& unit);

@@ -444,6 +444,19 @@ StoreSnapshot ExperimentStore::AddRow(std::int64_t version, const json& row, std
   return Commit(op, false);
 }
 
+StoreSnapshot ExperimentStore::AddRows(std::int64_t version, const json& rows) {
+  std::lock_guard lock(mutex_);
+  CheckVersion(version);
+  if (!state_.exists) throw InputError("experiment", "does not exist yet: create it first");
+  json ops = json::array();
+  std::int64_t id = state_.next_id;
+  for (Row& r : ValidateRows(rows, state_)) {
+    r.id = id++;
+    ops.push_back({{"type", "put"}, {"row", ToJson(r)}});
+  }
+  return Commit({{"type", "batch"}, {"ops", ops}}, false);
+}
+
 StoreSnapshot ExperimentStore::EditRow(std::int64_t version, std::int64_t id, const json& row) {
   std::lock_guard lock(mutex_);
   CheckVersion(version);

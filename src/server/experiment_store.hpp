@@ -110,6 +110,9 @@ class ExperimentStore {
   StoreSnapshot SetMetadata(std::int64_t version, const nlohmann::json& experiment, const std::string& unit);
   // index: position among the rows (default: at the end).
   StoreSnapshot AddRow(std::int64_t version, const nlohmann::json& row, std::optional<std::int64_t> index = {});
+  // Rows pasted or imported, after the others, as one change (one undo removes them all). Every
+  // row is validated first: FieldErrors names each refused one, and then none is added.
+  StoreSnapshot AddRows(std::int64_t version, const nlohmann::json& rows);
   StoreSnapshot EditRow(std::int64_t version, std::int64_t id, const nlohmann::json& row);
   StoreSnapshot DeleteRow(std::int64_t version, std::int64_t id);
   StoreSnapshot Undo(std::int64_t version);

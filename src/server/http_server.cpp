@@ -63,6 +63,14 @@ constexpr const char* kVideoUploadPattern = R"(/api/videos/([^/]{1,120}))";
 constexpr const char* kViewUploadPattern = R"(/api/views/([^/]{1,120}))";
 
 
+// Every field a request got wrong: {"error", "field"} of the first (as SendError) and
+// "errors": [{"field", "error"}] of them all, so the page names and highlights each.
+void SendFieldErrors(httplib::Response& res, const FieldErrors& e) {
+  ordered_json body = {{"error", e.what()}, {"field", e.quantity()}, {"errors", ordered_json::array()}};
+  for (const InputError& one : e.errors()) body["errors"].push_back({{"field", one.quantity()}, {"error", one.rule()}});
+  SendJson(res, 422, body);
+}
+
 std::string Seconds(std::chrono::milliseconds t) {
   std::ostringstream out;
   out << t.count() / 1000.0 << " s";
@@ -181,6 +189,8 @@ struct Server::Impl {
       }
     } catch (const VersionConflict& e) {
       SendJson(res, 409, {{"error", e.what()}, {"state", StateJson(e.current())}});
+    } catch (const FieldErrors& e) {
+      SendFieldErrors(res, e);
     } catch (const InputError& e) {
       SendError(res, 422, e.what(), e.quantity());
     } catch (const json::exception& e) {
@@ -226,6 +236,9 @@ struct Server::Impl {
         return store.AddRow(version, b.value("row", json::object()), index);
       });
     });
+    http.Post("/api/rows/import", [this](const httplib::Request& req, httplib::Response& res) {
+      Mutate(req, res, [this](const json& b) { return store.AddRows(VersionOf(b), b.value("rows", json())); });
+    });
     http.Put(R"(/api/rows/(\d{1,12}))", [this](const httplib::Request& req, httplib::Response& res) {
       Mutate(req, res, [this, &req](const json& b) {
         return store.EditRow(VersionOf(b), std::stoll(req.matches[1].str()), b.value("row", json::object()));
@@ -240,33 +253,7 @@ struct Server::Impl {
       Mutate(req, res, [this](const json& b) { return store.Undo(VersionOf(b)); });
     });
     http.Post("/api/check", [this](const httplib::Request& req, httplib::Response& res) {
-      try {
-        const json body = ParseBody(req);
-        const StoreSnapshot s = store.Get();
-        const json row_json = body.value("row", json::object());
-        Row row;
-        try {
-          row = ValidateRow(row_json, s.state);
-        } catch (const InputError& e) {
-          // A draft that is not yet complete is still checked as far as it goes.
-          ordered_json out = {{"complete", false}, {"error", e.what()}, {"field", e.quantity()}};
-          SendJson(res, 200, out);
-          return;
-        }
-        row.id = row_json.is_object() && row_json.contains("id") && row_json.at("id").is_number_integer()
-                     ? row_json.at("id").get<std::int64_t>()
-                     : 0;
-        ordered_json out = {{"complete", true}};
-        const ordered_json check = ToJson(CheckRow(s.state, row), s.state.unit);
-        for (const auto& [k, v] : check.items()) out[k] = v;
-        SendJson(res, 200, out);
-      } catch (const InputError& e) {
-        SendError(res, 422, e.what(), e.quantity());
-      } catch (const json::exception& e) {
-        SendError(res, 400, std::string("malformed JSON: ") + e.what());
-      } catch (const std::invalid_argument& e) {
-        SendError(res, 400, e.what());
-      }
+      Respond(req, res, [this](const json& b) { return CheckAnswer(store.Get().state, b.value("row", json::object())); });
     });
     http.Post("/api/report", [this](const httplib::Request&, httplib::Response& res) {
       std::lock_guard lock(report_mutex);  // one report at a time; the store stays free meanwhile

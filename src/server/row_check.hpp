@@ -32,6 +32,18 @@ Experiment StateExperiment(const ExperimentState& state);
 // the others (a new row). Never throws for bad input: that becomes an `invalid` flag.
 RowCheck CheckRow(const ExperimentState& state, const Row& row);
 
+// A row being typed: CheckRow, and for a row whose setting is complete but whose Y is not typed
+// yet (and that has no video to give it), the setting's part of the check — θ, α, X ± u(X),
+// x_max, the crossbar and the flags of L, H, D — so the page shows X, where to look for the body,
+// before Y is measured. Nothing of Y is judged then (y, residual and Y's flags are absent).
+RowCheck CheckDraft(const ExperimentState& state, const Row& row);
+
+// The answer of POST /api/check for a row as the page sends it (`id` when editing):
+// {"complete": true, ...ToJson(check)} for a row that could be saved; {"complete": false,
+// "error", "field"} for one that could not (the first rule it breaks), with its CheckDraft's
+// fields too when only Y is missing. Never throws for what the row holds.
+nlohmann::ordered_json CheckAnswer(const ExperimentState& state, const nlohmann::json& row_json);
+
 // RowCheckJson (app/row_check.hpp) in the experiment's unit.
 nlohmann::ordered_json ToJson(const RowCheck& check, const std::string& unit);
 

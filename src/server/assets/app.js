@@ -27,6 +27,9 @@ const el = (tag, props = {}, text) => {
   return e;
 };
 const fmt = (v, d) => (v === null || v === undefined || !isFinite(v)) ? '' : Number(v).toFixed(d);
+// A file's size as people read it: 812 B, 45 kB, 3.2 MB (powers of 1000, as file managers show).
+const formatBytes = (n) => n < 1000 ? `${n} B` : n < 1e6 ? `${(n / 1e3).toFixed(n < 1e4 ? 1 : 0)} kB`
+  : n < 1e9 ? `${(n / 1e6).toFixed(1)} MB` : `${(n / 1e9).toFixed(2)} GB`;
 const lengthDecimals = () => DECIMALS[S ? S.unit : 'mm'] ?? 2;
 const rowColumns = () => (S ? S.columns.filter((c) => !c.startsWith('u_')) : ['L', 'D', 'Y']);
 
@@ -79,13 +82,13 @@ async function change(method, path, body) {
     if (status === 200) { applyState(data); savedStatus(); return data; }
     if (status === 409) {
       applyState(data.state);
-      savedStatus();
+      setStatus('Not saved: the experiment changed meanwhile (another tab or person)', 'error');
       showMessage(data.error, 'error');
       return { conflict: true };
     }
     setStatus('Not saved: ' + (data.error || 'HTTP ' + status), 'error');
-    showMessage(data.error || 'HTTP ' + status, 'error');
-    return { error: data.error, field: data.field };
+    if (!data.errors || data.errors.length < 2) showMessage(data.error || 'HTTP ' + status, 'error');
+    return { error: data.error, field: data.field, errors: data.errors || [] };
   } finally {
     busy = false;
   }
@@ -103,7 +106,8 @@ async function poll() {
   if (!S || busy || editingId !== null || document.hidden) return;
   try {
     const { status, data } = await api('GET', '/api/state');
-    if (status === 200 && data.version !== S.version) { applyState(data); savedStatus(); }
+    // Only a newer state: an answer that left before this page's own change arrives after it.
+    if (status === 200 && data.version > S.version && !busy && editingId === null) { applyState(data); savedStatus(); }
   } catch (e) { /* status already says so */ }
 }
 
@@ -166,13 +170,50 @@ function fillExperimentForm() {
   for (const [k, id] of Object.entries(UNCERTAINTIES)) $(id).value = u[k] || '';
   $('f-unit').value = S.unit || 'mm';
   $('f-unit').disabled = S.rows.length > 0;
+  $('f-fit').value = (e.video_analysis || {}).fit === 'mu' ? 'mu' : 'g';
   showBodyFields();
+  showFormErrors([]);
   formDirty = false;
 }
 
 function showBodyFields() {
   const type = $('f-body').value;
   for (const label of document.querySelectorAll('[data-body]')) label.hidden = !label.dataset.body.split(' ').includes(type);
+  $('f-R-name').textContent = type === 'double-cone' ? 'cone radius R' : 'ball radius R';
+}
+
+// ---- the form's errors: all at once, each named as its label says and its field highlighted -----
+function formFieldIds() {
+  const ids = { 'experiment.notes': 'f-notes', 'experiment.body': 'f-body', 'experiment.body.type': 'f-body',
+    'experiment.apparatus.L_convention': 'f-conv', 'experiment.video_analysis.fit': 'f-fit', unit: 'f-unit' };
+  for (const [k, id] of Object.entries(FORM)) ids['experiment.' + k] = id;
+  for (const [k, id] of Object.entries(BODY_DIMS)) ids['experiment.body.' + k] = id;
+  for (const [k, id] of Object.entries(APPARATUS)) ids['experiment.apparatus.' + k] = id;
+  for (const [k, id] of Object.entries(UNCERTAINTIES)) ids['experiment.uncertainties.' + k] = id;
+  return ids;
+}
+
+// The words of a field's label, without its input ("ball radius R", "Square (mm)").
+function labelText(input) {
+  const label = input.closest('label');
+  if (!label) return input.name || input.id;
+  const copy = label.cloneNode(true);
+  for (const c of copy.querySelectorAll('input, select, textarea')) c.remove();
+  return copy.textContent.replace(/\s+/g, ' ').trim();
+}
+
+function showFormErrors(errors) {
+  const list = $('experiment-error');
+  list.replaceChildren();
+  for (const f of $('experiment-form').querySelectorAll('.field-error')) f.classList.remove('field-error');
+  const ids = formFieldIds();
+  let first = null;
+  for (const e of errors) {
+    const input = ids[e.field] ? $(ids[e.field]) : null;
+    if (input) { input.classList.add('field-error'); first = first || input; }
+    list.append(el('li', { class: 'error' }, `${input ? labelText(input) : e.field}: ${e.error}`));
+  }
+  if (first) first.focus();
 }
 
 function experimentFromForm() {
@@ -193,15 +234,22 @@ function experimentFromForm() {
   for (const [k, id] of Object.entries(UNCERTAINTIES)) if ($(id).value.trim()) e.uncertainties[k] = $(id).value.trim();
   // The calibration files and video options are set by the video section: kept as they are.
   for (const k of ['camera', 'scenes', 'video_analysis']) if (S.experiment[k] !== undefined) e[k] = S.experiment[k];
+  // What the motion fit measures, from the form (video_analysis.fit; "g" is the default).
+  const analysis = Object.assign({}, e.video_analysis || {});
+  if ($('f-fit').value === 'mu') analysis.fit = 'mu'; else delete analysis.fit;
+  if (Object.keys(analysis).length) e.video_analysis = analysis; else delete e.video_analysis;
   return e;
 }
 
 async function saveExperiment(event) {
   event.preventDefault();
-  $('experiment-error').textContent = '';
+  showFormErrors([]);
   const wasNew = !S.exists;
   const result = await change('PUT', '/api/experiment', { experiment: experimentFromForm(), unit: $('f-unit').value });
-  if (result && result.error) { $('experiment-error').textContent = result.error; return; }
+  if (result && result.error) {
+    showFormErrors(result.errors.length ? result.errors : [{ field: result.field || '', error: result.error }]);
+    return;
+  }
   if (result && !result.conflict) {
     formDirty = false;
     fillExperimentForm();
@@ -218,7 +266,7 @@ function renderHead() {
   head.append(el('th', { class: 'num' }, '#'), el('th', {}, 'trial'), el('th', {}, 'series'));
   for (const q of rowColumns()) head.append(el('th', { class: 'num' }, `${q} (${u})`));
   head.append(el('th', {}, 'note'), el('th', { class: 'num' }, 'θ (°)'), el('th', { class: 'num' }, 'α (°)'),
-    el('th', { class: 'num' }, `X ± u(X) (${u})`), el('th', { class: 'num' }, `Y − X (${u})`),
+    el('th', { class: 'num' }, `X${S && S.rows.some((r) => r.check && r.check.u_x > 0) ? ' ± u(X)' : ''} (${u})`), el('th', { class: 'num' }, `Y − X (${u})`),
     el('th', {}, 'flags'), el('th', {}, 'fit'), el('th', {}, ''));
 }
 
@@ -226,7 +274,8 @@ function computedCells(tr, check) {
   const d = lengthDecimals();
   const c = check || {};
   tr.append(el('td', { class: 'num' }, fmt(c.theta_deg, 3)), el('td', { class: 'num' }, fmt(c.alpha_deg, 3)));
-  const x = c.x === null || c.x === undefined ? '' : `${fmt(c.x, d)} ± ${fmt(c.u_x, d + 1)}`;
+  // Without any uncertainty set, X is exact for the page: shown without "± 0".
+  const x = c.x === null || c.x === undefined ? '' : c.u_x > 0 ? `${fmt(c.x, d)} ± ${fmt(c.u_x, d + 1)}` : fmt(c.x, d);
   tr.append(el('td', { class: 'num computed-x' }, x), el('td', { class: 'num computed-residual' }, fmt(c.residual, d)));
   const flags = el('td', { class: 'flags' });
   for (const f of (c.flags || [])) {
@@ -248,13 +297,22 @@ function fieldClass(check, field) {
 
 function renderRows() {
   const body = $('body');
+  // What is typed in the row being edited survives a re-render (a new state, a conflict).
+  const editing = body.querySelector('tr.editing');
+  const typed = editing && Number(editing.dataset.id) === editingId ? rowFromInputs(editing) : null;
   body.replaceChildren();
   if (!S) return;
   S.rows.forEach((row, i) => {
-    if (row.id === editingId) { body.append(inputRow(row, 'edit')); return; }
+    if (row.id === editingId) {
+      const tr = inputRow(typed ? Object.assign({ check: row.check }, typed) : row, 'edit');
+      tr.dataset.id = String(row.id);
+      if (typeof markTheirs === 'function') markTheirs(tr, row);  // rows.js: a conflict's values
+      body.append(tr);
+      return;
+    }
     const tr = el('tr', { tabindex: '0', dataset: { id: String(row.id) } });
     tr.append(el('td', { class: 'num muted' }, i + 1), el('td', {}, row.trial), el('td', {}, row.series));
-    for (const q of rowColumns()) tr.append(el('td', { class: 'num ' + fieldClass(row.check, q) }, row[q] ?? ''));
+    for (const q of rowColumns()) tr.append(valueCell(row, q));
     tr.append(el('td', { class: 'note' }, row.note));
     computedCells(tr, row.check);
     tr.append(typeof excludedCell === 'function' ? excludedCell(row) : el('td'));  // fit_toggle.js
@@ -275,6 +333,15 @@ function renderRows() {
     });
     body.append(tr);
   });
+}
+
+// A saved value; an empty one is asked for (a trial created from its video has no setting yet),
+// except a Y that the row's video gives: such a row is fitted once its Y comes from the video.
+function valueCell(row, q) {
+  const v = row[q] ?? '';
+  if (v !== '') return el('td', { class: 'num ' + fieldClass(row.check, q) }, v);
+  if (q === 'Y' && row.video) return el('td', { class: 'num muted', title: 'Y comes from the video: Track, then accept the rest position' }, 'from video');
+  return el('td', { class: 'num field-error missing', title: `${q} is missing: Edit the row (Enter) and type it` }, `${q}?`);
 }
 
 // A row of inputs: the entry row at the bottom (kind 'new') or a row being edited ('edit').
@@ -382,8 +449,9 @@ async function checkRow(tr) {
   const list = $('entry-flags');
   list.replaceChildren();
   const data = answer.data || {};
+  // A draft whose setting is complete has its check (X, where to look) before Y is typed.
   let check = null;
-  if (answer.status === 200 && data.complete) check = data;
+  if (answer.status === 200 && (data.complete || (data.x !== undefined && data.x !== null))) check = data;
   // Refresh the computed cells of this row.
   const cells = [...tr.children];
   const computedStart = 3 + rowColumns().length + 1;
@@ -395,10 +463,10 @@ async function checkRow(tr) {
     const cls = fieldClass(check, inp.name);
     if (cls) inp.classList.add(cls);
   }
-  if (check) {
-    for (const f of check.flags) list.append(el('li', { class: f.severity === 'error' ? 'error' : '' }, f.message));
-  } else if (data.error && Object.values(row).some((v) => v && v !== row.trial && v !== row.id)) {
-    list.append(el('li', { class: 'info' }, 'Not complete yet: ' + data.error));
+  if (check) for (const f of check.flags) list.append(el('li', { class: f.severity === 'error' ? 'error' : '' }, f.message));
+  if (!data.complete && data.error && Object.values(row).some((v) => v && v !== row.trial && v !== row.id)) {
+    list.append(el('li', { class: 'info' }, (check ? `X = ${fmt(check.x, lengthDecimals())} ${S.unit}: look for the body there. ` : '') +
+      'Not complete yet: ' + data.error));
   }
   tr.dataset.checked = String(seq);
   renderPlot(check);
@@ -413,7 +481,7 @@ async function submitRow(tr) {
     delete row.id;
     const result = await change('PUT', `/api/rows/${id}`, { row });
     if (result && !result.error && !result.conflict) { editingId = null; renderRows(); focusRow(id); }
-    else if (result && result.conflict) { editingId = null; renderRows(); }
+    else if (result && result.conflict) editConflict(id, row);  // rows.js: kept, with theirs beside it
     return;
   }
   delete row.id;
@@ -448,6 +516,7 @@ function startEdit(id) {
 function cancelEdit() {
   const id = editingId;
   editingId = null;
+  if (typeof clearConflict === 'function') clearConflict();
   renderRows();
   focusRow(id);
 }
@@ -468,91 +537,6 @@ async function undo() {
   editingId = null;
   const result = await change('POST', '/api/undo', {});
   if (result && !result.error && !result.conflict) showMessage('Undone', 'info');
-}
-
-// ---- plot: Y against X, the fit line and y = x, drawn as SVG by hand (works offline) --------------
-const SVG = 'http://www.w3.org/2000/svg';
-const svg = (tag, attrs = {}, text) => {
-  const e = document.createElementNS(SVG, tag);
-  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, String(v));
-  if (text !== undefined) e.textContent = text;
-  return e;
-};
-
-function niceTicks(lo, hi, count) {
-  const span = hi - lo;
-  const step0 = span / Math.max(count, 1);
-  const mag = Math.pow(10, Math.floor(Math.log10(step0)));
-  const step = [1, 2, 2.5, 5, 10].map((m) => m * mag).find((s) => span / s <= count) || 10 * mag;
-  const ticks = [];
-  for (let t = Math.ceil(lo / step) * step, i = 0; t <= hi + step * 1e-9 && i < 50; t += step, i++) ticks.push(Number(t.toPrecision(12)));
-  return ticks;
-}
-
-let lastDraftCheck = null;
-function renderPlot(draftCheck) {
-  if (draftCheck !== undefined) lastDraftCheck = draftCheck;
-  const plot = $('plot');
-  plot.replaceChildren();
-  if (!S) return;
-  const W = 640, H = 420, m = { l: 64, r: 16, t: 16, b: 48 };
-  const pts = S.rows.filter((r) => r.check && r.check.x !== null && r.check.y !== null)
-    .map((r) => ({ x: r.check.x, y: r.check.y, u: r.check.u_x, flagged: r.check.flags.length > 0, label: r.trial, excluded: !!r.excluded }));
-  const draft = lastDraftCheck && lastDraftCheck.x !== null && lastDraftCheck.y !== null ? lastDraftCheck : null;
-  const all = pts.concat(draft ? [{ x: draft.x, y: draft.y }] : []);
-  if (all.length === 0) {
-    plot.append(svg('text', { x: W / 2, y: H / 2, 'text-anchor': 'middle', class: 'empty' }, 'No rows with X and Y yet'));
-    return;
-  }
-  let lo = Math.min(...all.map((p) => Math.min(p.x, p.y))), hi = Math.max(...all.map((p) => Math.max(p.x, p.y)));
-  if (!(hi > lo)) { lo -= 1; hi += 1; }
-  const pad = (hi - lo) * 0.08;
-  lo -= pad; hi += pad;
-  const sx = (x) => m.l + (x - lo) / (hi - lo) * (W - m.l - m.r);
-  const sy = (y) => H - m.b - (y - lo) / (hi - lo) * (H - m.t - m.b);
-  const d = lengthDecimals();
-  for (const t of niceTicks(lo, hi, 8)) {
-    plot.append(svg('line', { x1: sx(t), x2: sx(t), y1: m.t, y2: H - m.b, class: 'grid' }));
-    plot.append(svg('line', { x1: m.l, x2: W - m.r, y1: sy(t), y2: sy(t), class: 'grid' }));
-    plot.append(svg('text', { x: sx(t), y: H - m.b + 16, 'text-anchor': 'middle', class: 'tick' }, String(t)));
-    plot.append(svg('text', { x: m.l - 6, y: sy(t) + 4, 'text-anchor': 'end', class: 'tick' }, String(t)));
-  }
-  plot.append(svg('line', { x1: m.l, x2: W - m.r, y1: H - m.b, y2: H - m.b, class: 'axis' }));
-  plot.append(svg('line', { x1: m.l, x2: m.l, y1: m.t, y2: H - m.b, class: 'axis' }));
-  plot.append(svg('text', { x: (W + m.l) / 2, y: H - 10, 'text-anchor': 'middle', class: 'label' }, `X, predicted equilibrium (${S.unit})`));
-  plot.append(svg('text', { x: 16, y: (H - m.b) / 2, 'text-anchor': 'middle', class: 'label', transform: `rotate(-90 16 ${(H - m.b) / 2})` }, `Y, measured (${S.unit})`));
-  const clip = svg('clipPath', { id: 'plot-area' });
-  clip.append(svg('rect', { x: m.l, y: m.t, width: W - m.l - m.r, height: H - m.t - m.b }));
-  plot.append(clip);
-  const area = svg('g', { 'clip-path': 'url(#plot-area)' });
-  plot.append(area);
-  area.append(svg('line', { x1: sx(lo), y1: sy(lo), x2: sx(hi), y2: sy(hi), class: 'diag' }));
-  if (S.fit && S.fit.slope !== undefined) {
-    const k = S.fit.slope, c = S.fit.intercept;
-    area.append(svg('line', { x1: sx(lo), y1: sy(k * lo + c), x2: sx(hi), y2: sy(k * hi + c), class: 'fit' }));
-  }
-  for (const p of pts) {
-    if (p.u > 0) area.append(svg('line', { x1: sx(p.x - p.u), x2: sx(p.x + p.u), y1: sy(p.y), y2: sy(p.y), class: 'errbar' }));
-    const dot = svg('circle', { cx: sx(p.x), cy: sy(p.y), r: 4.5, class: 'point' + (p.flagged ? ' flagged' : '') + (p.excluded ? ' excluded' : '') });
-    if (p.excluded) { dot.style.fill = 'none'; dot.style.stroke = '#999'; }  // hollow grey: shown, not fitted
-    dot.append(svg('title', {}, `${p.label}: X = ${fmt(p.x, d)}, Y = ${fmt(p.y, d)}${p.excluded ? ' (excluded from the fit)' : ''}`));
-    area.append(dot);
-  }
-  if (draft) area.append(svg('circle', { cx: sx(draft.x), cy: sy(draft.y), r: 6, class: 'point draft' }));
-}
-
-function renderFit() {
-  const dl = $('fit');
-  dl.replaceChildren();
-  if (!S) return;
-  const f = S.fit || {}, d = lengthDecimals();
-  const add = (k, v) => dl.append(el('dt', {}, k), el('dd', {}, v));
-  add('rows used', String(f.n ?? 0) + (f.excluded ? ` (${f.excluded} excluded)` : ''));
-  if (f.unavailable) { add('fit', f.unavailable.replace(/^fit: /, '')); return; }
-  add('slope k', `${fmt(f.slope, 4)} ± ${f.u_slope === null ? '—' : fmt(f.u_slope, 4)}`);
-  add(`intercept c (${S.unit})`, `${fmt(f.intercept, d)} ± ${f.u_intercept === null ? '—' : fmt(f.u_intercept, d)}`);
-  add('R²', fmt(f.r_squared, 5));
-  add(`residual SD (${S.unit})`, f.residual_sd === null ? '—' : fmt(f.residual_sd, d + 1));
 }
 
 function renderReport() {

@@ -70,7 +70,7 @@ async function loadVideoList(select) {
   if (status !== 200) return;
   const list = $('v-file');
   list.replaceChildren(el('option', { value: '' }, data.videos.length ? '— pick a video —' : '— no videos in the folder —'));
-  for (const v of data.videos) list.append(el('option', { value: v.path }, `${v.path} (${(v.bytes / 1048576).toFixed(1)} MiB)`));
+  for (const v of data.videos) list.append(el('option', { value: v.path }, `${v.path} (${formatBytes(v.bytes)})`));
   if (select) list.value = select;
 }
 
