@@ -322,6 +322,9 @@ struct Server::Impl {
     http.Get("/api/videos", [this](const httplib::Request& req, httplib::Response& res) {
       Respond(req, res, [this](const json&) { return internal::ListVideos(store); });
     });
+    http.Get("/api/video/info", [this](const httplib::Request& req, httplib::Response& res) {
+      Respond(req, res, [this, &req](const json&) { return internal::VideoInfo(store, req.get_param_value("video")); });
+    });
     http.Get("/api/video/frame", [this](const httplib::Request& req, httplib::Response& res) {
       try {
         const int frame = req.has_param("frame")
@@ -369,6 +372,13 @@ struct Server::Impl {
         std::string text;
         internal::SolveScene(store, store.Get(), b, &text);
         return store.SaveCalibrationFile(version, "scene", name, path, text);
+      });
+    });
+    http.Get(R"(/api/scenes/([^/]{1,64}))", [this](const httplib::Request& req, httplib::Response& res) {
+      Respond(req, res, [this, &req](const json&) {
+        const std::string name = req.matches[1].str();
+        internal::SceneFilePath(name);  // the name's rule
+        return internal::SavedScene(store.Get(), name);
       });
     });
     http.Post("/api/camera/calibrate", [this](const httplib::Request& req, httplib::Response& res) {
@@ -424,6 +434,32 @@ struct Server::Impl {
           row["video"] = video;
         }
         return add ? store.AddRow(version, row) : store.EditRow(version, id, row);
+      });
+    });
+    // Detaching: the row's video cell cleared (journaled), then the file set aside out of the
+    // folder's video list (internal/track_api.hpp) unless another trial names it.
+    http.Post(R"(/api/rows/(\d{1,12})/detach)", [this](const httplib::Request& req, httplib::Response& res) {
+      Respond(req, res, [this, &req](const json& b) {
+        const std::int64_t version = VersionOf(b);
+        const std::int64_t id = std::stoll(req.matches[1].str());
+        const StoreSnapshot s = store.Get();
+        const int index = s.state.IndexOf(id);
+        if (index < 0) throw InputError("row", "row " + std::to_string(id) + " does not exist");
+        const std::string video = s.state.rows[index].video;
+        if (video.empty()) throw InputError("video", "trial " + s.state.rows[index].trial + " has no video to detach");
+        ordered_json row = ToJson(s.state.rows[index]);
+        row.erase("video");
+        if (!row.contains("Y") || row.at("Y") == "")
+          throw InputError("video", "trial " + s.state.rows[index].trial +
+                                        " has no Y: without its video it would measure nothing (type its Y first, or "
+                                        "delete the trial)");
+        const StoreSnapshot after = store.EditRow(version, id, row);
+        std::string moved_to;
+        {
+          std::lock_guard lock(report_mutex);  // not while a track reads it
+          moved_to = internal::SetDetachedVideoAside(store, after, video);
+        }
+        return ordered_json{{"video", video}, {"moved_to", moved_to}, {"state", StateJson(after)}};
       });
     });
     http.Put(kVideoUploadPattern, [this](const httplib::Request& req, httplib::Response& res,

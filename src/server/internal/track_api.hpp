@@ -26,4 +26,15 @@ struct RestAsY {
 };
 RestAsY RowRestAsY(const ExperimentStore& store, const StoreSnapshot& snapshot, std::int64_t id);
 
+// The folder where detached videos are kept: hidden, so that GET /api/videos (which skips folders
+// starting with '.') no longer lists them, and no video of the experiment is ever deleted.
+inline constexpr const char* kDetachedVideoFolder = ".detached";
+
+// After POST /api/rows/<id>/detach has cleared the row's video cell: moves the file `video` into
+// kDetachedVideoFolder (as its file name, "-2", "-3"... before the extension when taken) unless a
+// row of `after` (the state with the cell cleared) still names it. Returns the file's new path
+// in the folder, or "" when it was left in place (still used, or already gone). Throws
+// EnvironmentError when the move fails (the row is then detached, the file still listed).
+std::string SetDetachedVideoAside(const ExperimentStore& store, const StoreSnapshot& after, const std::string& video);
+
 }  // namespace uphill::internal
