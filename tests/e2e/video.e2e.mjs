@@ -3,7 +3,10 @@
 // technician, in the page alone: creates the experiment, uploads chessboard photos and calibrates
 // the camera from them, uploads a trial's recording, clicks the calibration points on a
 // frame, saves the scene, tracks the video, accepts the rest position as Y, opens the report,
-// reloads and finds all of it again.
+// reloads and finds all of it again. Then, outside the counted steps (issue 32): a fresh browser
+// restores the clicks, marks and table height from the scene file; the frame names the points and
+// the left rail (+y); the scrubber and play/pause move through the clip; O clicked 5 px off is
+// the point the leave-one-out check names; the video is detached and leaves the folder's list.
 //
 // Truth: tools/make_video's clip of its default apparatus (sphere R = 25.4 mm, 8 mm rods,
 // L = 1000 mm, H = 100 mm, D = 150 mm; table 30 mm below O), its exact camera (cam.json) and pose
