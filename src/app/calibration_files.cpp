@@ -130,8 +130,10 @@ std::string SceneCalibrationText(const SceneCalibrationResult& r, const std::str
   for (const auto& p : r.residuals) out << "    " << p.label << ": " << Fixed(p.error_px, 3) << " px\n";
   if (const auto& check = r.leave_one_out)
     out << "  leave-one-out: without " << check->label << " the RMS error is " << Fixed(check->rms_without_px, 3)
-        << " px (the largest drop); it lies " << Fixed(check->residual_px, 2)
-        << " px from where the other points place it" << (check->explains ? ": check this point" : "") << "\n";
+        << " px (the largest drop); it lies "
+        << (std::isfinite(check->residual_px) ? Fixed(check->residual_px, 2) + " px from where the other points place it"
+                                              : "behind the camera in the pose the other points give")
+        << (check->explains ? ": check this point" : "") << "\n";
   Verdict(out, r.verdict, r.reasons);
   return out.str();
 }

@@ -373,6 +373,11 @@ SceneCalibrationResult CalibrateScene(const CameraIntrinsics& camera, const std:
       w.rms_px = std::sqrt(sum / static_cast<double>(points.size() - 1));
       without[i] = w;
     }
+  // How far a point lies from where the others place it, in words (behind the camera: no pixel).
+  const auto from_others = [](double px) -> std::string {
+    return std::isfinite(px) ? Fixed(px, 1) + " px from where the other points place it"
+                             : "behind the camera in the pose the other points give";
+  };
   // The point whose removal leaves the smallest RMS error (the largest drop).
   std::optional<size_t> lowest;
   for (size_t i = 0; i < points.size(); ++i)
@@ -385,8 +390,8 @@ SceneCalibrationResult CalibrateScene(const CameraIntrinsics& camera, const std:
     if ((result.scene.pose.rotation * points[i].position + result.scene.pose.translation).z() <= 0) {
       if (lowest && without[*lowest]->residual_px > kLeaveOneOutMinResidualPx)
         throw InputError(points[*lowest].label,
-                         "does not fit the other points (" + Fixed(without[*lowest]->residual_px, 1) +
-                             " px from where they place it), and with it " + points[i].label +
+                         "does not fit the other points (it lies " + from_others(without[*lowest]->residual_px) +
+                             "), and with it " + points[i].label +
                              " would lie behind the camera: check this point's pixel and position");
       throw InputError(points[i].label, "lies behind the camera in the best-fitting pose: the points and pixels disagree");
     }
@@ -412,8 +417,7 @@ SceneCalibrationResult CalibrateScene(const CameraIntrinsics& camera, const std:
     LeaveOneOutCheck& check = *result.leave_one_out;
     check.explains = check.residual_px > kLeaveOneOutMinResidualPx && check.rms_without_px <= 0.5 * result.rms_px;
     if (check.explains)
-      why.push_back(check.label + ": " + Fixed(check.residual_px, 1) +
-                    " px from where the other points place it; without it the RMS error falls from " +
+      why.push_back(check.label + ": " + from_others(check.residual_px) + "; without it the RMS error falls from " +
                     Fixed(result.rms_px, 2) + " to " + Fixed(check.rms_without_px, 2) + " px (check this point)");
     else if (result.rms_px > 2)
       why.push_back("no single point explains the error: without any one of them the RMS error stays at " +

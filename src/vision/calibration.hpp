@@ -122,6 +122,7 @@ struct LeaveOneOutCheck {
   size_t index = 0;           // into the points given
   std::string label;
   double residual_px = 0;     // its distance from where the pose fitted without it places it
+                              // (infinity: that pose puts it behind the camera)
   double rms_without_px = 0;  // RMS error of the other points about that pose
   bool explains = false;      // see above
 };
