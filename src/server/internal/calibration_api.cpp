@@ -132,6 +132,23 @@ ordered_json VideoInfo(const ExperimentStore& store, const std::string& video) {
   return {{"video", video}, {"width", probe.width}, {"height", probe.height}, {"fps", probe.fps}, {"frames", probe.frames}};
 }
 
+void CheckSceneFits(const StoreSnapshot& s, std::string scene, const std::string& video, const VideoProbe& probe) {
+  const ordered_json& meta = s.state.metadata;
+  if (!meta.is_object() || !meta.contains("scenes")) return;
+  if (scene.empty() && meta.at("scenes").size() == 1) scene = meta.at("scenes").begin().key();
+  if (scene.empty() || !meta.at("scenes").contains(scene)) return;
+  const std::string path = meta.at("scenes").at(scene).get<std::string>();
+  const auto it = s.state.files.find(path);
+  if (it == s.state.files.end()) return;
+  const SceneCalibration calibration = ParseSceneFile(path, it->second);
+  if (calibration.camera.width != probe.width || calibration.camera.height != probe.height)
+    throw InputError("video", video + " is " + std::to_string(probe.width) + "×" + std::to_string(probe.height) +
+                                " px but the scene file " + path + " (scene \"" + scene + "\") is for " +
+                                std::to_string(calibration.camera.width) + "×" +
+                                std::to_string(calibration.camera.height) +
+                                " px: calibrate a scene for this video's camera setting");
+}
+
 ordered_json ListVideos(const ExperimentStore& store) {
   ordered_json videos = ordered_json::array();
   const ContainedDirectory* folder = store.folder();
@@ -269,6 +286,7 @@ ImageSize ProbeImage(const std::string& path, const std::string& name) {
 }
 
 ordered_json SavedScene(const StoreSnapshot& snapshot, const std::string& name) {
+  SceneFilePath(name);  // the name's rule
   const std::string& unit = snapshot.state.unit;
   const ordered_json& meta = snapshot.state.metadata;
   if (!meta.is_object() || !meta.contains("scenes") || !meta.at("scenes").contains(name))

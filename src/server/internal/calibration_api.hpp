@@ -28,6 +28,11 @@ EncodedFrame VideoFrame(const ExperimentStore& store, const std::string& video, 
 // (app/video_frames.hpp ProbeVideo), for the page's player. Throws ProbeVideo's InputError.
 nlohmann::ordered_json VideoInfo(const ExperimentStore& store, const std::string& video);
 
+// A scene file that does not fit the video's size is refused when the video is attached (the
+// track would be wrong everywhere): the row's `scene`, or the experiment's only scene. Throws
+// InputError("video") naming both sizes, the scene and its file.
+void CheckSceneFits(const StoreSnapshot& snapshot, std::string scene, const std::string& video, const VideoProbe& probe);
+
 // GET /api/videos: {videos:[{path, bytes}]} the video files in the folder (by extension, at most
 // 3 folders deep, links not followed), sorted.
 nlohmann::ordered_json ListVideos(const ExperimentStore& store);
@@ -49,7 +54,8 @@ nlohmann::ordered_json SolveScene(const ExperimentStore& store, const StoreSnaps
 // GET /api/scenes/NAME: what the saved scene `name` was solved from, for the page to restore:
 // {name, path, points:[{name,u,v,x,y,z}], marks:[x...], table_z (null: not kept), unit}; a scene
 // file that keeps none of it gives empty lists. Throws InputError("name") when the experiment
-// has no such scene or its file is not there, the file's own InputError when it is malformed.
+// has no such scene, its name breaks SceneFilePath's rule or its file is not there; the file's own
+// InputError when it is malformed.
 nlohmann::ordered_json SavedScene(const StoreSnapshot& snapshot, const std::string& name);
 
 // The scene's file in the folder: calibration/scene-<name>.json. Throws InputError("name")

@@ -120,6 +120,10 @@ RestAsY RowRestAsY(const ExperimentStore& store, const StoreSnapshot& snapshot, 
           r.trial.rest->u ? Number(ToUnit(*r.trial.rest->u, Dimension::kLength, unit)) : ""};
 }
 
+namespace {
+
+// The file `video` moved into kDetachedVideoFolder unless a row of `after` names it; its new path,
+// or "" when left in place (still used, or already gone).
 std::string SetDetachedVideoAside(const ExperimentStore& store, const StoreSnapshot& after, const std::string& video) {
   for (const Row& row : after.state.rows)
     if (row.video == video) return "";  // another trial films the same recording
@@ -135,6 +139,28 @@ std::string SetDetachedVideoAside(const ExperimentStore& store, const StoreSnaps
     target = path.stem().string() + "-" + std::to_string(n) + path.extension().string();
   from.MoveFile(path.filename().string(), aside, target);
   return std::string(kDetachedVideoFolder) + "/" + target;
+}
+
+}  // namespace
+
+DetachedVideo DetachRowVideo(ExperimentStore& store, std::int64_t version, std::int64_t id, std::mutex& track_mutex) {
+  const StoreSnapshot s = store.Get();
+  const int index = s.state.IndexOf(id);
+  if (index < 0) throw InputError("row", "row " + std::to_string(id) + " does not exist");
+  const Row& old = s.state.rows[index];
+  if (old.video.empty()) throw InputError("video", "trial " + old.trial + " has no video to detach");
+  ordered_json row = ToJson(old);
+  row.erase("video");
+  if (!row.contains("Y"))
+    throw InputError("video", "trial " + old.trial +
+                                  " has no Y: without its video it would measure nothing (type its Y first, or delete "
+                                  "the trial)");
+  DetachedVideo out;
+  out.video = old.video;
+  out.after = store.EditRow(version, id, row);
+  std::lock_guard lock(track_mutex);
+  out.moved_to = SetDetachedVideoAside(store, out.after, out.video);
+  return out;
 }
 
 }  // namespace uphill::internal

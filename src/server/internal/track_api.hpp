@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -30,11 +31,17 @@ RestAsY RowRestAsY(const ExperimentStore& store, const StoreSnapshot& snapshot, 
 // starting with '.') no longer lists them, and no video of the experiment is ever deleted.
 inline constexpr const char* kDetachedVideoFolder = ".detached";
 
-// After POST /api/rows/<id>/detach has cleared the row's video cell: moves the file `video` into
-// kDetachedVideoFolder (as its file name, "-2", "-3"... before the extension when taken) unless a
-// row of `after` (the state with the cell cleared) still names it. Returns the file's new path
-// in the folder, or "" when it was left in place (still used, or already gone). Throws
+// POST /api/rows/<id>/detach: empties the row's video cell (a journaled edit, against `version`),
+// then, holding `track_mutex` (no track reads the file meanwhile), moves the file into
+// kDetachedVideoFolder (as its file name, "-2", "-3"... before the extension when taken) unless
+// another row still names it. Throws InputError for a row that does not exist, has no video, or
+// has no Y (without its video it would measure nothing), VersionConflict as the store, and
 // EnvironmentError when the move fails (the row is then detached, the file still listed).
-std::string SetDetachedVideoAside(const ExperimentStore& store, const StoreSnapshot& after, const std::string& video);
+struct DetachedVideo {
+  std::string video;     // the path the row named
+  std::string moved_to;  // the file's new path in the folder, "" when left in place (still used)
+  StoreSnapshot after;   // the state with the cell emptied
+};
+DetachedVideo DetachRowVideo(ExperimentStore& store, std::int64_t version, std::int64_t id, std::mutex& track_mutex);
 
 }  // namespace uphill::internal
