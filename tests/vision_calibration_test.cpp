@@ -276,6 +276,40 @@ TEST(SceneCalibration, TheMistypedRowIsTheOneNamed) {
   }
 }
 
+// Issue 32: two marks clicked 4-5 px off made the page blame O, the good click, by its residual
+// in the full fit. Truth: the pixels are the projections of the apparatus points through a pose
+// set here (LabPose, TrueCamera), so the one point moved by 5 px is the only wrong one; the
+// leave-one-out check must name it, whichever it is (O included), and the verdict says so.
+TEST(SceneCalibration, LeaveOneOutNamesThePointMovedByFivePixels) {
+  const CameraIntrinsics camera = TrueCamera();
+  for (const double noise_px : {0.0, 0.2})
+    for (size_t wrong = 0; wrong < ApparatusPoints().size(); ++wrong) {
+      std::vector<ScenePoint> points = Observe(camera, LabPose(), ApparatusPoints(), noise_px, 11);
+      points[0].label = "O";
+      points[wrong].pixel += Eigen::Vector2d(3, -4);  // 5 px
+      const SceneCalibrationResult r = CalibrateScene(camera, points);
+      ASSERT_TRUE(r.leave_one_out.has_value());
+      EXPECT_EQ(r.leave_one_out->index, wrong) << "noise " << noise_px;
+      EXPECT_EQ(r.leave_one_out->label, points[wrong].label);
+      EXPECT_TRUE(r.leave_one_out->explains) << points[wrong].label;
+      EXPECT_GT(r.leave_one_out->residual_px, 4.0);  // about where the other points put it: 5 px away
+      EXPECT_LT(r.leave_one_out->rms_without_px, noise_px + 0.05);
+      std::string reasons;
+      for (const auto& reason : r.reasons) reasons += reason + "\n";
+      EXPECT_NE(reasons.find(points[wrong].label + ": "), std::string::npos) << reasons;
+      EXPECT_EQ(r.verdict, "poor");
+    }
+  // No point moved: the check still reports the largest drop, but nothing is named.
+  const SceneCalibrationResult clean = CalibrateScene(camera, Observe(camera, LabPose(), ApparatusPoints(), 0.2, 11));
+  ASSERT_TRUE(clean.leave_one_out.has_value());
+  EXPECT_FALSE(clean.leave_one_out->explains);
+  EXPECT_EQ(clean.verdict, "good");
+  // Four points: a pose from the other three would fit them exactly, so there is no check.
+  std::vector<Eigen::Vector3d> four = ApparatusPoints();
+  four.resize(4);
+  EXPECT_FALSE(CalibrateScene(camera, Observe(camera, LabPose(), four, 0.2, 11)).leave_one_out.has_value());
+}
+
 TEST(SceneCalibration, DegenerateOrInconsistentPointsAreRefused) {
   const CameraIntrinsics camera = TrueCamera();
   const CameraPose pose = LabPose();
@@ -387,6 +421,25 @@ TEST_F(CameraCalibrationTest, CommandLineCalibratesCameraAndScene) {
   const SceneCalibration read_scene = ReadSceneFile(scene_path);
   // The calibrated (not the true) intrinsics: the centre is still within a few mm.
   EXPECT_LT((CameraCentre(read_scene.pose) - CameraCentre(LabPose())).norm(), 0.005);
+  // The scene file keeps the points as given (issue 32), named by their `name` cells.
+  const SceneInputs kept = ReadSceneInputs(scene_path);
+  ASSERT_EQ(kept.points.size(), positions.size());
+  for (size_t i = 0; i < positions.size(); ++i) {
+    EXPECT_EQ(kept.points[i].label, "P" + std::to_string(i));
+    EXPECT_LT((kept.points[i].pixel - pixels[i]).norm(), 1e-6);  // 10 digits in the CSV
+    EXPECT_LT((kept.points[i].position - positions[i]).norm(), 1e-9);
+  }
+  // One pixel moved by 5 px: the leave-one-out line names its row (row 5: P3).
+  std::string moved = csv.str();
+  const size_t row5 = moved.find("\nP3,") + 4;
+  moved.replace(row5, moved.find(',', row5) - row5, std::to_string(pixels[3].x() + 5));
+  { std::ofstream(dir / "moved.csv") << moved; }
+  const auto loo = RunUphill("calibrate scene --camera " + cam + " --points " + (dir / "moved.csv").string() + " -o " +
+                             (dir / "moved.json").string());
+  ASSERT_EQ(loo.status, 0) << loo.err;
+  EXPECT_NE(loo.out.find("leave-one-out: without " + (dir / "moved.csv").string() + ", row 5 (P3)"), std::string::npos)
+      << loo.out;
+  EXPECT_NE(loo.out.find("check this point"), std::string::npos) << loo.out;
 
   // Bad input: exit 2, the message names file, row and column, or the flag.
   const std::string refused_output = (dir / "x.json").string();
@@ -416,6 +469,20 @@ TEST_F(CameraCalibrationTest, CommandLineCalibratesCameraAndScene) {
   EXPECT_NE(bad.err.find("--square: '25' has no unit"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(refused_output));  // no output for refused input
   fs::remove_all(dir);
+}
+
+// calibration/views: the sample camera's chessboard views (calibration/README.md). Truth: the
+// camera that rendered them, make_video's 640 × 360 camera with fx = fy = 650 px (cam.json of
+// scripts/make-sample-videos.sh); the verdict must be "good".
+TEST(CameraCalibration, TheShippedSampleViewsGiveAGoodVerdict) {
+  std::vector<std::string> views;
+  for (const auto& entry : fs::directory_iterator(fs::path(UPHILL_SOURCE_DIR) / "calibration" / "views"))
+    views.push_back(entry.path().string());
+  ASSERT_GE(views.size(), 15u);
+  const CameraCalibration c = CalibrateCameraFromFiles(views, ChessboardTarget{9, 6, 0.020});
+  EXPECT_EQ(c.verdict, "good") << (c.reasons.empty() ? "" : c.reasons.front());
+  EXPECT_NEAR(c.camera.fx / 650, 1, 0.005);
+  EXPECT_NEAR(c.camera.fy / 650, 1, 0.005);
 }
 
 TEST(CalibrateTargetCommand, WritesAnSvgOfExactSizeAndAPngThatIsDetected) {

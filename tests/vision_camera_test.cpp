@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <opencv2/calib3d.hpp>
 #include <random>
 
@@ -32,6 +33,10 @@ fs::path TempDir(const std::string& name) {
 }
 
 void WriteText(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+std::string ReadText(const fs::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
 
 
 TEST(CameraModel, ProjectsWithoutDistortionAsThePinholeFormula) {
@@ -197,6 +202,53 @@ TEST(CameraFiles, CameraAndSceneRoundTripExactly) {
   EXPECT_EQ(s.camera.distortion, c.distortion);
   EXPECT_EQ(s.pose.rotation, scene.pose.rotation);
   EXPECT_EQ(s.pose.translation, scene.pose.translation);
+  fs::remove_all(dir);
+}
+
+// Issue 32: the scene file keeps what its pose was solved from (the clicks with their names, the
+// marks, the table's height). Truth: a round trip, write then read, gives back exactly what was
+// written; a file without them (as written before they were kept) reads as none.
+TEST(CameraFiles, SceneInputsRoundTripExactly) {
+  const fs::path dir = TempDir("scene_inputs");
+  const SceneCalibration scene{Camera1280({-0.1, 0.01, 0, 0}), LabPose()};
+  SceneInputs inputs;
+  inputs.points = {{"O", {640.25, 512.125}, {0, 0, 0}},
+                   {"left rail at the crossbar", {1001.5, 200.75}, {1.165, 0.06, 0.3}},
+                   {"mark 1 (left)", {812.0 / 3, 300.1}, {0.3, 0.0154506437768, 0.0772532188841}}};
+  inputs.marks_x = {0.3, 0.6};
+  inputs.table_z = -0.0125;
+  const std::string path = (dir / "scene-main.json").string();
+  WriteSceneFile(path, scene, CalibrationSummary{}, inputs);
+  const SceneInputs read = ReadSceneInputs(path);
+  ASSERT_EQ(read.points.size(), inputs.points.size());
+  for (size_t i = 0; i < inputs.points.size(); ++i) {
+    EXPECT_EQ(read.points[i].label, inputs.points[i].label);
+    EXPECT_EQ(read.points[i].pixel, inputs.points[i].pixel);
+    EXPECT_EQ(read.points[i].position, inputs.points[i].position);
+  }
+  EXPECT_EQ(read.marks_x, inputs.marks_x);
+  EXPECT_EQ(read.table_z, inputs.table_z);
+  EXPECT_EQ(ReadSceneFile(path).pose.translation, scene.pose.translation);  // the pose as before
+
+  const std::string old_path = (dir / "scene-old.json").string();
+  WriteSceneFile(old_path, scene, CalibrationSummary{});
+  const std::string old_text = ReadText(old_path);
+  EXPECT_EQ(old_text.find("points"), std::string::npos);  // nothing written that was not given
+  const SceneInputs none = ParseSceneInputs(old_path, old_text);
+  EXPECT_TRUE(none.points.empty());
+  EXPECT_TRUE(none.marks_x.empty());
+  EXPECT_FALSE(none.table_z.has_value());
+  EXPECT_EQ(ParseSceneFile(old_path, old_text).pose.rotation, scene.pose.rotation);
+
+  // A malformed record is refused naming the key, by both readers; a NaN is refused on writing.
+  std::string text = ReadText(path);
+  text.replace(text.find("\"u_px\""), 6, "\"u_mm\"");
+  EXPECT_NE(InputErrorOf([&] { ParseSceneFile(path, text); }).find(path + ".points[0].u_mm: unit does not match"),
+            std::string::npos);
+  EXPECT_NE(InputErrorOf([&] { ParseSceneInputs(path, text); }).find(".points[0].u_mm"), std::string::npos);
+  inputs.points[1].pixel.x() = NAN;
+  EXPECT_NE(InputErrorOf([&] { SceneFileText(scene, {}, inputs); }).find("left rail at the crossbar"),
+            std::string::npos);
   fs::remove_all(dir);
 }
 

@@ -49,7 +49,8 @@ cv::Mat ReadGreyImage(const std::string& path, const std::string& label) {
 }  // namespace
 
 SceneCalibrationResult CalibrateSceneFromPointsFile(const CameraIntrinsics& camera, const std::string& camera_name,
-                                                    const std::string& points_path, const std::string& frame_path) {
+                                                    const std::string& points_path, const std::string& frame_path,
+                                                    SceneInputs* inputs) {
   int frame_width = 0, frame_height = 0;
   if (!frame_path.empty()) {
     const cv::Mat frame = ReadGreyImage(frame_path, "--frame");
@@ -57,7 +58,14 @@ SceneCalibrationResult CalibrateSceneFromPointsFile(const CameraIntrinsics& came
     frame_height = frame.rows;
   }
   try {
-    return CalibrateScene(camera, ReadScenePoints(points_path), frame_width, frame_height);
+    std::vector<std::string> names;
+    const std::vector<ScenePoint> points = ReadScenePoints(points_path, &names);
+    SceneCalibrationResult result = CalibrateScene(camera, points, frame_width, frame_height);
+    if (inputs) {
+      inputs->points = points;
+      for (size_t i = 0; i < points.size(); ++i) inputs->points[i].label = names[i];
+    }
+    return result;
   } catch (const InputError& e) {
     // The library names rows (labels) or "points"/"frame"; say which file was meant.
     const std::string& q = e.quantity();
@@ -120,6 +128,12 @@ std::string SceneCalibrationText(const SceneCalibrationResult& r, const std::str
   Row(out, "RMS reprojection error", Fixed(r.rms_px, 3) + " px");
   out << "  residuals:\n";
   for (const auto& p : r.residuals) out << "    " << p.label << ": " << Fixed(p.error_px, 3) << " px\n";
+  if (const auto& check = r.leave_one_out)
+    out << "  leave-one-out: without " << check->label << " the RMS error is " << Fixed(check->rms_without_px, 3)
+        << " px (the largest drop); it lies "
+        << (std::isfinite(check->residual_px) ? Fixed(check->residual_px, 2) + " px from where the other points place it"
+                                              : "behind the camera in the pose the other points give")
+        << (check->explains ? ": check this point" : "") << "\n";
   Verdict(out, r.verdict, r.reasons);
   return out.str();
 }

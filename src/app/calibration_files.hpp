@@ -13,10 +13,12 @@
 namespace uphill {
 
 // The camera's pose from POINTS.csv (app/calibration_inputs.hpp). `frame_path`, when not empty:
-// a frame of the video, whose size must be the camera's. Throws InputError naming the points
-// file, or the frame and the camera file, and the rule broken.
+// a frame of the video, whose size must be the camera's. `inputs` (optional) receives the points
+// as the scene file keeps them (each named by its `name` cell, or "row N"). Throws InputError
+// naming the points file, or the frame and the camera file, and the rule broken.
 SceneCalibrationResult CalibrateSceneFromPointsFile(const CameraIntrinsics& camera, const std::string& camera_name,
-                                                    const std::string& points_path, const std::string& frame_path);
+                                                    const std::string& points_path, const std::string& frame_path,
+                                                    SceneInputs* inputs = nullptr);
 
 // The camera's pose from an image of a chessboard lying in the scene: its first inner corner at
 // `origin` (m, apparatus frame), its rows along `x_axis` and its columns along `y_axis` (unit
@@ -31,7 +33,8 @@ SceneCalibrationResult CalibrateSceneFromBoardFile(const CameraIntrinsics& camer
 std::string CameraCalibrationText(const CameraCalibration& c, const ChessboardTarget& target, bool fit_k3);
 
 // What `calibrate scene` prints: the camera's centre and viewing direction in the apparatus
-// frame, its distance to O, the RMS error, each point's residual and the verdict.
+// frame, its distance to O, the RMS error, each point's residual, the leave-one-out check (the
+// point whose removal lowers the RMS error most, vision/calibration.hpp) and the verdict.
 std::string SceneCalibrationText(const SceneCalibrationResult& r, const std::string& camera_name);
 
 }  // namespace uphill

@@ -21,7 +21,7 @@ std::string Num(double v) { return Printf("%.6g", v); }
 
 }  // namespace
 
-std::vector<ScenePoint> ReadScenePoints(const std::string& path) {
+std::vector<ScenePoint> ReadScenePoints(const std::string& path, std::vector<std::string>* names) {
   const CsvTable table = ReadCsvFile(path);
   int u = -1, v = -1, xyz[3] = {-1, -1, -1}, name = -1;
   std::string xyz_unit[3];
@@ -55,6 +55,7 @@ std::vector<ScenePoint> ReadScenePoints(const std::string& path) {
     const auto where = [&](int column) { return CellContext(table, row.row, table.header[column]); };
     p.label = table.source + ", row " + std::to_string(row.row);
     if (name >= 0 && !cell(name).empty()) p.label += " (" + cell(name) + ")";
+    if (names) names->push_back(name >= 0 && !cell(name).empty() ? cell(name) : "row " + std::to_string(row.row));
     p.pixel = {ParseQuantity(cell(u), Dimension::kDimensionless, where(u)),
                ParseQuantity(cell(v), Dimension::kDimensionless, where(v))};
     for (int k = 0; k < 3; ++k)

@@ -15,8 +15,9 @@ namespace uphill {
 // frame (metres after parsing) with a length unit in the header (`x_mm`) or in every cell
 // (`x` = "120mm"); optional `name` (added to the point's label for messages) and `note`
 // (ignored). Each point's label is "FILE, row N" (plus " (name)"). Throws InputError naming
-// the file, row and column: an unknown column, a missing one, a bad number or unit.
-std::vector<ScenePoint> ReadScenePoints(const std::string& path);
+// the file, row and column: an unknown column, a missing one, a bad number or unit. `names`
+// (optional) receives each point's name as a scene file keeps it: its `name` cell, or "row N".
+std::vector<ScenePoint> ReadScenePoints(const std::string& path, std::vector<std::string>* names = nullptr);
 
 // The target as an SVG of exact size in millimetres: (cols + 1) × (rows + 1) squares of
 // target.square with a white margin of one square, and a comment saying how to print it.

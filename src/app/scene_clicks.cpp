@@ -25,14 +25,20 @@ std::vector<ApparatusPoint> SettingCalibrationPoints(const Configuration& settin
   return ApparatusCalibrationPoints(rails, *crossbar, table_z, marks_x);
 }
 
-SceneClicksSolution SolveSceneClicks(const CameraIntrinsics& camera, const std::vector<ScenePoint>& clicks,
-                                     int frame_width, int frame_height, const std::optional<Scene>& scene) {
+SceneClicksSolution SolveSceneClicks(const CameraIntrinsics& camera, const SceneClicks& request, int frame_width,
+                                     int frame_height, const std::optional<Scene>& scene) {
   SceneClicksSolution out;
+  const std::vector<ScenePoint>& clicks = request.clicks;
   out.calibration = CalibrateScene(camera, clicks, frame_width, frame_height);
   const CameraPose& pose = out.calibration.scene.pose;
   std::vector<Eigen::Vector3d> positions;
   for (const ScenePoint& p : clicks) positions.push_back(p.position);
   out.reprojected = ProjectApparatusPoints(camera, pose, positions);
+  out.expected = VisibleApparatusPoints(camera, pose, request.unclicked);
+  out.axes = VisibleApparatusPoints(camera, pose,
+                                    {{"O", Eigen::Vector3d::Zero()},
+                                     {"+x", Eigen::Vector3d(kAxisLength, 0, 0)},
+                                     {"+y (left rail)", Eigen::Vector3d(0, kAxisLength, 0)}});
   if (scene) {
     std::vector<Eigen::Vector3d> path;
     for (int i = 0; i <= 200; ++i) {
@@ -44,7 +50,8 @@ SceneClicksSolution SolveSceneClicks(const CameraIntrinsics& camera, const std::
   }
   CalibrationSummary summary = out.calibration.Summary();
   summary.method = "points clicked in a frame of the video (uphill serve); " + summary.method;
-  out.scene_file = SceneFileText(out.calibration.scene, summary);
+  out.scene_file =
+      SceneFileText(out.calibration.scene, summary, SceneInputs{clicks, request.marks_x, request.table_z});
   return out;
 }
 

@@ -309,6 +309,9 @@ struct Server::Impl {
     http.Get("/api/videos", [this](const httplib::Request& req, httplib::Response& res) {
       Respond(req, res, [this](const json&) { return internal::ListVideos(store); });
     });
+    http.Get("/api/video/info", [this](const httplib::Request& req, httplib::Response& res) {
+      Respond(req, res, [this, &req](const json&) { return internal::VideoInfo(store, req.get_param_value("video")); });
+    });
     http.Get("/api/video/frame", [this](const httplib::Request& req, httplib::Response& res) {
       try {
         const int frame = req.has_param("frame")
@@ -357,6 +360,9 @@ struct Server::Impl {
         internal::SolveScene(store, store.Get(), b, &text);
         return store.SaveCalibrationFile(version, "scene", name, path, text);
       });
+    });
+    http.Get(R"(/api/scenes/([^/]{1,64}))", [this](const httplib::Request& req, httplib::Response& res) {
+      Respond(req, res, [this, &req](const json&) { return internal::SavedScene(store.Get(), req.matches[1].str()); });
     });
     http.Post("/api/camera/calibrate", [this](const httplib::Request& req, httplib::Response& res) {
       Respond(req, res, [this](const json& b) {
@@ -407,10 +413,17 @@ struct Server::Impl {
           row.erase("video");
         } else {
           const VideoProbe probe = ProbeVideo(internal::FolderFile(store, video, "video"), video);
-          CheckSceneFits(s, add ? "" : s.state.rows[index].scene, video, probe);
+          internal::CheckSceneFits(s, add ? "" : s.state.rows[index].scene, video, probe);
           row["video"] = video;
         }
         return add ? store.AddRow(version, row) : store.EditRow(version, id, row);
+      });
+    });
+    http.Post(R"(/api/rows/(\d{1,12})/detach)", [this](const httplib::Request& req, httplib::Response& res) {
+      Respond(req, res, [this, &req](const json& b) {
+        const internal::DetachedVideo d = internal::DetachRowVideo(store, VersionOf(b), std::stoll(req.matches[1].str()),
+                                                                   report_mutex);
+        return ordered_json{{"video", d.video}, {"moved_to", d.moved_to}, {"state", StateJson(d.after)}};
       });
     });
     http.Put(kVideoUploadPattern, [this](const httplib::Request& req, httplib::Response& res,
@@ -475,26 +488,6 @@ struct Server::Impl {
       res.set_header("Connection", "close");
       close();
     }
-  }
-
-  // A scene file that does not fit the video's size is refused when the video is attached (the
-  // track would be wrong everywhere): the row's scene, or the experiment's only scene.
-  static void CheckSceneFits(const StoreSnapshot& s, std::string scene, const std::string& video,
-                             const VideoProbe& probe) {
-    const ordered_json& meta = s.state.metadata;
-    if (!meta.is_object() || !meta.contains("scenes")) return;
-    if (scene.empty() && meta.at("scenes").size() == 1) scene = meta.at("scenes").begin().key();
-    if (scene.empty() || !meta.at("scenes").contains(scene)) return;
-    const std::string path = meta.at("scenes").at(scene).get<std::string>();
-    const auto it = s.state.files.find(path);
-    if (it == s.state.files.end()) return;
-    const SceneCalibration calibration = ParseSceneFile(path, it->second);
-    if (calibration.camera.width != probe.width || calibration.camera.height != probe.height)
-      throw InputError("video", video + " is " + std::to_string(probe.width) + "×" + std::to_string(probe.height) +
-                                    " px but the scene file " + path + " (scene \"" + scene + "\") is for " +
-                                    std::to_string(calibration.camera.width) + "×" +
-                                    std::to_string(calibration.camera.height) +
-                                    " px: calibrate a scene for this video's camera setting");
   }
 
   // The fit report of the files as they are, written into a private staging folder inside the

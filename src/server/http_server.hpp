@@ -18,14 +18,20 @@
 //                                         max_upload_bytes) becomes EXP/videos/<name>, atomically
 //   PUT    /api/views/<name>              the body (application/octet-stream, an image, at most
 //                                         max_view_upload_bytes) becomes EXP/calibration/views/<name>
+//   GET    /api/video/info?video=P         its size, frame rate and frame count
 //   GET    /api/video/frame?video=P&frame=N[&format=jpeg]   a frame as PNG (or JPEG)
 //   POST   /api/rows/<id>/video           {version, video}: attach a video of the folder to a row
+//   POST   /api/rows/<id>/detach          {version}: clear the row's video; the file is moved to
+//                                         EXP/.detached/ (out of the list) unless another row uses it
 //   GET    /api/scene/points?row=ID[&table_z=Z&marks=M,M]   the apparatus points to click
-//   POST   /api/scene/solve               {video, row?, clicks}: the pose, residuals, the path
+//   POST   /api/scene/solve               {video, row?, clicks, marks?, table_z?}: the pose,
+//                                         residuals, the leave-one-out check, the path
 //   POST   /api/rows/<id>/track           {}: the trial's video tracked and analysed (cached)
 //   POST   /api/rows/<id>/accept-y        {version}: the video's rest position becomes Y ± u_Y
-//   PUT    /api/scenes/<name>             {version, video, row?, clicks}: solve and save the
-//                                         scene file calibration/scene-<name>.json
+//   PUT    /api/scenes/<name>             {version, video, row?, clicks, marks?, table_z?}: solve
+//                                         and save the scene file calibration/scene-<name>.json
+//                                         (it keeps the clicks, the marks and the table's height)
+//   GET    /api/scenes/<name>             what the saved scene was solved from (to restore it)
 //   POST   /api/camera/calibrate          {version, folder, cols, rows, square}: the camera file
 //                                         calibration/camera.json from chessboard views
 // The state: {version, can_undo, directory, exists, experiment, unit, columns, rows:[{id, trial,

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <opencv2/calib3d.hpp>
@@ -342,36 +343,55 @@ SceneCalibrationResult CalibrateScene(const CameraIntrinsics& camera, const std:
   SceneCalibrationResult result;
   result.scene.camera = camera;
   result.scene.pose = *pose;
-  // Leave-one-out: each point predicted by the pose the other points give. A misread point pulls
-  // the full fit toward itself, so its own residual can be smaller than a good neighbour's; the
-  // pose without it does not, and the point's distance from that prediction names it.
-  std::vector<double> deleted(points.size(), 0.0);
-  std::vector<bool> in_front_without(points.size(), false);
-  if (points.size() >= 5)
+  // Leave-one-out: the pose refitted without each point in turn. A misread point pulls the full
+  // fit toward itself, so its own residual can be smaller than a good neighbour's; the pose
+  // without it does not, so removing it lowers the RMS error of the others most.
+  struct Without {
+    bool in_front = false;  // every other point in front of the camera in the pose without it
+    double residual_px = 0, rms_px = 0;
+  };
+  std::vector<std::optional<Without>> without(points.size());
+  if (points.size() >= kMinPointsForLeaveOneOut)
     for (size_t i = 0; i < points.size(); ++i) {
-      const std::optional<CameraPose> without = FitPose(camera, points, i);
-      if (!without) continue;
-      bool all_in_front = true;
-      for (size_t k = 0; k < points.size(); ++k)
-        if (k != i && (without->rotation * points[k].position + without->translation).z() <= 0) all_in_front = false;
-      in_front_without[i] = all_in_front;
-      deleted[i] = (ProjectApparatusPoints(camera, *without, {points[i].position})[0] - points[i].pixel).norm();
+      const std::optional<CameraPose> pose_without = FitPose(camera, points, i);
+      if (!pose_without) continue;
+      Without w;
+      w.in_front = true;
+      double sum = 0;
+      for (size_t k = 0; k < points.size(); ++k) {
+        const bool in_front = (pose_without->rotation * points[k].position + pose_without->translation).z() > 0;
+        // A point behind the camera has no pixel: infinitely far from its click.
+        const double e = in_front ? (ProjectApparatusPoint(camera, *pose_without, points[k].position) - points[k].pixel).norm()
+                                  : std::numeric_limits<double>::infinity();
+        if (k == i) {
+          w.residual_px = e;
+        } else {
+          w.in_front = w.in_front && in_front;
+          sum += e * e;
+        }
+      }
+      w.rms_px = std::sqrt(sum / static_cast<double>(points.size() - 1));
+      without[i] = w;
     }
-  const auto culprit = [&]() -> std::optional<size_t> {
-    if (points.size() < 5) return std::nullopt;
-    std::vector<double> sorted = deleted;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    const double median = sorted[sorted.size() / 2];
-    const size_t worst = static_cast<size_t>(std::max_element(deleted.begin(), deleted.end()) - deleted.begin());
-    if (deleted[worst] > 5 * median && deleted[worst] > 2) return worst;
-    return std::nullopt;
-  }();
+  // How far a point lies from where the others place it, in words (behind the camera: no pixel).
+  const auto from_others = [](double px) -> std::string {
+    return std::isfinite(px) ? Fixed(px, 1) + " px from where the other points place it"
+                             : "behind the camera in the pose the other points give";
+  };
+  // The point whose removal leaves the smallest RMS error (the largest drop).
+  std::optional<size_t> lowest;
+  for (size_t i = 0; i < points.size(); ++i)
+    if (without[i] && without[i]->in_front && (!lowest || without[i]->rms_px < without[*lowest]->rms_px)) lowest = i;
+  if (lowest) {
+    result.leave_one_out = LeaveOneOutCheck{*lowest, points[*lowest].label, without[*lowest]->residual_px,
+                                            without[*lowest]->rms_px, false};
+  }
   for (size_t i = 0; i < points.size(); ++i)
     if ((result.scene.pose.rotation * points[i].position + result.scene.pose.translation).z() <= 0) {
-      if (culprit && in_front_without[*culprit])
-        throw InputError(points[*culprit].label,
-                         "does not fit the other points (" + Fixed(deleted[*culprit], 1) +
-                             " px from where they place it), and with it " + points[i].label +
+      if (lowest && without[*lowest]->residual_px > kLeaveOneOutMinResidualPx)
+        throw InputError(points[*lowest].label,
+                         "does not fit the other points (it lies " + from_others(without[*lowest]->residual_px) +
+                             "), and with it " + points[i].label +
                              " would lie behind the camera: check this point's pixel and position");
       throw InputError(points[i].label, "lies behind the camera in the best-fitting pose: the points and pixels disagree");
     }
@@ -393,9 +413,16 @@ SceneCalibrationResult CalibrateScene(const CameraIntrinsics& camera, const std:
                   " px is above 2 px: a point misread or mismeasured, or the camera file is not this camera's");
   if (flatness < 0.05)
     why.push_back("the points lie nearly on one line: the rotation about it is poorly determined");
-  if (culprit)
-    why.push_back(points[*culprit].label + ": " + Fixed(deleted[*culprit], 1) +
-                  " px from where the other points place it, far more than any other point (check this point)");
+  if (result.leave_one_out) {
+    LeaveOneOutCheck& check = *result.leave_one_out;
+    check.explains = check.residual_px > kLeaveOneOutMinResidualPx && check.rms_without_px <= 0.5 * result.rms_px;
+    if (check.explains)
+      why.push_back(check.label + ": " + from_others(check.residual_px) + "; without it the RMS error falls from " +
+                    Fixed(result.rms_px, 2) + " to " + Fixed(check.rms_without_px, 2) + " px (check this point)");
+    else if (result.rms_px > 2)
+      why.push_back("no single point explains the error: without any one of them the RMS error stays at " +
+                    Fixed(check.rms_without_px, 2) + " px or more (several points off, or the wrong camera file)");
+  }
   result.verdict = why.empty() ? "good" : "poor";
   return result;
 }

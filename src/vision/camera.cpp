@@ -316,6 +316,67 @@ CameraIntrinsics CameraFromJson(const std::string& path, const json& j) {
 
 SceneCalibration SceneFromJson(const std::string& path, const json& j);
 
+// Longest point name kept (the page's names are short; a longer one is refused, not cut).
+constexpr size_t kMaxPointNameBytes = 64;
+
+SceneInputs InputsFromJson(const std::string& path, const json& j) {
+  SceneInputs inputs;
+  if (j.contains("points")) {
+    const json& points = j.at("points");
+    if (!points.is_array()) throw InputError(path + ".points", "must be an array of {name, u_px, v_px, x_m, y_m, z_m}");
+    for (size_t i = 0; i < points.size(); ++i) {
+      const std::string context = path + ".points[" + std::to_string(i) + "]";
+      const json& p = points[i];
+      CheckKeys(p, {"name", "u_px", "v_px", "x_m", "y_m", "z_m"}, context);
+      const json& name = Member(p, "name", context);
+      if (!name.is_string() || name.get<std::string>().empty() || name.get<std::string>().size() > kMaxPointNameBytes)
+        throw InputError(context + ".name", "must be a text of 1 to " + std::to_string(kMaxPointNameBytes) + " bytes");
+      ScenePoint point;
+      point.label = name.get<std::string>();
+      point.pixel = {Number(Member(p, "u_px", context), context + ".u_px"),
+                     Number(Member(p, "v_px", context), context + ".v_px")};
+      point.position = {Number(Member(p, "x_m", context), context + ".x_m"),
+                        Number(Member(p, "y_m", context), context + ".y_m"),
+                        Number(Member(p, "z_m", context), context + ".z_m")};
+      inputs.points.push_back(point);
+    }
+  }
+  if (j.contains("marks_m")) inputs.marks_x = Numbers(j.at("marks_m"), path + ".marks_m");
+  if (j.contains("table_z_m")) inputs.table_z = Number(j.at("table_z_m"), path + ".table_z_m");
+  return inputs;
+}
+
+void RequireFinite(double value, const std::string& context) {
+  if (!std::isfinite(value)) throw InputError(context, "must be finite");
+}
+
+ordered_json InputsToJson(const SceneInputs& inputs) {
+  ordered_json j = ordered_json::object();
+  if (!inputs.points.empty()) {
+    ordered_json points = ordered_json::array();
+    for (size_t i = 0; i < inputs.points.size(); ++i) {
+      const ScenePoint& p = inputs.points[i];
+      const std::string context = "points[" + std::to_string(i) + "]";
+      if (p.label.empty() || p.label.size() > kMaxPointNameBytes)
+        throw InputError(context + ".name", "must be a text of 1 to " + std::to_string(kMaxPointNameBytes) + " bytes");
+      if (!p.pixel.allFinite()) throw InputError(context + " (" + p.label + ")", "pixel must be finite");
+      if (!p.position.allFinite()) throw InputError(context + " (" + p.label + ")", "position must be finite");
+      points.push_back({{"name", p.label}, {"u_px", p.pixel.x()}, {"v_px", p.pixel.y()}, {"x_m", p.position.x()},
+                        {"y_m", p.position.y()}, {"z_m", p.position.z()}});
+    }
+    j["points"] = points;
+  }
+  if (!inputs.marks_x.empty()) {
+    for (double m : inputs.marks_x) RequireFinite(m, "marks");
+    j["marks_m"] = inputs.marks_x;
+  }
+  if (inputs.table_z) {
+    RequireFinite(*inputs.table_z, "table_z");
+    j["table_z_m"] = *inputs.table_z;
+  }
+  return j;
+}
+
 }  // namespace
 
 CameraIntrinsics ReadCameraFile(const std::string& path) { return CameraFromJson(path, ReadJsonFile(path)); }
@@ -326,11 +387,24 @@ SceneCalibration ReadSceneFile(const std::string& path) { return SceneFromJson(p
 SceneCalibration ParseSceneFile(const std::string& path, const std::string& text) {
   return SceneFromJson(path, ParseJsonText(path, text));
 }
+SceneInputs ReadSceneInputs(const std::string& path) {
+  const json j = ReadJsonFile(path);
+  SceneFromJson(path, j);
+  return InputsFromJson(path, j);
+}
+SceneInputs ParseSceneInputs(const std::string& path, const std::string& text) {
+  const json j = ParseJsonText(path, text);
+  SceneFromJson(path, j);
+  return InputsFromJson(path, j);
+}
 
 namespace {
 SceneCalibration SceneFromJson(const std::string& path, const json& j) {
   CheckFormat(j, path, kSceneFormat);
-  CheckKeys(j, {"format", "camera", "pose", "camera_centre_m", "viewing_direction", "calibration"}, path);
+  CheckKeys(j, {"format", "camera", "pose", "camera_centre_m", "viewing_direction", "calibration", "points", "marks_m",
+               "table_z_m"},
+            path);
+  (void)InputsFromJson(path, j);  // a scene file with a malformed record of its inputs is refused as a whole
   SceneCalibration scene;
   scene.camera = IntrinsicsFromJson(Member(j, "camera", path), path + ".camera", {});
   const json& pose = Member(j, "pose", path);
@@ -376,11 +450,12 @@ void WriteCameraFile(const std::string& path, const CameraIntrinsics& camera,
 }
 
 void WriteSceneFile(const std::string& path, const SceneCalibration& scene,
-                    const CalibrationSummary& summary) {
-  WriteFileAtomically(path, SceneFileText(scene, summary));
+                    const CalibrationSummary& summary, const SceneInputs& inputs) {
+  WriteFileAtomically(path, SceneFileText(scene, summary, inputs));
 }
 
-std::string SceneFileText(const SceneCalibration& scene, const CalibrationSummary& summary) {
+std::string SceneFileText(const SceneCalibration& scene, const CalibrationSummary& summary,
+                          const SceneInputs& inputs) {
   ValidateIntrinsics(scene.camera, "camera");
   ValidateRotation(scene.pose.rotation, "pose.rotation");
   if (!scene.pose.translation.allFinite()) throw InputError("pose.translation", "must be finite");
@@ -397,6 +472,7 @@ std::string SceneFileText(const SceneCalibration& scene, const CalibrationSummar
          {"camera_centre_m", {centre.x(), centre.y(), centre.z()}},
          {"viewing_direction", {axis.x(), axis.y(), axis.z()}},
          {"calibration", SummaryToJson(summary)}};
+  j.update(InputsToJson(inputs));
   return j.dump(2) + "\n";
 }
 

@@ -20,6 +20,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -80,13 +81,32 @@ void ValidateIntrinsics(const CameraIntrinsics& camera, const std::string& conte
 // InputError naming the file, the key and the rule broken (missing key, wrong type, a unit that
 // does not match, fx ≤ 0, a rotation that is not orthonormal, ...).
 //   camera file  "format": "uphill-camera/1": intrinsics + calibration diagnostics
-//   scene file   "format": "uphill-scene/1": the camera file's intrinsics + the pose
+//   scene file   "format": "uphill-scene/1": the camera file's intrinsics + the pose (+ its inputs)
 CameraIntrinsics ReadCameraFile(const std::string& path);
 struct SceneCalibration {
   CameraIntrinsics camera;
   CameraPose pose;
 };
 SceneCalibration ReadSceneFile(const std::string& path);
+
+// A point of known position seen in a frame: what a scene's pose is solved from
+// (vision/calibration.hpp CalibrateScene), and what a scene file keeps of it.
+struct ScenePoint {
+  std::string label;                                   // e.g. "file.csv, row 3" or a point's name
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();     // raw pixel (u, v)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // apparatus frame, metres
+};
+
+// What a scene's pose was solved from, kept in its file so that a person can check it and the
+// page of `uphill serve` can restore the clicks after a reload or in another browser: the points
+// (label = the point's name), the marks' distances from O along the rails and the height of the
+// table under the crossbar's feet. All optional: files written by other means, and scene files
+// written before these were kept, have none, and read as empty.
+struct SceneInputs {
+  std::vector<ScenePoint> points;
+  std::vector<double> marks_x;    // metres, in the order given
+  std::optional<double> table_z;  // metres; nullopt: not recorded
+};
 
 // How a calibration was obtained, stored in the files for the person who checks them; the
 // readers accept and ignore it (the numbers above are all the vision layer uses).
@@ -102,13 +122,20 @@ struct CalibrationSummary {
 void WriteCameraFile(const std::string& path, const CameraIntrinsics& camera,
                      const CalibrationSummary& summary);
 void WriteSceneFile(const std::string& path, const SceneCalibration& scene,
-                    const CalibrationSummary& summary);
+                    const CalibrationSummary& summary, const SceneInputs& inputs = {});
 // The files' text, exactly as the writers above write it (for a writer that stores the file
 // itself: the server journals it before writing). Same InputError checks.
 std::string CameraFileText(const CameraIntrinsics& camera, const CalibrationSummary& summary);
-std::string SceneFileText(const SceneCalibration& scene, const CalibrationSummary& summary);
+// `inputs` (optional): written as the scene file's "points", "marks_m" and "table_z_m"; a
+// non-finite value is an InputError naming it, before writing anything.
+std::string SceneFileText(const SceneCalibration& scene, const CalibrationSummary& summary,
+                          const SceneInputs& inputs = {});
 // The same readers from a file's text; `path` names it in messages.
 CameraIntrinsics ParseCameraFile(const std::string& path, const std::string& text);
 SceneCalibration ParseSceneFile(const std::string& path, const std::string& text);
+// What a scene file keeps of its inputs (empty when it keeps none). Throws InputError as
+// ReadSceneFile does, also naming a point's key ("path.points[2].u_px") and the rule broken.
+SceneInputs ReadSceneInputs(const std::string& path);
+SceneInputs ParseSceneInputs(const std::string& path, const std::string& text);
 
 }  // namespace uphill

@@ -3,7 +3,10 @@
 // technician, in the page alone: creates the experiment, uploads chessboard photos and calibrates
 // the camera from them, uploads a trial's recording, clicks the calibration points on a
 // frame, saves the scene, tracks the video, accepts the rest position as Y, opens the report,
-// reloads and finds all of it again.
+// reloads and finds all of it again. Then, outside the counted steps (issue 32): a fresh browser
+// restores the clicks, marks and table height from the scene file; the frame names the points and
+// the left rail (+y); the scrubber and play/pause move through the clip; O clicked 5 px off is
+// the point the leave-one-out check names; the video is detached and leaves the folder's list.
 //
 // Truth: tools/make_video's clip of its default apparatus (sphere R = 25.4 mm, 8 mm rods,
 // L = 1000 mm, H = 100 mm, D = 150 mm; table 30 mm below O), its exact camera (cam.json) and pose
@@ -34,7 +37,9 @@ assert.ok(url && dir && work && makeVideo, 'UPHILL_URL, UPHILL_EXP_DIR, UPHILL_E
 const clip = path.join(work, 'clip');
 execFileSync(makeVideo, [clip, '--width', '640', '--height', '360', '--boards', '12', '--noise', '1', '--mu', '0.05',
   '--x0-band', '-0.02', '--seconds', '1'], { stdio: 'ignore' });
-const truthX = Number(fs.readFileSync(path.join(clip, 'truth.csv'), 'utf8').trim().split('\n').pop().split(',')[2]);
+const truthLines = fs.readFileSync(path.join(clip, 'truth.csv'), 'utf8').trim().split('\n');
+const truthX = Number(truthLines[truthLines.length - 1].split(',')[2]);
+const truthFrames = truthLines.length - 1;  // a line per frame after the header
 const truthPoints = fs.readFileSync(path.join(clip, 'points.csv'), 'utf8').trim().split('\n').slice(1).map((line) => {
   const [name, u, v, x, y, z] = line.split(',');
   return { name, u: Number(u), v: Number(v), x: Number(x), y: Number(y), z: Number(z) };
@@ -199,6 +204,76 @@ try {
   assert.equal(experiment.scenes.main, 'calibration/scene-main.json');
   const csv = fs.readFileSync(path.join(dir, 'measurements.csv'), 'utf8').trim().split('\n');
   assert.equal(csv[0].split(',').includes('video'), true);
+
+  // The checks below are not steps of the technician's path (not counted).
+  // 8. The clicks, the marks and the table's height are in the scene file, and a fresh browser
+  // (no local storage) restores them from it (issue 32, item 7).
+  assert.deepEqual(saved.points.map((p) => p.name), truthPoints.map((p) => p.name));
+  assert.deepEqual(saved.marks_m.map((m) => Math.round(m * 1e6) / 1e3), [300, 600, 900]);  // mm, kept in m
+  assert.equal(Math.round(saved.table_z_m * 1e6) / 1e3, -30);
+  const fresh = await openPage(browser, url, 60000, (text) => /status of 4\d\d/.test(text));
+  await fresh.page.goto(url);
+  await fresh.page.waitForSelector('#s-points tr[data-name="mark 900 right"]');
+  await fresh.page.waitForSelector('#s-result [class^="verdict-"]');
+  assert.equal(await fresh.page.inputValue('#s-marks'), '300, 600, 900');
+  assert.equal(await fresh.page.inputValue('#s-table'), '-30');
+  for (const p of truthPoints) {
+    const cells = await fresh.page.$$eval(`#s-points tr[data-name="${p.name}"] td`, (tds) => tds.map((td) => td.textContent));
+    const clicked = saved.points.find((q) => q.name === p.name);
+    assert.equal(cells[4], clicked.u_px.toFixed(2), `${p.name} restored in a fresh browser`);
+    assert.equal(cells[5], clicked.v_px.toFixed(2), `${p.name} restored in a fresh browser`);
+  }
+  assert.deepEqual(fresh.problems, []);
+  await fresh.page.context().close();
+
+  // 9. The overlay names the points and the axes (+y: the left rail); a player replaces the frame
+  // number: a scrubber over the clip's frames and play/pause (items 9).
+  await page.selectOption('#s-zoom', '1');
+  await shot('video-4-labels.png');
+  const labels = await page.$$eval('#s-overlay text', (ts) => ts.map((t) => t.textContent));
+  assert.ok(labels.some((t) => t.startsWith('O ')), `O named on the frame: ${labels}`);
+  assert.ok(labels.some((t) => t.startsWith('left rail crossbar (+y) ')), `the left rail is +y on the frame: ${labels}`);
+  assert.match(await page.textContent('#s-points tr[data-name="left rail crossbar"] button.pick'), /\(\+y\)/);
+  assert.ok(await page.isVisible('#s-play'));
+  const frames = Number(await page.getAttribute('#s-scrub', 'max')) + 1;
+  assert.equal(frames, truthFrames, 'the scrubber spans the clip');
+  await page.$eval('#s-scrub', (s) => { s.value = '10'; s.dispatchEvent(new Event('change')); });
+  await page.waitForSelector(`#s-where:has-text("frame 11 of ${truthFrames}")`);
+  await page.click('#s-play');  // plays from frame 11 to the end, then shows the last frame
+  await page.waitForSelector(`#s-where:has-text("frame ${truthFrames} of ${truthFrames}")`);
+  await page.waitForSelector('#s-play:has-text("Play")');
+
+  // 10. O clicked 5 px off: the leave-one-out check names O, not the largest residual (item 8).
+  await page.selectOption('#s-zoom', '8');
+  await page.evaluate(() => { document.getElementById('s-view').scrollIntoView({ block: 'nearest' }); });
+  const o = truthPoints.find((p) => p.name === 'O');
+  await page.locator('#s-points tr[data-name="O"] button.pick').click();
+  await page.evaluate(([u, v]) => {
+    const view = document.getElementById('s-view');
+    const scale = document.getElementById('s-img').getBoundingClientRect().width / 640;
+    view.scrollLeft = (u + 0.5) * scale - view.clientWidth / 2;
+    view.scrollTop = (v + 0.5) * scale - view.clientHeight / 2;
+  }, [o.u, o.v]);
+  const box = await page.locator('#s-img').boundingBox();
+  const zoom = box.width / 640;
+  await page.mouse.click(box.x + (o.u + 0.5 + 3) * zoom, box.y + (o.v + 0.5 - 4) * zoom);
+  await page.waitForSelector('#s-points tr.suspect[data-name="O"]');
+  assert.match(await page.textContent('#s-result'), /O: [0-9.]+ px from where the other points place it/);
+  assert.equal(await page.locator('#s-points tr.suspect').count(), 1);
+
+  // 11. Detaching the video (confirmed): the trial keeps its Y but no video, and the file leaves
+  // the folder's list for .detached/ (item 6).
+  page.once('dialog', (d) => d.accept());
+  await page.click('#v-detach');
+  await page.waitForSelector('#v-status:has-text("detached videos/clip.mp4")');
+  assert.ok(!fs.existsSync(path.join(dir, 'videos', 'clip.mp4')));
+  assert.ok(fs.existsSync(path.join(dir, '.detached', 'clip.mp4')));
+  const afterDetach = await (await page.request.get(url + 'api/state')).json();
+  assert.equal(afterDetach.rows[0].video, undefined);
+  assert.equal(afterDetach.rows[0].Y, state.rows[0].Y);
+  const listed = await (await page.request.get(url + 'api/videos')).json();
+  assert.deepEqual(listed.videos, []);
+  assert.ok(await page.isHidden('#v-panel'));
   assert.deepEqual(problems, []);
   console.log(`video e2e: ok — ${steps} steps, ` +
     `${seconds.toFixed(1)} s of the server's and the browser's work, ` +

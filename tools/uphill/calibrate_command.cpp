@@ -117,6 +117,7 @@ void RunScene(const CalibrateFlags& f) {
   CheckOutput(f);
   const CameraIntrinsics camera = ReadCameraFile(f.camera);
   SceneCalibrationResult r;
+  SceneInputs inputs;  // what the scene file keeps of a points file (a board's corners are not kept)
   if (!f.board_image.empty()) {
     if (!f.points.empty()) throw InputError("--points/--board-image", "give one of them, not both");
     if (f.board_origin.empty()) throw InputError("--board-origin", "is required with --board-image");
@@ -125,10 +126,10 @@ void RunScene(const CalibrateFlags& f) {
     r = CalibrateSceneFromBoardFile(camera, f.board_image, Target(f.target), origin, x, y);
   } else {
     if (f.points.empty()) throw InputError("--points", "is required (or --board-image)");
-    r = CalibrateSceneFromPointsFile(camera, f.camera, f.points, f.frame);
+    r = CalibrateSceneFromPointsFile(camera, f.camera, f.points, f.frame, &inputs);
   }
   MakeOutputFolder(f);
-  WriteSceneFile(f.output, r.scene, r.Summary());  // first: the printout then describes a saved file
+  WriteSceneFile(f.output, r.scene, r.Summary(), inputs);  // first: the printout then describes a saved file
   std::cout << SceneCalibrationText(r, f.camera);
   std::cout << "wrote " << f.output << "\n";
 }

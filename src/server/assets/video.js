@@ -1,7 +1,9 @@
 // The video section of the page of `uphill serve`: the camera from chessboard views, a trial's
 // recording (picked from the folder or uploaded), the scene calibrated by clicks on a frame, and
 // the track with its analysis. As in app.js, the server computes everything (the pose at each
-// click, the residuals, the model's path, the track) and this script only draws its answers.
+// click, the residuals, the leave-one-out check, where the unclicked points and the axes are, the
+// model's path, the track) and this script only draws its answers. A saved scene file keeps the
+// clicks, the marks and the table's height: the page restores them from it (GET /api/scenes/N).
 // Uses app.js's S, api, change, el, svg, $, fmt, showMessage, nextTrial.
 'use strict';
 
@@ -9,7 +11,10 @@ const V = {
   rowId: null,      // the trial shown
   video: '',        // its video (a path in the folder)
   width: 0, height: 0,
+  frames: 0, fps: 25, playing: false,  // the video's frame count and rate (GET /api/video/info), the player
+  frameSeq: 0,      // answers to older frame requests are dropped
   points: [],       // [{name, x, y, z, u, v, own}] lengths in the experiment's unit, u v raw px
+  restored: [],     // the clicks of the saved scene (the same form), merged in by loadPoints
   active: 0,        // index of the point the next click places
   solution: null,   // the server's last answer to /api/scene/solve
   track: null,      // the server's last answer to /api/rows/<id>/track
@@ -52,6 +57,7 @@ function showRow(id) {
   const row = id === null ? null : rowOf(id);
   const video = row && row.video ? row.video : '';
   $('v-panel').hidden = !video;
+  $('v-detach').hidden = !video;
   $('t-accept').hidden = !V.track || V.track.row !== id;
   if (video === V.video) return;
   V.video = video;
@@ -61,7 +67,33 @@ function showRow(id) {
   $('t-strip').replaceChildren();
   $('s-result').replaceChildren();
   $('track-summary').textContent = '';
-  if (video) { loadFrame(); loadPoints(); }
+  V.playing = false;
+  V.frames = 0;
+  $('s-scrub').value = '0';
+  if (video) {
+    loadVideoInfo();
+    loadFrame();
+    restoreScene().then(loadPoints);
+  }
+}
+
+// The scene saved for this trial (its `scene` cell, else the one named in the form, else the
+// experiment's only scene): its clicks, marks and table height, as they were when it was saved.
+async function restoreScene() {
+  V.restored = [];
+  const row = rowOf(V.rowId);
+  const scenes = (S && S.experiment.scenes) || {};
+  const names = Object.keys(scenes);
+  let name = row && row.scene && scenes[row.scene] ? row.scene : $('s-name').value.trim();
+  if (!scenes[name]) name = names.length === 1 ? names[0] : '';
+  if (!name) return;
+  const { status, data } = await api('GET', `/api/scenes/${encodeURIComponent(name)}`);
+  if (status !== 200) return;
+  const tidy = (m) => String(Number(m.toPrecision(9)));  // 300 mm, not 300.00000000000006 from metres
+  $('s-name').value = name;
+  if (data.marks.length) $('s-marks').value = data.marks.map(tidy).join(', ');
+  if (data.table_z !== null) $('s-table').value = tidy(data.table_z);
+  V.restored = data.points.map((p) => ({ name: p.name, x: p.x, y: p.y, z: p.z, u: p.u, v: p.v, own: true }));
 }
 
 // ---- videos in the folder, attach, upload -------------------------------------------------------
@@ -108,6 +140,22 @@ function upload(file) {
     await attach(data.path);
   };
   xhr.send(file);
+}
+
+// Detaching: the row loses its video, and the file leaves the folder's list of videos (the server
+// moves it into .detached/ unless another trial uses it). The page cannot undo it: confirmed first.
+async function detach() {
+  const row = rowOf(V.rowId);
+  if (!row || !row.video) return;
+  if (!window.confirm(`Detach ${row.video} from trial ${row.trial}? The file is moved to the folder's .detached/ ` +
+    'folder (unless another trial uses it) and leaves the list of videos. This cannot be undone from the page.')) return;
+  const { status, data } = await api('POST', `/api/rows/${row.id}/detach`, { version: S.version });
+  if (status === 409) { applyState(data.state); showMessage(data.error, 'error'); return; }
+  if (status !== 200) { $('v-status').textContent = 'Not detached: ' + data.error; return; }
+  applyState(data.state);
+  savedStatus();
+  await loadVideoList();
+  $('v-status').textContent = `detached ${data.video}` + (data.moved_to ? `; the file is now ${data.moved_to}` : '');
 }
 
 // ---- camera -------------------------------------------------------------------------------------
@@ -170,28 +218,81 @@ async function calibrateCamera(ev) {
   }
 }
 
-// ---- the frame and the clicks -------------------------------------------------------------------
+// ---- the frame, the player and the clicks --------------------------------------------------------
+// The player replaces a frame-number box: play/pause and a scrubber over the video's frames.
+// While playing or dragging, frames come as JPEG (quick); the frame shown when it stops comes
+// as PNG, the exact pixels to click.
+function buildPlayer() {
+  const play = el('button', { type: 'button', id: 's-play', title: 'Play the video; pause it to click a frame' }, '▶ Play');
+  const scrub = el('input', { type: 'range', id: 's-scrub', min: '0', max: '0', step: '1', value: '0',
+    'aria-label': 'Frame of the video' });
+  const where = el('span', { id: 's-where', class: 'muted' }, '');
+  const player = el('span', { class: 'player' });
+  player.append(play, ' ', scrub, ' ', where);
+  $('s-frame').closest('label').replaceWith(player);
+}
+
 function frameNumber() {
-  const n = Number($('s-frame').value);
+  const n = Number($('s-scrub').value);
   return Number.isInteger(n) && n >= 0 ? n : 0;
 }
 
-function loadFrame() {
+// The video's frame count and rate, for the scrubber and for playing.
+async function loadVideoInfo() {
+  const video = V.video;
+  const { status, data } = await api('GET', `/api/video/info?video=${encodeURIComponent(video)}`);
+  if (status !== 200 || video !== V.video) return;
+  V.frames = data.frames;
+  if (data.fps > 0) V.fps = data.fps;
+  $('s-scrub').max = String(Math.max(0, data.frames - 1));
+  showWhere();
+}
+
+const showWhere = () => { $('s-where').textContent = `frame ${frameNumber() + 1} of ${V.frames || '?'} (${(frameNumber() / V.fps).toFixed(2)} s)`; };
+
+// Loads the scrubber's frame; false when it failed or a newer request overtook it.
+async function loadFrame(quick) {
+  const seq = ++V.frameSeq;
   const img = $('s-img');
-  img.onerror = async () => {
+  const url = `/api/video/frame?video=${encodeURIComponent(V.video)}&frame=${frameNumber()}` + (quick ? '&format=jpeg' : '');
+  const loaded = await new Promise((resolve) => {
+    img.onload = () => resolve(true);
+    img.onerror = () => resolve(false);
+    img.src = url;
+  });
+  if (seq !== V.frameSeq) return false;
+  if (!loaded) {
     // The server says why in JSON: ask again for the message.
-    const r = await fetch(img.src);
+    const r = await fetch(url);
     let msg = 'HTTP ' + r.status;
     try { msg = (await r.json()).error; } catch (e) { /* keep the status */ }
     $('s-result').replaceChildren(el('span', { class: 'error' }, msg));
-  };
-  img.onload = () => {
-    V.width = img.naturalWidth;
-    V.height = img.naturalHeight;
-    applyZoom();
-    drawOverlay();
-  };
-  img.src = `/api/video/frame?video=${encodeURIComponent(V.video)}&frame=${frameNumber()}`;
+    return false;
+  }
+  V.width = img.naturalWidth;
+  V.height = img.naturalHeight;
+  showWhere();
+  applyZoom();
+  drawOverlay();
+  return true;
+}
+
+async function togglePlay() {
+  if (V.playing) { V.playing = false; return; }
+  V.playing = true;
+  $('s-play').textContent = '⏸ Pause';
+  const scrub = $('s-scrub');
+  if (frameNumber() >= V.frames - 1) scrub.value = '0';
+  while (V.playing && frameNumber() < V.frames - 1) {
+    const started = performance.now();
+    scrub.value = String(frameNumber() + 1);
+    if (!await loadFrame(true)) break;
+    const wait = 1000 / V.fps - (performance.now() - started);  // real time, or as fast as frames decode
+    if (wait > 0) await new Promise((resolve) => setTimeout(resolve, wait));
+  }
+  V.playing = false;
+  $('s-play').textContent = '▶ Play';
+  await loadFrame(false);
 }
 
 function applyZoom() {
@@ -218,13 +319,14 @@ async function loadPoints() {
   if (status !== 200) { $('s-result').replaceChildren(el('span', { class: 'error' }, data.error)); return; }
   let saved = [];
   try { saved = JSON.parse(localStorage.getItem(clicksKey()) || '[]'); } catch (e) { saved = []; }
-  const before = new Map([...V.points, ...saved].map((p) => [p.name, p]));
+  const before = new Map([...V.restored, ...V.points, ...saved].map((p) => [p.name, p]));
   V.points = data.points.map((p) => {
     const old = before.get(p.name);
     return { name: p.name, x: p.x, y: p.y, z: p.z, u: old ? old.u : null, v: old ? old.v : null };
   });
   for (const p of before.values())
     if (p.own && !V.points.some((q) => q.name === p.name)) V.points.push(p);
+  V.restored = [];  // merged once: from now on the page's own clicks
   V.active = Math.max(0, V.points.findIndex((p) => p.u === null));
   renderPoints();
   solve();
@@ -234,14 +336,27 @@ function keepClicks() {
   try { localStorage.setItem(clicksKey(), JSON.stringify(V.points.filter((p) => p.u !== null || p.own))); } catch (e) { /* private mode */ }
 }
 
+// Sets style properties through the CSSOM (the page's Content-Security-Policy refuses style
+// attributes; properties set here are allowed, and override app.css).
+const styled = (node, style) => { Object.assign(node.style, style); return node; };
+
+// Which rail a point of the setting is on, as the apparatus frame says it: the left rail is at +y.
+const sideOf = (name) => (/\bleft\b/.test(name) ? ' (+y)' : /\bright\b/.test(name) ? ' (−y)' : '');
+
 function renderPoints() {
   const body = $('s-points').querySelector('tbody');
   body.replaceChildren();
   const d = lengthDecimals();
   const residual = new Map((V.solution ? V.solution.points : []).map((p) => [p.name, p.residual_px]));
   V.points.forEach((p, i) => {
-    const tr = el('tr', { class: i === V.active ? 'active' : '', dataset: { name: p.name } });
-    const pick = el('button', { type: 'button', class: 'pick', title: 'Click this point in the frame next' }, p.name);
+    const suspect = V.solution && V.solution.leave_one_out && V.solution.leave_one_out.explains &&
+      V.solution.leave_one_out.name === p.name;
+    const tr = styled(el('tr', { class: (i === V.active ? 'active' : '') + (suspect ? ' suspect' : ''), dataset: { name: p.name } }),
+      suspect ? { outline: '2px solid #d33' } : {});
+    const side = sideOf(p.name);
+    const pick = el('button', { type: 'button', class: 'pick', title: 'Click this point in the frame next' +
+      (side ? ': the left rail is the one at +y, on your left when you stand at O and look toward the crossbar' : '') },
+    p.name + side);
     pick.addEventListener('click', () => { V.active = i; renderPoints(); });
     const nameCell = el('td');
     nameCell.append(pick);
@@ -301,6 +416,12 @@ function clickedPoints() {
   return V.points.filter((p) => p.u !== null).map((p) => ({ name: p.name, u: p.u, v: p.v, x: p.x, y: p.y, z: p.z }));
 }
 
+// What the scene file keeps besides the clicks, and the points to show where the pose puts them.
+function sceneInputs() {
+  return { marks: marksList(), table_z: Number($('s-table').value) || 0,
+    unclicked: V.points.filter((p) => p.u === null).map((p) => ({ name: p.name, x: p.x, y: p.y, z: p.z })) };
+}
+
 async function solve() {
   const clicks = clickedPoints();
   const out = $('s-result');
@@ -312,7 +433,7 @@ async function solve() {
     return;
   }
   const seq = ++V.seq;
-  const { status, data } = await api('POST', '/api/scene/solve', { video: V.video, row: V.rowId, clicks });
+  const { status, data } = await api('POST', '/api/scene/solve', Object.assign({ video: V.video, row: V.rowId, clicks }, sceneInputs()));
   if (seq !== V.seq) return;
   if (status !== 200) {
     V.solution = null;
@@ -335,6 +456,10 @@ async function solve() {
   drawOverlay();
 }
 
+// Over the frame: each clicked point (a circle) with its name, where the pose puts it (a cross)
+// and its residual; the points not clicked yet where the pose expects them (a diamond, named);
+// the axes at O (+x toward the crossbar, +y toward the left rail); the model's path. The point
+// the leave-one-out check names is drawn in the error colour.
 function drawOverlay() {
   const layer = $('s-overlay');
   layer.replaceChildren();
@@ -343,26 +468,52 @@ function drawOverlay() {
   // Frame pixels per screen pixel: marks and labels keep their size on screen at every zoom.
   const scale = V.width / ($('s-stage').getBoundingClientRect().width || V.width);
   const r = 6 * scale;
-  if (V.solution) {
-    const path = V.solution.path.map(([u, v]) => `${u.toFixed(2)},${v.toFixed(2)}`).join(' ');
+  const colour = { axis: '#7cfc00', expected: '#ff9f1c', suspect: '#ff3b3b' };
+  const label = (x, y, text, cls) => {
+    const t = styled(svg('text', { x: x + r * 1.5, y: y - r, 'font-size': 12 * scale, class: cls }),
+      colour[cls] ? { fill: colour[cls] } : {});
+    t.textContent = text;
+    layer.append(t);
+  };
+  const solution = V.solution;
+  const loo = solution && solution.leave_one_out && solution.leave_one_out.explains ? solution.leave_one_out.name : null;
+  if (solution) {
+    const path = solution.path.map(([u, v]) => `${u.toFixed(2)},${v.toFixed(2)}`).join(' ');
     if (path) layer.append(svg('polyline', { class: 'path', points: path, 'stroke-width': 2 * scale }));
-    for (const p of V.solution.points) {
+    const o = solution.axes.find((a) => a.name === 'O');
+    for (const a of solution.axes)
+      if (o && a !== o) {
+        layer.append(styled(svg('line', { class: 'axis', x1: o.u, y1: o.v, x2: a.u, y2: a.v, 'stroke-width': 2 * scale }),
+          { stroke: colour.axis }));
+        label(a.u, a.v, a.name, 'axis');
+      }
+    for (const p of solution.expected) {
+      const s = 5 * scale;
+      layer.append(styled(svg('path', { class: 'expected', 'stroke-width': 1.5 * scale,
+        d: `M${p.u},${p.v - s}L${p.u + s},${p.v}L${p.u},${p.v + s}L${p.u - s},${p.v}Z` }), { fill: 'none', stroke: colour.expected }));
+      label(p.u, p.v, p.name + sideOf(p.name), 'expected');
+    }
+    for (const p of solution.points) {
       const s = 5 * scale;
       layer.append(svg('path', { class: 'model', 'stroke-width': 1.5 * scale,
         d: `M${p.u_model - s},${p.v_model - s}L${p.u_model + s},${p.v_model + s}M${p.u_model - s},${p.v_model + s}L${p.u_model + s},${p.v_model - s}` }));
-      const t = svg('text', { x: p.u + r * 1.5, y: p.v - r, 'font-size': 12 * scale });
-      t.textContent = `${p.residual_px.toFixed(2)} px`;
-      layer.append(t);
     }
   }
+  const residual = new Map((solution ? solution.points : []).map((p) => [p.name, p.residual_px]));
   for (const p of V.points)
-    if (p.u !== null) layer.append(svg('circle', { class: 'clicked', cx: p.u, cy: p.v, r, 'stroke-width': 1.5 * scale }));
+    if (p.u !== null) {
+      layer.append(styled(svg('circle', { class: p.name === loo ? 'clicked suspect' : 'clicked', cx: p.u, cy: p.v, r,
+        'stroke-width': 1.5 * scale }), p.name === loo ? { stroke: colour.suspect } : {}));
+      label(p.u, p.v, p.name + sideOf(p.name) + (residual.has(p.name) ? ` ${residual.get(p.name).toFixed(2)} px` : ''),
+        p.name === loo ? 'suspect' : 'clicked-label');
+    }
 }
 
 async function saveScene() {
   const clicks = clickedPoints();
   const name = $('s-name').value.trim() || 'main';
-  const result = await change('PUT', `/api/scenes/${encodeURIComponent(name)}`, { video: V.video, row: V.rowId, clicks });
+  const result = await change('PUT', `/api/scenes/${encodeURIComponent(name)}`,
+    Object.assign({ video: V.video, row: V.rowId, clicks }, sceneInputs()));
   if (result && result.error) { $('s-result').replaceChildren(el('span', { class: 'error' }, 'Not saved: ' + result.error)); return; }
   if (result && !result.conflict) showMessage(`Scene "${name}" saved as ${S.experiment.scenes[name]}`, 'info');
 }
@@ -422,6 +573,9 @@ async function acceptY() {
 }
 
 // ---- wiring ---------------------------------------------------------------------------------------
+buildPlayer();
+$('v-status').before(el('button', { type: 'button', id: 'v-detach', hidden: '', title: 'Detach the video from this trial' },
+  'Detach the video'), ' ');
 $('camera-form').addEventListener('submit', calibrateCamera);
 $('v-row').addEventListener('change', () => showRow($('v-row').value === 'new' ? null : Number($('v-row').value)));
 $('v-attach').addEventListener('click', () => attach($('v-file').value));
@@ -429,7 +583,10 @@ $('v-upload').addEventListener('change', () => upload($('v-upload').files[0]));
 $('cam-upload').addEventListener('change', () => uploadViews([...$('cam-upload').files]));
 $('s-img').addEventListener('click', frameClick);
 $('s-zoom').addEventListener('change', () => { applyZoom(); drawOverlay(); });
-$('s-frame').addEventListener('change', loadFrame);
+$('s-play').addEventListener('click', togglePlay);
+$('s-scrub').addEventListener('input', () => loadFrame(true));
+$('s-scrub').addEventListener('change', () => loadFrame(false));
+$('v-detach').addEventListener('click', detach);
 $('s-table').addEventListener('change', loadPoints);
 $('s-marks').addEventListener('change', loadPoints);
 $('s-add').addEventListener('click', addOwnPoint);
@@ -437,3 +594,6 @@ $('s-save').addEventListener('click', saveScene);
 $('t-run').addEventListener('click', track);
 $('t-accept').addEventListener('click', acceptY);
 loadVideoList();
+// app.js may have applied the first state before this script ran (its request can answer before
+// this file arrives, in a browser without a cache): show it now.
+if (S) onStateApplied();

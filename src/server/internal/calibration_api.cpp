@@ -38,6 +38,17 @@ double LengthIn(const json& j, const std::string& field, const std::string& unit
 
 double InUnit(double si, const std::string& unit) { return ToUnit(si, Dimension::kLength, unit); }
 
+constexpr std::size_t kMaxMarks = 20;  // marks on the rails a request may give
+
+// The marks' distances along the rails (metres) from a list of numbers in `unit`.
+std::vector<double> Marks(const json& list, const std::string& unit) {
+  if (!list.is_array() || list.size() > kMaxMarks)
+    throw InputError("marks", "must be a list of at most " + std::to_string(kMaxMarks) + " distances");
+  std::vector<double> marks;
+  for (const json& m : list) marks.push_back(LengthIn(m, "marks", unit));
+  return marks;
+}
+
 const Row* RowOf(const StoreSnapshot& snapshot, const json& id) {
   if (id.is_null()) return nullptr;
   if (!id.is_number_integer()) throw InputError("row", "must be a row id");
@@ -71,6 +82,33 @@ bool IsImageName(const std::string& name) {
   return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" || ext == ".tiff";
 }
 
+// The list body[key] of points {name, u, v, x, y, z} (u, v only `with_pixel`), lengths in `unit`.
+std::vector<ScenePoint> PointList(const json& body, const std::string& key, bool with_pixel, const std::string& unit) {
+  const json& list = body.value(key, json::array());
+  if (!list.is_array() || list.size() > 100) throw InputError(key, "must be a list of at most 100 points");
+  std::vector<ScenePoint> points;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const json& c = list[i];
+    const std::string field = key + "[" + std::to_string(i) + "]";
+    if (!c.is_object()) throw InputError(field, with_pixel ? "must be an object {name, u, v, x, y, z}" : "must be an object {name, x, y, z}");
+    ScenePoint p;
+    p.label = c.value("name", json("")).is_string() ? c.value("name", "") : "";
+    if (p.label.empty()) p.label = "point " + std::to_string(i + 1);
+    p.label = p.label.substr(0, 64);
+    if (with_pixel) {
+      for (const char* k : {"u", "v"})
+        if (!c.contains(k) || !c.at(k).is_number() || !std::isfinite(c.at(k).get<double>()))
+          throw InputError(field + "." + k, "must be a pixel coordinate (a number)");
+      p.pixel = {c.at("u").get<double>(), c.at("v").get<double>()};
+    }
+    p.position = {LengthIn(c.value("x", json()), p.label + ": x", unit),
+                  LengthIn(c.value("y", json()), p.label + ": y", unit),
+                  LengthIn(c.value("z", json()), p.label + ": z", unit)};
+    points.push_back(p);
+  }
+  return points;
+}
+
 }  // namespace
 
 std::string FolderFile(const ExperimentStore& store, const std::string& relative, const std::string& field) {
@@ -87,6 +125,28 @@ std::string FolderFile(const ExperimentStore& store, const std::string& relative
 EncodedFrame VideoFrame(const ExperimentStore& store, const std::string& video, int frame, bool jpeg,
                         DecodeBudget& budget, std::chrono::milliseconds wait) {
   return ReadVideoFrame(FolderFile(store, video, "video"), video, frame, jpeg, &budget, wait);
+}
+
+ordered_json VideoInfo(const ExperimentStore& store, const std::string& video) {
+  const VideoProbe probe = ProbeVideo(FolderFile(store, video, "video"), video);
+  return {{"video", video}, {"width", probe.width}, {"height", probe.height}, {"fps", probe.fps}, {"frames", probe.frames}};
+}
+
+void CheckSceneFits(const StoreSnapshot& s, std::string scene, const std::string& video, const VideoProbe& probe) {
+  const ordered_json& meta = s.state.metadata;
+  if (!meta.is_object() || !meta.contains("scenes")) return;
+  if (scene.empty() && meta.at("scenes").size() == 1) scene = meta.at("scenes").begin().key();
+  if (scene.empty() || !meta.at("scenes").contains(scene)) return;
+  const std::string path = meta.at("scenes").at(scene).get<std::string>();
+  const auto it = s.state.files.find(path);
+  if (it == s.state.files.end()) return;
+  const SceneCalibration calibration = ParseSceneFile(path, it->second);
+  if (calibration.camera.width != probe.width || calibration.camera.height != probe.height)
+    throw InputError("video", video + " is " + std::to_string(probe.width) + "×" + std::to_string(probe.height) +
+                                " px but the scene file " + path + " (scene \"" + scene + "\") is for " +
+                                std::to_string(calibration.camera.width) + "×" +
+                                std::to_string(calibration.camera.height) +
+                                " px: calibrate a scene for this video's camera setting");
 }
 
 ordered_json ListVideos(const ExperimentStore& store) {
@@ -119,9 +179,7 @@ ordered_json ScenePoints(const StoreSnapshot& snapshot, const json& query) {
   const double table_z = query.contains("table_z") ? LengthIn(query.at("table_z"), "table_z", unit) : 0.0;
   std::vector<double> marks;
   if (query.contains("marks")) {
-    if (!query.at("marks").is_array() || query.at("marks").size() > 20)
-      throw InputError("marks", "must be a list of at most 20 distances");
-    for (const json& m : query.at("marks")) marks.push_back(LengthIn(m, "marks", unit));
+    marks = Marks(query.at("marks"), unit);
   }
   std::vector<ApparatusPoint> points;
   std::string note;
@@ -152,26 +210,13 @@ ordered_json SolveScene(const ExperimentStore& store, const StoreSnapshot& snaps
   const std::string video = body.at("video").get<std::string>();
   const VideoProbe probe = ProbeVideo(FolderFile(store, video, "video"), video);
   const CameraIntrinsics camera = ExperimentCamera(snapshot);
-  const json& clicks = body.value("clicks", json::array());
-  if (!clicks.is_array() || clicks.size() > 100) throw InputError("clicks", "must be a list of at most 100 points");
-  std::vector<ScenePoint> points;
-  for (std::size_t i = 0; i < clicks.size(); ++i) {
-    const json& c = clicks[i];
-    const std::string field = "clicks[" + std::to_string(i) + "]";
-    if (!c.is_object()) throw InputError(field, "must be an object {name, u, v, x, y, z}");
-    ScenePoint p;
-    p.label = c.value("name", json("")).is_string() ? c.value("name", "") : "";
-    if (p.label.empty()) p.label = "point " + std::to_string(i + 1);
-    p.label = p.label.substr(0, 64);
-    for (const char* k : {"u", "v"})
-      if (!c.contains(k) || !c.at(k).is_number() || !std::isfinite(c.at(k).get<double>()))
-        throw InputError(field + "." + k, "must be a pixel coordinate (a number)");
-    p.pixel = {c.at("u").get<double>(), c.at("v").get<double>()};
-    p.position = {LengthIn(c.value("x", json()), p.label + ": x", unit),
-                  LengthIn(c.value("y", json()), p.label + ": y", unit),
-                  LengthIn(c.value("z", json()), p.label + ": z", unit)};
-    points.push_back(p);
-  }
+  SceneClicks request;
+  request.clicks = PointList(body, "clicks", true, unit);
+  if (body.contains("unclicked"))
+    for (const ScenePoint& p : PointList(body, "unclicked", false, unit)) request.unclicked.push_back({p.label, p.position});
+  if (body.contains("marks")) request.marks_x = Marks(body.at("marks"), unit);
+  if (body.contains("table_z")) request.table_z = LengthIn(body.at("table_z"), "table_z", unit);
+  const std::vector<ScenePoint>& points = request.clicks;
   std::optional<Scene> scene;
   if (const Row* row = RowOf(snapshot, body.value("row", json()))) {
     try {
@@ -182,7 +227,7 @@ ordered_json SolveScene(const ExperimentStore& store, const StoreSnapshot& snaps
   }
   SceneClicksSolution s;
   try {
-    s = SolveSceneClicks(camera, points, probe.width, probe.height, scene);
+    s = SolveSceneClicks(camera, request, probe.width, probe.height, scene);
   } catch (const InputError& e) {
     if (e.quantity() == "frame")
       throw InputError("video", video + " is " + std::to_string(probe.width) + "×" + std::to_string(probe.height) +
@@ -204,10 +249,24 @@ ordered_json SolveScene(const ExperimentStore& store, const StoreSnapshot& snaps
   for (const Eigen::Vector2d& p : s.centre_path) path.push_back({p.x(), p.y()});
   const Eigen::Vector3d centre = CameraCentre(s.calibration.scene.pose);
   if (scene_file) *scene_file = s.scene_file;
+  ordered_json leave_one_out = nullptr;
+  if (const auto& check = s.calibration.leave_one_out)
+    leave_one_out = {{"name", check->label},
+                     {"residual_px", check->residual_px},
+                     {"rms_without_px", check->rms_without_px},
+                     {"explains", check->explains}};
+  const auto pixels = [](const std::vector<ApparatusPoint>& list) {
+    ordered_json out = ordered_json::array();
+    for (const ApparatusPoint& p : list) out.push_back({{"name", p.name}, {"u", p.pixel.x()}, {"v", p.pixel.y()}});
+    return out;
+  };
   return {{"rms_px", s.calibration.rms_px},
           {"verdict", s.calibration.verdict},
           {"reasons", s.calibration.reasons},
+          {"leave_one_out", leave_one_out},
           {"points", out_points},
+          {"expected", pixels(s.expected)},
+          {"axes", pixels(s.axes)},
           {"path", path},
           {"camera_centre", {{"x", InUnit(centre.x(), unit)}, {"y", InUnit(centre.y(), unit)}, {"z", InUnit(centre.z(), unit)}}},
           {"unit", unit}};
@@ -224,6 +283,35 @@ ImageSize ProbeImage(const std::string& path, const std::string& name) {
   const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (image.empty()) throw InputError(name, not_image);
   return {image.cols, image.rows};
+}
+
+ordered_json SavedScene(const StoreSnapshot& snapshot, const std::string& name) {
+  SceneFilePath(name);  // the name's rule
+  const std::string& unit = snapshot.state.unit;
+  const ordered_json& meta = snapshot.state.metadata;
+  if (!meta.is_object() || !meta.contains("scenes") || !meta.at("scenes").contains(name))
+    throw InputError("name", "the experiment has no scene \"" + name + "\"");
+  const std::string path = meta.at("scenes").at(name).get<std::string>();
+  const auto it = snapshot.state.files.find(path);
+  if (it == snapshot.state.files.end())
+    throw InputError("name", "the scene file " + path + " is not in the experiment folder (or cannot be read)");
+  const SceneInputs inputs = ParseSceneInputs(path, it->second);
+  ordered_json points = ordered_json::array();
+  for (const ScenePoint& p : inputs.points)
+    points.push_back({{"name", p.label},
+                      {"u", p.pixel.x()},
+                      {"v", p.pixel.y()},
+                      {"x", InUnit(p.position.x(), unit)},
+                      {"y", InUnit(p.position.y(), unit)},
+                      {"z", InUnit(p.position.z(), unit)}});
+  ordered_json marks = ordered_json::array();
+  for (double m : inputs.marks_x) marks.push_back(InUnit(m, unit));
+  return {{"name", name},
+          {"path", path},
+          {"points", points},
+          {"marks", marks},
+          {"table_z", inputs.table_z ? ordered_json(InUnit(*inputs.table_z, unit)) : ordered_json(nullptr)},
+          {"unit", unit}};
 }
 
 std::string SceneFilePath(const std::string& name) {

@@ -24,6 +24,15 @@ std::string FolderFile(const ExperimentStore& store, const std::string& relative
 EncodedFrame VideoFrame(const ExperimentStore& store, const std::string& video, int frame, bool jpeg,
                         DecodeBudget& budget, std::chrono::milliseconds wait);
 
+// GET /api/video/info?video=P: {video, width, height, fps, frames} as the container states them
+// (app/video_frames.hpp ProbeVideo), for the page's player. Throws ProbeVideo's InputError.
+nlohmann::ordered_json VideoInfo(const ExperimentStore& store, const std::string& video);
+
+// A scene file that does not fit the video's size is refused when the video is attached (the
+// track would be wrong everywhere): the row's `scene`, or the experiment's only scene. Throws
+// InputError("video") naming both sizes, the scene and its file.
+void CheckSceneFits(const StoreSnapshot& snapshot, std::string scene, const std::string& video, const VideoProbe& probe);
+
 // GET /api/videos: {videos:[{path, bytes}]} the video files in the folder (by extension, at most
 // 3 folders deep, links not followed), sorted.
 nlohmann::ordered_json ListVideos(const ExperimentStore& store);
@@ -32,12 +41,22 @@ nlohmann::ordered_json ListVideos(const ExperimentStore& store);
 // points of the row's setting (app/scene_clicks.hpp), or only O when the row gives no L, H, D.
 nlohmann::ordered_json ScenePoints(const StoreSnapshot& snapshot, const nlohmann::json& query);
 
-// POST /api/scene/solve {video, frame?, row?, clicks:[{name,u,v,x,y,z}]}: the pose from the
-// clicks (app/scene_clicks.hpp) with the experiment's camera file:
-// {rms_px, verdict, reasons, points:[{name,u,v,u_model,v_model,residual_px}], path:[[u,v]...],
-//  camera_centre:{x,y,z}}. `scene_file` (optional) receives the scene file's text.
+// POST /api/scene/solve {video, frame?, row?, clicks:[{name,u,v,x,y,z}], unclicked?:[{name,x,y,z}],
+// marks?:[x...], table_z?}: the pose from the clicks (app/scene_clicks.hpp) with the experiment's
+// camera file: {rms_px, verdict, reasons, leave_one_out:{name, residual_px, rms_without_px,
+// explains} or null (vision/calibration.hpp), points:[{name,u,v,u_model,v_model,residual_px}],
+// expected:[{name,u,v}] (the unclicked points in view), axes:[{name,u,v}] (O, +x, +y in view),
+// path:[[u,v]...], camera_centre:{x,y,z}}. `scene_file` (optional) receives the scene file's text, which keeps
+// the clicks, the marks and the table's height.
 nlohmann::ordered_json SolveScene(const ExperimentStore& store, const StoreSnapshot& snapshot,
                                   const nlohmann::json& body, std::string* scene_file = nullptr);
+
+// GET /api/scenes/NAME: what the saved scene `name` was solved from, for the page to restore:
+// {name, path, points:[{name,u,v,x,y,z}], marks:[x...], table_z (null: not kept), unit}; a scene
+// file that keeps none of it gives empty lists. Throws InputError("name") when the experiment
+// has no such scene, its name breaks SceneFilePath's rule or its file is not there; the file's own
+// InputError when it is malformed.
+nlohmann::ordered_json SavedScene(const StoreSnapshot& snapshot, const std::string& name);
 
 // The scene's file in the folder: calibration/scene-<name>.json. Throws InputError("name")
 // unless the name is 1 to 32 letters, digits, '-' or '_'.

@@ -2,12 +2,15 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <optional>
 
 #include "app/video_frames.hpp"
 #include "app/video_trials.hpp"
 #include "io/experiment.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
+#include "video_upload.hpp"
 
 namespace uphill::internal {
 namespace {
@@ -115,6 +118,49 @@ RestAsY RowRestAsY(const ExperimentStore& store, const StoreSnapshot& snapshot, 
   const std::string& unit = snapshot.state.unit;
   return {Number(ToUnit(r.trial.rest->value, Dimension::kLength, unit)),
           r.trial.rest->u ? Number(ToUnit(*r.trial.rest->u, Dimension::kLength, unit)) : ""};
+}
+
+namespace {
+
+// The file `video` moved into kDetachedVideoFolder unless a row of `after` names it; its new path,
+// or "" when left in place (still used, or already gone).
+std::string SetDetachedVideoAside(const ExperimentStore& store, const StoreSnapshot& after, const std::string& video) {
+  for (const Row& row : after.state.rows)
+    if (row.video == video) return "";  // another trial films the same recording
+  const ContainedDirectory* folder = store.folder();
+  if (!folder || KindInFolder(*folder, video, "video") != ContainedDirectory::Kind::kFile) return "";
+  const std::filesystem::path path(video);
+  std::optional<ContainedDirectory> subfolder;
+  if (path.has_parent_path()) subfolder.emplace(folder->Subdirectory(path.parent_path().generic_string(), false));
+  const ContainedDirectory& from = subfolder ? *subfolder : *folder;
+  const ContainedDirectory aside = folder->Subdirectory(kDetachedVideoFolder, true);
+  std::string target = path.filename().string();
+  for (int n = 2; aside.KindOf(target) != ContainedDirectory::Kind::kAbsent; ++n)
+    target = path.stem().string() + "-" + std::to_string(n) + path.extension().string();
+  from.MoveFile(path.filename().string(), aside, target);
+  return std::string(kDetachedVideoFolder) + "/" + target;
+}
+
+}  // namespace
+
+DetachedVideo DetachRowVideo(ExperimentStore& store, std::int64_t version, std::int64_t id, std::mutex& track_mutex) {
+  const StoreSnapshot s = store.Get();
+  const int index = s.state.IndexOf(id);
+  if (index < 0) throw InputError("row", "row " + std::to_string(id) + " does not exist");
+  const Row& old = s.state.rows[index];
+  if (old.video.empty()) throw InputError("video", "trial " + old.trial + " has no video to detach");
+  ordered_json row = ToJson(old);
+  row.erase("video");
+  if (!row.contains("Y"))
+    throw InputError("video", "trial " + old.trial +
+                                  " has no Y: without its video it would measure nothing (type its Y first, or delete "
+                                  "the trial)");
+  DetachedVideo out;
+  out.video = old.video;
+  out.after = store.EditRow(version, id, row);
+  std::lock_guard lock(track_mutex);
+  out.moved_to = SetDetachedVideoAside(store, out.after, out.video);
+  return out;
 }
 
 }  // namespace uphill::internal

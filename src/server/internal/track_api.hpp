@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -25,5 +26,22 @@ struct RestAsY {
   std::string y, u_y;
 };
 RestAsY RowRestAsY(const ExperimentStore& store, const StoreSnapshot& snapshot, std::int64_t id);
+
+// The folder where detached videos are kept: hidden, so that GET /api/videos (which skips folders
+// starting with '.') no longer lists them, and no video of the experiment is ever deleted.
+inline constexpr const char* kDetachedVideoFolder = ".detached";
+
+// POST /api/rows/<id>/detach: empties the row's video cell (a journaled edit, against `version`),
+// then, holding `track_mutex` (no track reads the file meanwhile), moves the file into
+// kDetachedVideoFolder (as its file name, "-2", "-3"... before the extension when taken) unless
+// another row still names it. Throws InputError for a row that does not exist, has no video, or
+// has no Y (without its video it would measure nothing), VersionConflict as the store, and
+// EnvironmentError when the move fails (the row is then detached, the file still listed).
+struct DetachedVideo {
+  std::string video;     // the path the row named
+  std::string moved_to;  // the file's new path in the folder, "" when left in place (still used)
+  StoreSnapshot after;   // the state with the cell emptied
+};
+DetachedVideo DetachRowVideo(ExperimentStore& store, std::int64_t version, std::int64_t id, std::mutex& track_mutex);
 
 }  // namespace uphill::internal
