@@ -11,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 #include <random>
 
+#include "bench/baseline_edge_tracker.hpp"
 #include "bench/results_document.hpp"
 #include "bench/track_random_draw.hpp"
 #include "footage/footage_clip.hpp"
@@ -168,19 +169,11 @@ TrackerOutput TrackWithCore(const DecodedClip& clip) {
 TrackerOutput TrackWithBaseline(const DecodedClip& clip) {
   TrackerOutput out;
   try {
-    BallTracker tracker(clip.scene, clip.calibration, OptionsFor(clip));
-    const auto revise = [&] {
-      for (const auto& [k, b] : tracker.TakeRevisions())
-        if (k >= 0 && k < static_cast<long>(out.frames.size()))
-          out.frames[k] = {b.found, b.u, b.v, NAN, b.x, k / clip.fps + b.time_offset};
-    };
+    BaselineEdgeTracker tracker(clip.scene, clip.calibration);
     for (size_t k = 0; k < clip.frames.size(); ++k) {
-      const BallObservation b = tracker.Track(clip.frames[k]);
-      revise();
-      out.frames.push_back({b.found, b.u, b.v, NAN, b.x, k / clip.fps + b.time_offset});
+      const BaselineObservation b = tracker.Track(clip.frames[k]);
+      out.frames.push_back({b.found, b.u, b.v, NAN, b.x, k / clip.fps});
     }
-    tracker.Finish();
-    revise();
   } catch (const InputError& e) {
     out.frames.clear();
     out.refusal = e.what();

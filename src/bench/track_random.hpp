@@ -54,7 +54,7 @@ using ClipTracker = std::function<TrackerOutput(const DecodedClip&)>;
 
 // "core": `uphill track`'s path (TrackVideo on the file, the sidecar written and read back).
 TrackerOutput TrackWithCore(const DecodedClip& clip);
-// "baseline": vision::BallTracker fed the decoded frames (until vision exposes a baseline tracker).
+// "baseline": the edge-fit tracker of bench/baseline_edge_tracker.hpp fed the decoded frames.
 TrackerOutput TrackWithBaseline(const DecodedClip& clip);
 
 struct TrackRandomOptions {

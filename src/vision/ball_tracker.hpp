@@ -82,7 +82,7 @@
 // the fitted smear against the track's speed (ExposureEstimate()).
 //
 // Accuracy (tests/vision_track_test.cpp, tests/vision_povray_test.cpp, `uphill bench track`):
-// see docs/track.md for the measured table; the camera and scene calibration's own errors add to
+// see docs/track.md, "Accuracy"; the camera and scene calibration's own errors add to
 // these on real video.
 //
 // Hard cases: the near rail hides the lower edge (masked); the body leaves the frame or drops

@@ -85,7 +85,7 @@ struct FitRequest {
   // iteration: from a coarse search 3 (more add nothing; fewer can stop on a wrong place under a
   // rolling shutter's shear); a narrow pass after a coarse search in 2; a
   // pass started within half a pixel or so, at a fit of the same frame or a checked prediction,
-  // in 1 (ball_tracker.cpp; docs/track.md, "The fit's Jacobian").
+  // in 1 (ball_tracker.cpp).
   int iterations = 3;
 };
 

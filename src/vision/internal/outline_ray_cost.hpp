@@ -22,7 +22,7 @@ namespace uphill::internal {
 inline constexpr double kEdgeShiftPriorPx = 0.3;
 // σ of the background's factor along a ray (its level and its tilt): the body's soft shadow and
 // uneven light. A factor free to tilt along the ray takes up part of an edge's position, so it is
-// held tightly (docs/track.md, "The fit's Jacobian").
+// held tightly.
 inline constexpr double kShadowPrior = 0.01;
 inline constexpr double kRayLossFactor = 1.5;  // Cauchy scale: this many times a good ray's χ²
 // A smear longer than this many radii is fitted with the body's shading (body_shading.hpp).

@@ -1,7 +1,7 @@
 // The ball tracker's thresholds (ball_tracker.cpp and the tracker_*.cpp files beside it), in one
 // place, each with the reason for its value. Pixels are raw image pixels; "noise" is a sample's
-// residual RMS in linear units (outline_fit.hpp). The values were chosen on rendered footage
-// (docs/track.md, "How the tracker was checked"); docs/benchmarks.md gives what they measure.
+// residual RMS in linear units (outline_fit.hpp). The values were chosen on rendered footage;
+// `uphill bench track` measures what they give (docs/bench.md; its results: docs/benchmarks.md).
 #pragma once
 
 #include <cstddef>
