@@ -222,6 +222,14 @@ TEST_F(DefaultView, InitialGuessAndLostBallKeepTheirRows) {
   const nlohmann::json side = nlohmann::json::parse(side_in);
   EXPECT_EQ(side["format"], "uphill-track/1");
   EXPECT_EQ(side["partial"], true);
+  // The models the clip needed: no readout given or asked for, and every found frame measured by
+  // one of the two measurements (the rows' own flags are the truth).
+  EXPECT_EQ(side["models"]["rolling_shutter"], "global");
+  int by_model = 0, found = 0;
+  for (const TrackRow& r : track.rows) by_model += r.ball.found && r.ball.full_model, found += r.ball.found;
+  EXPECT_EQ(side["models"]["frames_by_outline_model"], by_model);
+  EXPECT_EQ(side["models"]["frames_by_edge_fit"], found - by_model);
+  EXPECT_EQ(side["frames_with_ball"], found);
 }
 
 // Paints the upper half (in the picture) of a sphere of radius r centred at c dark, up to

@@ -209,6 +209,7 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
     result.measured_exposure_frames = e->frames;
   }
   result.readout = tracker_options.readout;
+  result.readout_asked = tracker_options.measure_readout;
   if (const auto r = tracker.ReadoutEstimate()) {
     result.readout = r->seconds;
     result.measured_readout_frames = r->frames;
@@ -316,20 +317,17 @@ void WriteTrack(const std::string& csv_path, const TrackResult& result, const Tr
   }
   if (!result.exposure_changes.empty()) side["exposure_changes_at_frames"] = result.exposure_changes;
   // The models the clip needed, as chosen from it (ball_tracker.hpp, "Model only what the scene
-  // needs"), each with the flag that overrides it.
+  // needs"); the flags that override each: docs/track.md, "Output".
   int outline_model = 0;
   for (const TrackRow& r : result.rows) outline_model += r.ball.found && r.ball.full_model;
   side["models"] = {
-      {"exposure", result.exposure ? "given (--exposure)"
-                   : result.measured_exposure ? "measured from the smear against the speed (--exposure overrides)"
-                                              : "not measured: half the frame time assumed (--exposure overrides)"},
-      {"rolling_shutter", result.measured_readout_frames > 0 ? "measured from the outline's shear (--readout overrides)"
-                          : result.readout > 0                 ? "given (--readout)"
-                                                               : "global shutter (--readout sets a readout, auto measures it)"},
+      {"exposure", result.exposure ? "given" : result.measured_exposure ? "measured" : "assumed half a frame"},
+      {"rolling_shutter", result.measured_readout_frames > 0 ? "measured"
+                          : result.readout > 0               ? "given"
+                          : result.readout_asked             ? "not measurable (too little shear): global assumed"
+                                                             : "global"},
       {"frames_by_edge_fit", found - outline_model},
-      {"frames_by_outline_model", outline_model},
-      {"outline_model_means", "the background learnt from the clip, the body's colours per ray, the smear over the "
-                              "exposure; the edge fit is used where it agrees with it"}};
+      {"frames_by_outline_model", outline_model}};
   if (result.partial) side["partial_reason"] = result.partial_reason;
   OutputPaths::CreateFolders(std::filesystem::path(csv_path).parent_path().string());
   WriteFileAtomically(csv_path, csv.str());

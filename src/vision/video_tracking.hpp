@@ -54,6 +54,7 @@ struct TrackResult {
   int measured_exposure_frames = 0;
   double readout = 0;  // as used: given, or measured (measured_readout_frames > 0)
   int measured_readout_frames = 0;
+  bool readout_asked = false;       // --readout auto: to be measured (it may not have been)
   std::optional<double> readout_u;  // s, the measured readout's standard uncertainty
   int image_height = 0;             // px, the rows the readout spans
   VideoTransfer transfer = VideoTransfer::kSrgb;
