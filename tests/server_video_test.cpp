@@ -530,6 +530,28 @@ TEST_F(TrackApiTest, RestPositionBecomesY) {
   Stop();
   Start();
   EXPECT_EQ(State()["rows"][0]["Y"], state["rows"][0]["Y"]);
+
+  // The typed Y against the video's, by the report's rule (|typed − video| > 3σ, σ the combined
+  // standard uncertainty): the accepted Y agrees; one typed 40 mm off (the recording of another
+  // setting attached to the trial) is flagged, with a warning, before it could be accepted.
+  auto [again_status, again] = Send("POST", "/api/rows/" + std::to_string(id) + "/track", json::object());
+  ASSERT_EQ(again_status, 200) << again.dump();
+  ASSERT_TRUE(again["typed_y"].is_object()) << again.dump();
+  EXPECT_FALSE(again["typed_y"]["flagged"].get<bool>());
+  EXPECT_NEAR(again["typed_y"]["difference"].get<double>(), 0, 1e-3);
+  json off = State()["rows"][0];
+  off.erase("check");
+  off.erase("id");
+  off["Y"] = std::to_string(std::stod(off["Y"].get<std::string>()) + 40);
+  auto [edited, edited_state] = Send("PUT", "/api/rows/" + std::to_string(id), {{"version", State()["version"]}, {"row", off}});
+  ASSERT_EQ(edited, 200) << edited_state.dump();
+  auto [flagged_status, flagged] = Send("POST", "/api/rows/" + std::to_string(id) + "/track", json::object());
+  ASSERT_EQ(flagged_status, 200) << flagged.dump();
+  EXPECT_TRUE(flagged["typed_y"]["flagged"].get<bool>()) << flagged.dump();
+  EXPECT_NEAR(flagged["typed_y"]["difference"].get<double>(), 40, 1e-3);
+  bool warned = false;
+  for (const json& w : flagged["warnings"]) warned |= w.get<std::string>().find("differ by 40") != std::string::npos;
+  EXPECT_TRUE(warned) << flagged["warnings"].dump();
 }
 
 TEST_F(TrackApiTest, NoRestNoY) {

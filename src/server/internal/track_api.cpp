@@ -10,6 +10,8 @@
 #include "io/experiment.hpp"
 #include "io/units.hpp"
 #include "model/input_error.hpp"
+#include "report/video_trials.hpp"
+#include "server/row_check.hpp"
 #include "video_upload.hpp"
 
 namespace uphill::internal {
@@ -92,6 +94,25 @@ ordered_json TrackRowVideo(const ExperimentStore& store, const StoreSnapshot& sn
     out["fit"] = {{"text", "not available: " + t.fit_unavailable}};
   }
   out["warnings"] = t.notes;
+  // A Y typed in the row is compared with the video's, by the report's rule (CompareY): a video
+  // of another setting attached to the trial shows here, before its Y is accepted.
+  const Row& row = snapshot.state.rows[static_cast<std::size_t>(RowIndex(snapshot, id))];
+  const RowCheck check = CheckRow(snapshot.state, row);
+  out["typed_y"] = nullptr;
+  if (t.rest && t.rest->u && check.y) {
+    const YComparison c = CompareY(*check.y, check.u_y.value_or(0), t.rest->value, *t.rest->u);
+    out["typed_y"] = {{"typed", L(c.typed)}, {"video", L(c.video)}, {"difference", L(c.difference)},
+                      {"sigma", L(c.sigma)}, {"flagged", c.flagged}};
+    if (c.flagged) {
+      char text[300];
+      std::snprintf(text, sizeof text,
+                    "the typed Y = %.6g %s and the video's rest position %.6g %s differ by %.3g %s, more than 3 "
+                    "combined standard uncertainties (%.2g %s): is this the trial's recording, and its scene?",
+                    L(c.typed), unit.c_str(), L(c.video), unit.c_str(), L(c.difference), unit.c_str(), L(c.sigma),
+                    unit.c_str());
+      out["warnings"].push_back(text);
+    }
+  }
   out["width"] = probe.width;
   out["height"] = probe.height;
   ordered_json strip = ordered_json::array();
