@@ -1,7 +1,9 @@
 // The baseline beside the tracker in `uphill bench track --random`: the edge-fit tracker as it
 // stood before the appearance and smear models were added (the project's commit efef5cc), kept
 // whole so that every benchmark run measures the tracker against the simplest method that
-// worked. It is not a product: nothing but the benchmark links it.
+// worked. It is not a product: nothing but the benchmark links it. Its outline geometry, edge
+// search and near-rail mask repeat what src/vision grew from them, on purpose: sharing that code
+// would move the baseline whenever the tracker changes.
 //
 // What it does: grey-level gradient edges along rays across the outline predicted at the last
 // positions (constant acceleration over three frames), a Cauchy-robust Ceres fit of the centre
