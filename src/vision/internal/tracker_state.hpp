@@ -189,10 +189,15 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // A fit is a body when enough rays agree with it, the body stands out of the background by
   // several noise levels, and its inlier rays fit within a few noise levels. `agreement`: the
   // share of the fitted rays that must be inliers (less near the prediction, where a painted
-  // body's band or the rails may cost rays, than for a body found anew).
+  // body's band or the rails may cost rays, than for a body found anew). Before any frame was
+  // accepted the clip's noise is not known (`noise` is a guess, and a 1080p phone clip's is three
+  // times it): the levels are then the fit's own residual RMS, so that a body found where it is
+  // is not refused for the guess.
   bool Accept(const FitOutcome& f, double agreement) const {
+    const double level = noises.empty() ? std::max(noise, f.noise) : noise;
+    const double misfit = f.misfit * noise / level;
     return f.ok && f.inliers >= std::max(10.0, 0.25 * options.rays) && f.inliers >= agreement * f.rays_fitted &&
-           f.contrast >= options.min_contrast && f.contrast >= 6 * noise && f.misfit < 3;
+           f.contrast >= options.min_contrast && f.contrast >= 6 * level && misfit < 3;
   }
 
   // Two passes: around the guess with the given half width, then narrow around the first fit
