@@ -184,6 +184,7 @@ void RunTrackBenchmark(const TrackBenchmarkOptions& f, std::ostream& out) {
     random.cache = f.random_cache;
     random.fresh = f.fresh;
     random.json = f.json;
+    random.only = f.draw_ids;
     return RunTrackRandom(random, out);
   }
   std::unique_ptr<TrackMatrixRecord> matrix;

@@ -30,6 +30,7 @@ struct TrackBenchmarkOptions {
   std::optional<std::uint64_t> seed;    // unset: a new seed each run (printed)
   std::string random_cache = "/tmp/uphill-bench-random";
   std::string json;                     // --json FILE: the random scenes' results
+  std::vector<std::string> draw_ids;    // --draw ID...: only these of the N draws
 };
 
 void RunTrackBenchmark(const TrackBenchmarkOptions& options, std::ostream& out);

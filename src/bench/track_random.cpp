@@ -13,6 +13,7 @@
 
 #include "bench/baseline_edge_tracker.hpp"
 #include "bench/results_document.hpp"
+#include "bench/track_random_analysis.hpp"
 #include "bench/track_random_draw.hpp"
 #include "footage/footage_clip.hpp"
 #include "io/atomic_file.hpp"
@@ -114,6 +115,12 @@ double Quantile(std::vector<double> values, double p) {
   return values[std::min(values.size() - 1, rank == 0 ? 0 : rank - 1)];
 }
 
+ordered_json AnalysisJson(const AnalysisScore& a) {
+  ordered_json pulls = ordered_json::array();
+  for (const AnalysisPull& p : a.pulls) pulls.push_back({{"name", p.name}, {"error", p.error}, {"u", p.u}});
+  return {{"kind", a.kind}, {"pulls", pulls}};
+}
+
 ordered_json ScoreJson(const Score& s) {
   const auto number = [](double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(); };
   return {{"px_rms", number(s.px_rms)},   {"px_p95", number(s.px_p95)},         {"mm_rms_x", number(s.mm_rms)},
@@ -132,7 +139,21 @@ struct Draw {
   RandomScene scene;
   FootageFiles files;
   Score core, baseline;
+  AnalysisScore analysis;  // of the core's track
 };
+
+// A pull's value in the unit the lab reads: mm, ms, m/s², or μ as is.
+std::string PullText(const AnalysisPull& p) {
+  const double scale = p.name == "Y" || p.name == "x0" ? 1e3 : p.name == "t0" ? 1e3 : 1;
+  const char* unit = p.name == "Y" || p.name == "x0" ? " mm" : p.name == "t0" ? " ms" : p.name == "g" ? " m/s2" : "";
+  return p.name + Fixed(" %+.4g", p.error * scale) + unit + Fixed(" ± %.2g", p.u * scale) + Fixed(" (pull %+.2f)", p.Pull());
+}
+
+std::string AnalysisText(const AnalysisScore& a) {
+  std::string text = "  analyse-track: " + a.kind;
+  for (size_t i = 0; i < a.pulls.size(); ++i) text += (i ? ", " : ": ") + PullText(a.pulls[i]);
+  return text + "\n";
+}
 
 std::vector<std::string> Cells(const std::string& tracker, const Score& s) {
   return {tracker,
@@ -200,6 +221,7 @@ void RunTrackRandom(const TrackRandomOptions& o, std::ostream& out) {
   for (int k = 0; k < o.draws; ++k) {
     Draw d;
     d.scene = DrawRandomScene(DrawSeed(seed, k));
+    if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), d.scene.id) == o.only.end()) continue;
     const FootageCondition& c = d.scene.condition;
     out << "draw " << d.scene.id << ": " << d.scene.Summary() << "\n" << std::flush;
     FootageProgress progress;
@@ -216,7 +238,8 @@ void RunTrackRandom(const TrackRandomOptions& o, std::ostream& out) {
                      c.shutter.readout > 0, work.string()};
     d.core = ScoreOf(o.core(clip), truth, motion, c.release_time);
     d.baseline = ScoreOf(o.baseline(clip), truth, motion, c.release_time);
-    if (k == 0) table.Start(out);
+    d.analysis = ScoreAnalysis((work / "core.csv").string(), c);
+    if (draws.empty()) table.Start(out);
     std::vector<std::string> row = Cells("core", d.core);
     row.insert(row.begin(), d.scene.id);
     table.Add(row);
@@ -224,7 +247,7 @@ void RunTrackRandom(const TrackRandomOptions& o, std::ostream& out) {
     row.insert(row.begin(), "");
     table.Add(row);
     out << Fixed("  (rendered in %.0f s", d.files.render_wall_seconds) << Fixed(", %.0f CPU s", d.files.render_cpu_seconds)
-        << (d.files.from_cache ? ", from the cache)\n" : ")\n") << std::flush;
+        << (d.files.from_cache ? ", from the cache)\n" : ")\n") << AnalysisText(d.analysis) << std::flush;
     json_draws.push_back({{"id", d.scene.id},
                           {"seed", d.scene.seed},
                           {"scene", d.scene.Summary()},
@@ -232,7 +255,8 @@ void RunTrackRandom(const TrackRandomOptions& o, std::ostream& out) {
                           {"render_wall_s", d.files.render_wall_seconds},
                           {"render_cpu_s", d.files.render_cpu_seconds},
                           {"core", ScoreJson(d.core)},
-                          {"baseline", ScoreJson(d.baseline)}});
+                          {"baseline", ScoreJson(d.baseline)},
+                          {"analysis", AnalysisJson(d.analysis)}});
     draws.push_back(std::move(d));
   }
 
@@ -256,6 +280,32 @@ void RunTrackRandom(const TrackRandomOptions& o, std::ostream& out) {
                      {"frames_in_view", in_view}, {"frames_found", found}, {"silent_wrong", wrong},
                      {"refused", refused}};
   }
+  // analyse-track over the draws: per quantity, the draws scored, those within 3 stated u, and
+  // the RMS pull; a rest position's |error| too (the goal: 0.02 mm on a sharp clip).
+  std::map<std::string, std::vector<double>> pulls;
+  std::vector<double> rest_mm;
+  int unscored = 0;
+  for (const Draw& d : draws) {
+    unscored += d.analysis.pulls.empty();
+    for (const AnalysisPull& p : d.analysis.pulls) {
+      pulls[p.name].push_back(p.Pull());
+      if (p.name == "Y") rest_mm.push_back(std::abs(p.error) * 1e3);
+    }
+  }
+  out << "  analyse-track on the core's tracks (pull = (fitted - true)/stated u): ";
+  ordered_json pull_summary;
+  for (const auto& [name, values] : pulls) {
+    int within = 0;
+    double sum = 0;
+    for (double v : values) within += std::abs(v) <= 3, sum += std::isfinite(v) ? v * v : 0;
+    const double rms = std::sqrt(sum / values.size());
+    out << name << " " << within << "/" << values.size() << " within 3u, RMS pull " << Fixed("%.2f", rms) << "; ";
+    pull_summary[name] = {{"draws", values.size()}, {"within_3u", within}, {"rms_pull", rms}};
+  }
+  out << "rest |Y error| median " << Fixed("%.4f mm", Quantile(rest_mm, 0.5)) << ", max "
+      << Fixed("%.4f mm", Quantile(rest_mm, 1.0)) << "; " << unscored << " draws without pulls\n";
+  summary["analysis"] = {{"pulls", pull_summary}, {"rest_error_mm_median", Quantile(rest_mm, 0.5)},
+                         {"draws_without_pulls", unscored}};
   std::vector<double> diff;
   const Draw* worst = nullptr;
   for (const Draw& d : draws) {

@@ -63,6 +63,7 @@ struct TrackRandomOptions {
   std::string cache = "/tmp/uphill-bench-random";
   bool fresh = false;                 // render again
   std::string json;                   // "" = no JSON file
+  std::vector<std::string> only;      // non-empty: only the draws with these ids (to replay one)
   ClipTracker core = TrackWithCore, baseline = TrackWithBaseline;
 };
 

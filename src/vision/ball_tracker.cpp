@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <opencv2/imgproc.hpp>
 
 #include "internal/tracker_state.hpp"
@@ -187,7 +188,10 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
   if (m.scene_changed_at) return {};
 
   // A frame the model measured. `acquired`: the body was found anew (not near the prediction).
-  auto finish = [&](const FitOutcome& fit, const FitRequest& q, bool acquired) {
+  // `outline`: an edge fit that found a body at rest all round where the model, without the
+  // background, put it elsewhere (the acquisition below); it measures the frame.
+  auto finish = [&](const FitOutcome& fit, const FitRequest& q, bool acquired,
+                    const std::optional<internal::EdgeFitOutcome>& outline = std::nullopt) {
     const bool needs_model_before = m.needs_model;
     BallObservation o = m.Observe(fit, q);
     m.light_inverse_distance = fit.light_inverse_distance;
@@ -212,7 +216,13 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
     // fast path (grey contrast, no pattern near the outline: it agrees with the model); where the
     // background under the body was never seen it stands in for the model until it is.
     bool edge_fallback = false;
-    if (acquired || fit.rays_without_background > 0) {
+    if (outline) {
+      m.needs_model = true;  // the edge fit and the model disagree: not a clip for the fast path
+      const double offset = o.time_offset;
+      o = m.ObserveEdges(*outline);
+      o.time_offset = offset;
+      edge_fallback = true;
+    } else if (acquired || fit.rays_without_background > 0) {
       if (acquired) m.edges->Reset();
       const internal::EdgeFitOutcome e = m.edges->Measure(frame, o.x, o.z, kNarrowHalfWidthPx + 1);
       const double apart = e.ok ? (m.geometry.Project(e.x, e.z) - Vector2d(o.u, o.v)).norm() : 1e9;
@@ -223,8 +233,24 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
         o = m.ObserveEdges(e);
         o.time_offset = offset;
         edge_fallback = true;
+      } else if (fit.rays_without_background > 0 &&
+                 (m.geometry.Project(q.centre.x(), q.centre.y()) - m.geometry.Project(m.found_at.x(), m.found_at.y())).norm() < kAtRestPx) {
+        // A body at rest whose background was never seen: the model has only the body's inside
+        // to go by, and a print (stripes, dots) can hold its outline off the body. The contrast
+        // at the outline alone then measures it, where it finds a clean outline that the
+        // model's misses, still where the body was found (and predicted there).
+        const internal::EdgeFitOutcome w = m.edges->Measure(frame, o.x, o.z, 2 * m.options.search_half_width_px);
+        const Vector2d at = m.geometry.Project(w.x, w.z);
+        if (m.CleanOutline(w) && (at - Vector2d(o.u, o.v)).norm() > kFastMaxDisagreementPx &&
+            (at - m.geometry.Project(m.found_at.x(), m.found_at.y())).norm() < kAtRestPx) {
+          const double offset = o.time_offset;
+          o = m.ObserveEdges(w);
+          o.time_offset = offset;
+          edge_fallback = true;
+        }
       }
     }
+    if (acquired) m.found_at = Vector2d(o.x, o.z);
     m.LearnShading(frame, o, q.velocity);
     m.Remember(f, t, o);
     if (m.history.size() == 1 && fit.rays_without_background > 0) {
@@ -239,7 +265,8 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
     // by the fast path): a still scene's background needs no more looks than that, normalised by
     // each frame's gain.
     if (m.scene_suspect == 0) {
-      const cv::Rect body = m.BodyRegion(Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]), smear);
+      const Vector2d held = edge_fallback ? Vector2d(o.x, o.z) : Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
+      const cv::Rect body = m.BodyRegion(held, smear);
       const int reach = static_cast<int>(std::ceil(2 * m.RadiusPx(o.x, o.z) + step_px)) + 2;
       const cv::Rect near(body.x - reach, body.y - reach, body.width + 2 * reach, body.height + 2 * reach);
       const bool whole = f % kLearnEvery == 0 || m.learnt_near_at != f - 1;
@@ -272,7 +299,8 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
       // blur predicted, run off the search window, and its truncated centroid lag toward the
       // prediction (0.7 px at 10 px per frame under a 360° shutter): the model measures the frame.
       const bool blur_holds = off < 1.0 + 0.1 * step_px;
-      const bool trusted = m.Trusted(e) && off < std::max(4.0, 0.5 * m.RadiusPx(centre.x(), centre.y()) + step_px);
+      const bool trusted = m.Trusted(e) && m.OnPath(e.x, e.z) &&
+                           off < std::max(4.0, 0.5 * m.RadiusPx(centre.x(), centre.y()) + step_px);
       if (trusted && blur_holds) {
         m.distrusted = 0;
         const BallObservation o = m.ObserveEdges(e);
@@ -297,42 +325,11 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
                         m.geometry.Project(centre.x(), centre.y())).norm();
     if (m.Accept(fit, 0.45) && off < std::max(4.0, 0.5 * m.RadiusPx(centre.x(), centre.y()) + step_px)) return finish(fit, q, false);
   }
-  // (Re)acquire: the initial guess in the first frame, else along the path near the prediction,
-  // then along the whole path.
-  std::vector<Vector2d> guesses;
-  if (f == 0 && m.options.init_uv) {
-    const Vector2d nrm = UndistortPixel(camera, *m.options.init_uv);
-    const Vector3d ray = m.geometry.to_apparatus * Vector3d(nrm.x(), nrm.y(), 1.0);
-    if (std::abs(ray.y()) > 1e-12) {
-      const double s = -m.geometry.eye.y() / ray.y();
-      if (s > 0) guesses.emplace_back(m.geometry.eye.x() + s * ray.x(), m.geometry.eye.z() + s * ray.z());
-    }
-  }
-  if (predicted) {
-    const double reach = 4 * m.geometry.a + 3 * velocity.norm() / m.options.fps;
-    for (const Vector2d& c : m.Candidates(frame, gain, centre.x() - reach, centre.x() + reach)) guesses.push_back(c);
-  }
-  if (guesses.empty() || !predicted)
-    for (const Vector2d& c : m.Candidates(frame, gain, m.x_lo, m.x_hi)) guesses.push_back(c);
-  for (const Vector2d& guess : guesses) {
-    // Without a prediction a candidate's fit depends on its window of the frame alone.
-    const cv::Rect window = predicted ? cv::Rect() : m.BodyRegion(guess, Vector2d::Zero());
-    if (!predicted && m.rejected.Unchanged(frame, window)) continue;
-    const Vector2d v = predicted ? velocity : Vector2d::Zero();
-    const FitRequest q = m.Request(guess, v, predicted && m.history.size() >= 2, 2 * m.options.search_half_width_px,
-                                   predicted ? acceleration : Vector2d::Zero());
-    const FitOutcome fit = m.Measure({frame, {0, 0}, gain}, q, Impl::Search::kAcquiring);
-    if (!m.Accept(fit, 0.6)) {
-      if (!predicted) m.rejected.Remember(frame, window);
-    } else {
-      m.rejected.Clear();
-      const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
-      if (!predicted || (m.geometry.Project(c.x(), c.y()) - m.geometry.Project(centre.x(), centre.y())).norm() >
-                            2 * m.RadiusPx(c.x(), c.y()) + 3 * velocity.norm() / m.options.fps / m.MetresPerPx(c.x(), c.y()))
-        m.history.clear();
-      return finish(fit, q, !predicted);
-    }
-  }
+  // (Re)acquire: near the prediction, else along the whole path.
+  std::optional<Impl::Prediction> near;
+  if (predicted) near = Impl::Prediction{centre, velocity, acceleration};
+  if (const std::optional<Impl::Found> found = m.Acquire(frame, gain, f, near))
+    return finish(found->fit, found->request, found->anew, found->outline);
   // Predicted past the path's ends (beyond the fall-off point the rails no longer carry it,
   // before x_low it has reached O) and not found: it fell or was taken off, and following its
   // prediction further costs full-model fits of an empty scene. The search along the path still

@@ -82,6 +82,20 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
                       " frames without the ball (kept as missing, not interpolated)");
   const double sigma = o.u_x, band = o.band_sigmas * o.u_x;
   const int n = s.size();
+  // The tracker's systematic error at rest, m: tracker_floor_px at the body's scale (its half-size
+  // across the rolling axis over the outline's radius in pixels, the median over the frames).
+  // Every frame at rest shares it, so no number of them averages it away: it adds in quadrature
+  // to each position estimate's scatter/√n. Where the rails run toward the camera the path is
+  // foreshortened and the error along it is larger by 1/cos of that angle; side views (the
+  // sector the docs recommend) stay within 20 % of it.
+  std::vector<double> radii;
+  for (const TrackFrame& f : track.frames)
+    if (f.found && f.radius_px > 0) radii.push_back(f.radius_px);
+  const double floor_m = radii.empty() ? 0.0 : o.tracker_floor_px * scene.body().across / Median(radii);
+  const auto with_floor = [&](Estimate e) {
+    e.u = std::hypot(e.u.value_or(0.0), floor_m);
+    return e;
+  };
   // Mean ± scatter/√n of the frames [begin, end) within 3σ of their median (a glitch does not
   // count), σ/√n when fewer than 3.
   const auto stationary = [&](int begin, int end) {
@@ -92,7 +106,7 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
     if (kept.empty()) kept.push_back(m);
     const auto [mean, sd] = MeanAndSd(kept, 0, static_cast<int>(kept.size()));
     const int count = static_cast<int>(kept.size());
-    return std::pair{Estimate{mean, (count >= 3 ? sd : sigma) / std::sqrt(count)}, sd};
+    return std::pair{with_floor(Estimate{mean, (count >= 3 ? sd : sigma) / std::sqrt(count)}), sd};
   };
 
   // Release.
@@ -101,7 +115,8 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
     const auto [x, sd] = stationary(0, n);
     a.scatter_at_rest = sd;
     a.rest = TrackEvent{"comes to rest", {s.t[0], std::nullopt}, x,
-                        "never moves: mean of all " + std::to_string(n) + " frames found, u = scatter/sqrt(n)"};
+                        "never moves: mean of all " + std::to_string(n) +
+                            " frames found, u = scatter/sqrt(n) and the tracker's systematic error in quadrature"};
     a.fit.unavailable = "the ball never moves (every frame within " + Mm(band) + " of the first ones): no trajectory to fit";
     a.notes.push_back("the ball stays at rest for the whole track: its position is a measured Y");
     return a;
@@ -133,10 +148,11 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
     for (double z : zt) steady_z = steady_z && std::abs(z - zm) <= band;
     const std::optional<RestFit> rest = FitRest(s, r0, n, o.rest_frames);
     if (*tail >= o.rest_frames && r0 > i_out && steady_z && rest && rest->x.value < scene.x_max() - band) {
-      a.rest = TrackEvent{"comes to rest", {rest->t, std::nullopt}, rest->x,
+      a.rest = TrackEvent{"comes to rest", {rest->t, std::nullopt}, with_floor(rest->x),
                           "fit of the final " + std::to_string(*tail) + " frames within " + Mm(band) +
                               ": constant from t on (" + std::to_string(rest->frames) +
-                              " frames), a quadratic approach before; u from the scatter"};
+                              " frames), a quadratic approach before; u from the scatter and the tracker's "
+                              "systematic error in quadrature"};
       if (!a.scatter_at_rest) a.scatter_at_rest = rest->scatter;
       moving_end = r0;
     }

@@ -24,6 +24,10 @@
 //    profiled over the frame times): x_r ± its standard error from the scatter, t_r. This is a
 //    measured Y for the fit report. A ball that never leaves its band is at rest from the first
 //    frame: rest (the mean ± scatter/√n), no release, no fit.
+//    Every position estimate at rest (release, rest) adds the tracker's systematic error in
+//    quadrature to its scatter: the frames at rest share one bias, which averaging does not
+//    reduce; tracker_floor_px at the body's scale (Body::across over the median outline radius
+//    in pixels; an underestimate by 1/cos of the path's foreshortening, ≤ 20 % from the side).
 //    Position estimates (release, rest) use the frames within min(k, 3)·σ, not k·σ: the wider
 //    band also holds the first frames of the motion.
 //  - fall-off: the motion ends up at x_max: the last frames found reach x_max within k·σ plus

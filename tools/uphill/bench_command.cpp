@@ -133,6 +133,9 @@ void AddTrack(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& 
       ->capture_default_str()
       ->needs(random);
   cmd->add_option("--json", o->json, "file for the random scenes' results (JSON)")->needs(random);
+  cmd->add_option("--draw", o->draw_ids, "only the draws with these ids (to replay one; with --seed)")
+      ->delimiter(',')
+      ->needs(random);
   RunsWith(cmd, o, argv, RunTrackBenchmark);
 }
 

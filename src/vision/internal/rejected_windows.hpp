@@ -23,7 +23,7 @@ namespace uphill::internal {
 
 class RejectedWindows {
  public:
-  static constexpr int kMaxWindows = 8;
+  static constexpr int kMaxWindows = 16;  // every place the search proposes (Candidates)
   static constexpr double kMaxMedianChange = 12;   // levels, summed over the channels
   static constexpr double kMinChange = 24;         // levels, summed over the channels
   static constexpr double kNoiseFactor = 3;

@@ -1,5 +1,4 @@
-// The tracker's measure and acquire stages (tracker_state.hpp): the outline fits, their
-// observations, and the candidates along the path where the body is looked for anew.
+// The tracker's measure stage (tracker_state.hpp): the outline fits and their observations.
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
@@ -83,80 +82,6 @@ FitOutcome BallTracker::Impl::MeasureNear(const internal::FrameView& view, FitRe
                  geometry.Project(q.centre.x(), q.centre.y())).norm() < 0.5)
     return one;
   return Measure(view, wide);
-}
-
-std::vector<Vector2d> BallTracker::Impl::Candidates(const cv::Mat& frame, double gain, double x0, double x1) const {
-  x0 = std::max(x0, x_lo);
-  x1 = std::min(x1, x_hi);
-  if (!(x1 > x0)) return {};
-  const int n = 32;
-  // Candidates a quarter radius apart in the image.
-  const Vector2d p0 = geometry.Project(x0, scene.At(x0).z), p1 = geometry.Project(x1, scene.At(x1).z);
-  const double r_mid = RadiusPx(0.5 * (x0 + x1), scene.At(0.5 * (x0 + x1)).z);
-  const int count = std::clamp(static_cast<int>((p1 - p0).norm() / std::max(1.0, 0.25 * r_mid)) + 1, 8, 2000);
-  std::vector<std::pair<double, double>> scored;  // (score, x)
-  std::vector<cv::Vec3f> inside(n), outside(n);
-  for (int i = 0; i < count; ++i) {
-    const double xc = x0 + (x1 - x0) * (i + 0.5) / count;
-    const double zc = scene.At(xc).z;
-    if (!WithinLens(geometry.cal.pose.rotation * Vector3d(xc, 0, zc) + geometry.cal.pose.translation)) continue;
-    std::vector<Vector3d> pts = geometry.OutlinePoints(xc, zc, n);
-    pts.emplace_back(xc, 0, zc);
-    const std::vector<Vector2d> image = ProjectApparatusPoints(geometry.cal.camera, geometry.cal.pose, pts);
-    const Vector2d q = image[n];
-    int used = 0;
-    std::vector<double> bg_in, bg_out;
-    for (int k = 0; k < n; ++k) {
-      const Vector2d dir = (image[k] - q).normalized();
-      const double r = (image[k] - q).norm();
-      const Vector2d pin = image[k] - 0.4 * r * dir, pout = image[k] + 3.0 * dir;
-      bool ok = std::min({pin.x(), pin.y(), pout.x(), pout.y()}) >= 1 && std::max(pin.x(), pout.x()) < frame.cols - 2 &&
-                std::max(pin.y(), pout.y()) < frame.rows - 2;
-      ok = ok && !occluder.at<std::uint8_t>(static_cast<int>(pout.y() + 0.5), static_cast<int>(pout.x() + 0.5));
-      if (!ok) continue;
-      inside[used] = internal::SampleLinear(frame, background->table(), pin.x(), pin.y());
-      outside[used] = internal::SampleLinear(frame, background->table(), pout.x(), pout.y());
-      if (background->Known(pin.x(), pin.y()) && background->Known(pout.x(), pout.y())) {
-        bg_in.push_back(cv::norm(inside[used] - background->At(pin.x(), pin.y()) * gain));
-        bg_out.push_back(cv::norm(outside[used] - background->At(pout.x(), pout.y()) * gain));
-      }
-      ++used;
-    }
-    if (used < n / 2) continue;
-    double score;
-    if (static_cast<int>(bg_in.size()) >= used * 3 / 4) {
-      // Inside differs from the background, outside does not.
-      std::nth_element(bg_in.begin(), bg_in.begin() + bg_in.size() / 2, bg_in.end());
-      std::nth_element(bg_out.begin(), bg_out.begin() + bg_out.size() / 2, bg_out.end());
-      score = bg_in[bg_in.size() / 2] - bg_out[bg_out.size() / 2];
-    } else {
-      // The inside's median colour against each outside sample: a body of one colour on any
-      // surroundings gives a consistent step.
-      cv::Vec3f median_in;
-      std::vector<float> channel(used);
-      for (int c = 0; c < 3; ++c) {
-        for (int k = 0; k < used; ++k) channel[k] = inside[k][c];
-        std::nth_element(channel.begin(), channel.begin() + used / 2, channel.end());
-        median_in[c] = channel[used / 2];
-      }
-      std::vector<double> steps(used);
-      for (int k = 0; k < used; ++k) steps[k] = cv::norm(median_in - outside[k]);
-      std::nth_element(steps.begin(), steps.begin() + used / 4, steps.end());
-      score = steps[used / 4];  // the lower quartile: the step must hold nearly all round
-    }
-    scored.emplace_back(score, xc);
-  }
-  std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-  std::vector<Vector2d> out;
-  for (const auto& [score, xc] : scored) {
-    if (score < options.min_contrast || out.size() >= 3) break;
-    // Distinct candidates: at least a radius apart.
-    const Vector2d p = geometry.Project(xc, scene.At(xc).z);
-    bool near = false;
-    for (const Vector2d& o : out) near = near || (geometry.Project(o.x(), o.y()) - p).norm() < RadiusPx(xc, scene.At(xc).z);
-    if (!near) out.emplace_back(xc, scene.At(xc).z);
-  }
-  return out;
 }
 
 double BallTracker::Impl::Quality(const FitOutcome& f) const {

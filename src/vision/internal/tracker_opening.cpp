@@ -15,8 +15,8 @@
 
 namespace uphill {
 
-bool BallTracker::Impl::SilhouetteConfirms(const internal::FrameView& view, const Vector2d& centre,
-                                           double smear_px) const {
+BallTracker::Impl::Silhouette BallTracker::Impl::SilhouetteOf(const internal::FrameView& view, const Vector2d& centre,
+                                                              double smear_px) const {
   // Samples on rings inside the outline (its projected points drawn towards the centre's pixel)
   // and just outside it, clear of the limb, where the smear and the point spread blend body and
   // background. Inside, most samples must differ from the background; outside, most must match
@@ -64,9 +64,11 @@ bool BallTracker::Impl::SilhouetteConfirms(const internal::FrameView& view, cons
   };
   const Count inside = count(kInside), outside = count(kOutside);
   auto decided = [](const Count& n) { return n.samples > 0 && n.known >= kSilhouetteMinKnownShare * n.samples; };
-  if (!decided(inside) || !decided(outside)) return false;
+  if (!decided(inside) || !decided(outside)) return Silhouette::kUndecided;
   return inside.differ >= kSilhouetteMinBodyShare * inside.known &&
-         outside.known - outside.differ >= kSilhouetteMinBackgroundShare * outside.known;
+                 outside.known - outside.differ >= kSilhouetteMinBackgroundShare * outside.known
+             ? Silhouette::kConfirms
+             : Silhouette::kContradicts;
 }
 
 double BallTracker::Impl::SmearOf(long f, const BallObservation& o) const {
@@ -92,7 +94,7 @@ void BallTracker::Impl::KeepOpening(long f, double t, const cv::Mat& frame, cons
   opening_bytes += bytes;
   const OpeningFrame& kept = opening.back();
   const bool confirmed =
-      o.found && SilhouetteConfirms({kept.window, kept.origin, kept.gain}, Vector2d(o.x, o.z), SmearOf(f, o));
+      o.found && SilhouetteOf({kept.window, kept.origin, kept.gain}, Vector2d(o.x, o.z), SmearOf(f, o)) == Silhouette::kConfirms;
   opening_confirmed_run = confirmed ? opening_confirmed_run + 1 : 0;
   if (opening_confirmed_run < kOpeningAnchorFrames) return;
   opening_closed = true;
@@ -111,9 +113,14 @@ void BallTracker::Impl::RecoverOpening() {
     for (OpeningFrame& kept : opening)
       if (kept.frame == k) kept.observed = revised;
   auto view = [](const OpeningFrame& k) { return internal::FrameView{k.window, k.origin, k.gain}; };
-  auto confirmed = [&](const OpeningFrame& k) {
-    return k.observed.found && SilhouetteConfirms(view(k), Vector2d(k.observed.x, k.observed.z), SmearOf(k.frame, k.observed));
+  auto silhouette = [&](const OpeningFrame& k) {
+    return SilhouetteOf(view(k), Vector2d(k.observed.x, k.observed.z), SmearOf(k.frame, k.observed));
   };
+  auto confirmed = [&](const OpeningFrame& k) { return k.observed.found && silhouette(k) == Silhouette::kConfirms; };
+  // A position the background contradicts (the inside looks like the table, or the outside like
+  // a body): one the background does not show is kept as the tracker found it, for want of a
+  // better look (the body never left the place for long enough).
+  auto contradicted = [&](const OpeningFrame& k) { return k.observed.found && silhouette(k) == Silhouette::kContradicts; };
   // The anchor: the first run of confirmed frames, judged with the background as learnt by now.
   const int n = static_cast<int>(opening.size());
   int anchor = -1;
@@ -139,7 +146,7 @@ void BallTracker::Impl::RecoverOpening() {
   // From the anchor's run outwards: backwards to the first frame, and forwards over the frames
   // kept after it that the background does not confirm. Each frame is predicted from the two
   // next to it on the anchor's side (constant velocity; a body at rest stays), searched as a
-  // tracked frame is, and accepted only where the background confirms it.
+  // tracked frame is, and accepted unless the background contradicts it.
   auto sweep = [&](int from, int to, int step) {
     const int last = from - step;  // the run's frame next to `from`
     Vector2d next(opening[last].observed.x, opening[last].observed.z);
@@ -154,8 +161,8 @@ void BallTracker::Impl::RecoverOpening() {
         continue;
       }
       if (misses > kOpeningMaxMisses) {
-        // Beyond the search's reach: a frame the background does not confirm is not reported.
-        if (k.observed.found && !confirmed(k)) report(k, BallObservation{});
+        // Beyond the search's reach: a frame the background contradicts is not reported.
+        if (contradicted(k)) report(k, BallObservation{});
         continue;
       }
       const Vector2d predicted = 2 * next - after;
@@ -170,14 +177,15 @@ void BallTracker::Impl::RecoverOpening() {
       BallObservation o;
       if (accepted) {
         o = Observe(fit, q);
-        accepted = SilhouetteConfirms(view(k), c, std::max(o.smear_px, step_px * Exposure() * options.fps));
+        accepted = SilhouetteOf(view(k), c, std::max(o.smear_px, step_px * Exposure() * options.fps)) !=
+                   Silhouette::kContradicts;
       }
-          if (accepted) {
+      if (accepted) {
         report(k, o);
         next = c;
         misses = 0;
       } else {
-        if (k.observed.found && !confirmed(k)) report(k, BallObservation{});
+        if (contradicted(k)) report(k, BallObservation{});
         next = predicted;
         ++misses;
       }

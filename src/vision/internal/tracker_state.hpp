@@ -3,8 +3,10 @@
 //   ball_tracker.cpp          set-up, the public interface, and Track: one frame through the stages
 //   tracker_motion.cpp        predict: the motion through the last centres, the exposure, the row
 //                             delay, the body's region, and the scene-change watch
-//   tracker_measure.cpp       measure and acquire: the outline fits (two passes, or one near a
-//                             good prediction), their observations, and the candidates along the path
+//   tracker_acquire.cpp       acquire: the places along the path where the body is looked for
+//                             anew (Candidates), and the search that fits them (Acquire)
+//   tracker_measure.cpp       measure: the outline fits (two passes, or one near a good
+//                             prediction) and their observations
 //   tracker_refit.cpp         assess and revise: frames kept for a refit once the background and
 //                             the motion are known, the readout settled at the end, a body withdrawn
 //   tracker_opening.cpp       the clip's opening: its frames measured again at the end, backwards
@@ -108,6 +110,7 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   std::unique_ptr<internal::EdgeFit> edges;
   bool needs_model = false;
   int distrusted = 0;
+  Vector2d found_at = Vector2d::Zero();  // the centre where the body was last found anew, m
   long confident_model_frame = -1;  // the last frame the model measured, its background known
   long learnt_near_at = -1;         // the last frame whose background the model's path learnt
   // A body found anew where the model could not check it against the background (rays whose
@@ -121,7 +124,7 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   std::optional<Unconfirmed> unconfirmed;
   // The clip's opening: each frame (the band's bounding box) from the first until the body has
   // been found in kOpeningAnchorFrames frames in a row that the background confirms
-  // (SilhouetteConfirms). A body at rest from the first frame hides the background under it, so
+  // (SilhouetteOf). A body at rest from the first frame hides the background under it, so
   // those frames are measured without it and may lock onto the body's reflections, its print or
   // the table; once the body has moved away the background is known, and Finish() measures the
   // opening again, backwards from that run (RecoverOpening).
@@ -192,12 +195,20 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // body's band or the rails may cost rays, than for a body found anew). Before any frame was
   // accepted the clip's noise is not known (`noise` is a guess, and a 1080p phone clip's is three
   // times it): the levels are then the fit's own residual RMS, so that a body found where it is
-  // is not refused for the guess.
+  // is not refused for the guess. And the centre must lie on the path (OnPath).
   bool Accept(const FitOutcome& f, double agreement) const {
     const double level = noises.empty() ? std::max(noise, f.noise) : noise;
     const double misfit = f.misfit * noise / level;
     return f.ok && f.inliers >= std::max(10.0, 0.25 * options.rays) && f.inliers >= agreement * f.rays_fitted &&
-           f.contrast >= options.min_contrast && f.contrast >= 6 * level && misfit < 3;
+           f.contrast >= options.min_contrast && f.contrast >= 6 * level && misfit < 3 &&
+           OnPath(f.p[internal::kCentreX], f.p[internal::kCentreZ]);
+  }
+  // Whether a centre lies on the rails' range [x_low, x_max], within a pixel: beyond x_max the
+  // body has fallen between the rails, and a fit there is the table where it was (the background
+  // under it never seen), not the body.
+  bool OnPath(double x, double z) const {
+    const double pixel = MetresPerPx(x, z);
+    return x > scene.x_low() - pixel && x < scene.x_max() + pixel;
   }
 
   // Two passes: around the guess with the given half width, then narrow around the first fit
@@ -215,8 +226,29 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // Whether the lens model maps the camera-frame point where it is (LensModelReach).
   bool WithinLens(const Vector3d& pc) const { return pc.z() > 0 && pc.head<2>().norm() < lens_reach * pc.z(); }
 
-  // Candidates along the path between x0 and x1, best first: the predicted outline's inside
-  // against its outside (against the background where it is known).
+  // The motion's prediction for a frame: centre (x, z) at its reference time, m; velocity, m/s;
+  // acceleration, m/s².
+  struct Prediction {
+    Vector2d centre, velocity, acceleration;
+  };
+  // A body found by the search: its fit and request, the edge fit that measures it instead
+  // (a body at rest whose clean outline the model, without the background, missed), and whether
+  // it was found anew (not near the prediction).
+  struct Found {
+    FitOutcome fit;
+    FitRequest request;
+    std::optional<internal::EdgeFitOutcome> outline;
+    bool anew = false;
+  };
+  // The search: the initial guess in frame 0 (TrackerOptions::init_uv), the candidates near the
+  // prediction `near` (the first one accepted is the body), else along the whole path (the one
+  // that stands out of its surroundings by the most noise levels). Clears the history when the
+  // body is found anew or far from the prediction.
+  std::optional<Found> Acquire(const cv::Mat& frame, double gain, long f, const std::optional<Prediction>& near);
+
+  // Candidates along the path between x0 and x1: the best kCandidatesByColour by the predicted
+  // outline's inside against its outside (against the background where it is known), then the
+  // best kCandidatesByStep by the grey step across the outline.
   std::vector<Vector2d> Candidates(const cv::Mat& frame, double gain, double x0, double x1) const;
 
   // Quality in [0, 1]: the share of the visible outline's rays that agree with the fit, lowered
@@ -237,6 +269,15 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   }
 
   BallObservation ObserveEdges(const internal::EdgeFitOutcome& e) const;
+
+  // An edge fit that found the body's outline all round: most of its rays within a pixel of it,
+  // their scatter below half a pixel, in contrast well above the noise. Looser than Trusted (the
+  // fast path's check, which must also hold where the model would do better): it only decides
+  // between the edge fit and a model fit that has no background to go by.
+  bool CleanOutline(const internal::EdgeFitOutcome& e) const {
+    return e.ok && e.inliers >= 0.35 * kEdgePoints && e.inliers >= kCleanOutlineAgreement * e.attempted &&
+           e.contrast >= kFastMinContrast && e.rms_px <= kCleanOutlineRmsPx;
+  }
 
   // A frame where the body rests (found near a prediction that barely moves) is a sharp view of
   // its shading.
@@ -277,11 +318,13 @@ struct BallTracker::Impl : internal::TrackerThresholds {
 
   void Withdraw();
 
-  // Whether the pixels inside the body's outline centred at `centre` differ from the background
-  // (known there) as a body's must: false when the background is unknown under too much of it,
-  // or when the inside looks like the background (a fit on the table's texture or on a reflection).
+  // What the background says of a body whose outline is centred at `centre`: it confirms it
+  // when the pixels inside differ from the background as a body's must and those just outside
+  // match it; it contradicts it when they do not (a fit on the table's texture or on a
+  // reflection); it cannot decide where the background is unknown under too much of either.
   // `smear_px`: the body's smear over the exposure, along the path (BallObservation::smear_px).
-  bool SilhouetteConfirms(const internal::FrameView& view, const Vector2d& centre, double smear_px) const;
+  enum class Silhouette { kConfirms, kContradicts, kUndecided };
+  Silhouette SilhouetteOf(const internal::FrameView& view, const Vector2d& centre, double smear_px) const;
   // The smear of frame f's observation, px: fitted, or (the fast path fits none) the step to a
   // neighbouring frame's centre over the exposure.
   double SmearOf(long f, const BallObservation& o) const;

@@ -50,6 +50,27 @@ struct TrackerThresholds {
   static constexpr double kFastMinAgreement = 0.85;
   // Edge fit against the model at acquisition, px: within this the clip may take the fast path.
   static constexpr double kFastMaxDisagreementPx = 0.5;
+  // Share of the fitted rays that must agree with a body found anew (not near a prediction):
+  // before the background is known a print near the limb or the rod across it costs rays (a
+  // spheroid with a painted band over a rod: 58 % of them), while a patch of the table that
+  // happens to fit an outline is told apart by its contrast (the candidates' best is taken).
+  static constexpr double kAcquireAgreement = 0.55;
+  // The search along the path: the places it proposes, by the colour inside the outline against
+  // outside and by the grey step across it (Candidates), and the fits it tries per frame, skipping
+  // the places already refused whose pixels did not change (rejected_windows.hpp), so that a
+  // body ranked below the rails' own contrast (thick rods inside every outline) is reached
+  // within a few frames.
+  static constexpr std::size_t kCandidatesByColour = 12, kCandidatesByStep = 4;
+  static constexpr int kAcquireFitsPerFrame = 5;
+  // CleanOutline: the share of the edge fit's rays within a pixel of its outline, and their RMS,
+  // px, for the edge fit to stand in for a model fit without background (a print's stripes near
+  // the limb scatter the edges by about 0.35 px; a body partly hidden by the rails, or half in
+  // shadow, leaves under 75 % of them on its outline).
+  static constexpr double kCleanOutlineAgreement = 0.8, kCleanOutlineRmsPx = 0.5;
+  // A body within this of where it was found anew, px, is still at rest there: an edge fit's
+  // centre on a printed body scatters by a few tenths of a pixel, a rolling body leaves the
+  // place within a few frames.
+  static constexpr double kAtRestPx = 1.0;
   // Untrusted fast fits in a row after which the clip takes the model on every frame.
   static constexpr int kFastDistrust = 3;
   // Frames between background updates of the whole band: a still scene's background changes
@@ -79,7 +100,7 @@ struct TrackerThresholds {
   // 300 frames, five seconds at 60 fps, of a body at rest).
   static constexpr int kOpeningAnchorFrames = 5;
   static constexpr std::size_t kOpeningBytes = 256u << 20;
-  // SilhouetteConfirms: a sample inside the outline is the body's when it differs from the
+  // SilhouetteOf: a sample inside the outline is the body's when it differs from the
   // background by this many noise levels (and at least kSilhouetteMinContrast, linear light) in a
   // channel; the inside is a body's when this share of its samples are (a mirror ball shows the
   // table near its limb, a print may match the cloth in places: most of the inside still differs);

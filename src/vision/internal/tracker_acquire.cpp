@@ -1,0 +1,174 @@
+// The tracker's acquire stage (tracker_state.hpp): the places along the path where the body is
+// looked for anew, and the search that fits them.
+#include <algorithm>
+#include <cmath>
+
+#include "tracker_state.hpp"
+
+namespace uphill {
+
+std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat& frame, double gain, long f,
+                                                                 const std::optional<Prediction>& near) {
+  const bool predicted = near.has_value();
+  std::vector<Vector2d> guesses;
+  if (f == 0 && options.init_uv) {
+    const Vector2d nrm = UndistortPixel(geometry.cal.camera, *options.init_uv);
+    const Vector3d ray = geometry.to_apparatus * Vector3d(nrm.x(), nrm.y(), 1.0);
+    if (std::abs(ray.y()) > 1e-12) {
+      const double s = -geometry.eye.y() / ray.y();
+      if (s > 0) guesses.emplace_back(geometry.eye.x() + s * ray.x(), geometry.eye.z() + s * ray.z());
+    }
+  }
+  if (predicted) {
+    const double reach = 4 * geometry.a + 3 * near->velocity.norm() / options.fps;
+    for (const Vector2d& c : Candidates(frame, gain, near->centre.x() - reach, near->centre.x() + reach)) guesses.push_back(c);
+  }
+  if (guesses.empty() || !predicted)
+    for (const Vector2d& c : Candidates(frame, gain, x_lo, x_hi)) guesses.push_back(c);
+  // Near a prediction the first candidate accepted is the body. Found anew, every candidate is
+  // fitted and the one standing out of its surroundings by the most noise levels is taken: a
+  // patch of the table's texture may fit an outline too, but never by the contrast of a body.
+  std::optional<Found> best;
+  double best_score = 0;
+  int fitted = 0;
+  for (const Vector2d& guess : guesses) {
+    // Without a prediction a candidate's fit depends on its window of the frame alone.
+    const cv::Rect window = predicted ? cv::Rect() : BodyRegion(guess, Vector2d::Zero());
+    if (!predicted && rejected.Unchanged(frame, window)) continue;
+    if (++fitted > kAcquireFitsPerFrame) break;
+    const Vector2d v = predicted ? near->velocity : Vector2d::Zero();
+    const FitRequest q = Request(guess, v, predicted && history.size() >= 2, 2 * options.search_half_width_px,
+                                   predicted ? near->acceleration : Vector2d::Zero());
+    const FitOutcome fit = Measure({frame, {0, 0}, gain}, q, Search::kAcquiring);
+    if (!Accept(fit, kAcquireAgreement)) {
+      if (!predicted) rejected.Remember(frame, window);
+      continue;
+    }
+    const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
+    if (predicted) {
+      rejected.Clear();
+      if ((geometry.Project(c.x(), c.y()) - geometry.Project(near->centre.x(), near->centre.y())).norm() >
+          2 * RadiusPx(c.x(), c.y()) + 3 * near->velocity.norm() / options.fps / MetresPerPx(c.x(), c.y()))
+        history.clear();
+      return Found{fit, q, std::nullopt, false};
+    }
+    // Where the background is unknown, a candidate whose outline the edge fit finds all round
+    // comes before any other: a print or a reflection can hold the model's outline off a body,
+    // a patch of the table has no such outline.
+    std::optional<internal::EdgeFitOutcome> outline;
+    if (fit.rays_without_background > 0) {
+      edges->Reset();
+      const internal::EdgeFitOutcome w = edges->Measure(frame, c.x(), c.y(), 2 * options.search_half_width_px);
+      if (CleanOutline(w)) outline = w;
+    }
+    const double score = fit.contrast / std::max(noise, fit.noise) + (outline ? 1e6 : 0);
+    if (!best || score > best_score) best = Found{fit, q, outline}, best_score = score;
+  }
+  if (!best) return std::nullopt;
+  {
+    best->anew = true;
+    rejected.Clear();
+    history.clear();
+    // The edge fit measures the frame only where it disagrees with the model: where they agree
+    // the model's fit stands, as everywhere else.
+    const bool disagree = best->outline && (geometry.Project(best->outline->x, best->outline->z) -
+                                            geometry.Project(best->fit.p[internal::kCentreX], best->fit.p[internal::kCentreZ]))
+                                               .norm() > kFastMaxDisagreementPx;
+    if (!disagree) best->outline.reset();
+    return best;
+  }
+}
+
+std::vector<Vector2d> BallTracker::Impl::Candidates(const cv::Mat& frame, double gain, double x0, double x1) const {
+  x0 = std::max(x0, x_lo);
+  x1 = std::min(x1, x_hi);
+  if (!(x1 > x0)) return {};
+  const int n = 32;
+  // Candidates a quarter radius apart in the image.
+  const Vector2d p0 = geometry.Project(x0, scene.At(x0).z), p1 = geometry.Project(x1, scene.At(x1).z);
+  const double r_mid = RadiusPx(0.5 * (x0 + x1), scene.At(0.5 * (x0 + x1)).z);
+  const int count = std::clamp(static_cast<int>((p1 - p0).norm() / std::max(1.0, 0.25 * r_mid)) + 1, 8, 2000);
+  std::vector<std::pair<double, double>> scored, stepped;  // (score, x)
+  std::vector<cv::Vec3f> inside(n), outside(n);
+  std::vector<double> edge_steps(n);
+  for (int i = 0; i < count; ++i) {
+    const double xc = x0 + (x1 - x0) * (i + 0.5) / count;
+    const double zc = scene.At(xc).z;
+    if (!WithinLens(geometry.cal.pose.rotation * Vector3d(xc, 0, zc) + geometry.cal.pose.translation)) continue;
+    std::vector<Vector3d> pts = geometry.OutlinePoints(xc, zc, n);
+    pts.emplace_back(xc, 0, zc);
+    const std::vector<Vector2d> image = ProjectApparatusPoints(geometry.cal.camera, geometry.cal.pose, pts);
+    const Vector2d q = image[n];
+    int used = 0;
+    std::vector<double> bg_in, bg_out;
+    for (int k = 0; k < n; ++k) {
+      const Vector2d dir = (image[k] - q).normalized();
+      const double r = (image[k] - q).norm();
+      const Vector2d pin = image[k] - 0.4 * r * dir, pout = image[k] + 3.0 * dir;
+      bool ok = std::min({pin.x(), pin.y(), pout.x(), pout.y()}) >= 1 && std::max(pin.x(), pout.x()) < frame.cols - 2 &&
+                std::max(pin.y(), pout.y()) < frame.rows - 2;
+      ok = ok && !occluder.at<std::uint8_t>(static_cast<int>(pout.y() + 0.5), static_cast<int>(pout.x() + 0.5));
+      if (!ok) continue;
+      inside[used] = internal::SampleLinear(frame, background->table(), pin.x(), pin.y());
+      outside[used] = internal::SampleLinear(frame, background->table(), pout.x(), pout.y());
+      const Vector2d just_in = image[k] - 2.0 * dir;
+      const cv::Vec3f across = outside[used] - internal::SampleLinear(frame, background->table(), just_in.x(), just_in.y());
+      edge_steps[used] = (across[0] + across[1] + across[2]) / 3;
+      if (background->Known(pin.x(), pin.y()) && background->Known(pout.x(), pout.y())) {
+        bg_in.push_back(cv::norm(inside[used] - background->At(pin.x(), pin.y()) * gain));
+        bg_out.push_back(cv::norm(outside[used] - background->At(pout.x(), pout.y()) * gain));
+      }
+      ++used;
+    }
+    if (used < n / 2) continue;
+    double score;
+    if (static_cast<int>(bg_in.size()) >= used * 3 / 4) {
+      // Inside differs from the background, outside does not.
+      std::nth_element(bg_in.begin(), bg_in.begin() + bg_in.size() / 2, bg_in.end());
+      std::nth_element(bg_out.begin(), bg_out.begin() + bg_out.size() / 2, bg_out.end());
+      score = bg_in[bg_in.size() / 2] - bg_out[bg_out.size() / 2];
+    } else {
+      // The inside's median colour against each outside sample: a body of one colour on any
+      // surroundings gives a consistent step.
+      cv::Vec3f median_in;
+      std::vector<float> channel(used);
+      for (int c = 0; c < 3; ++c) {
+        for (int k = 0; k < used; ++k) channel[k] = inside[k][c];
+        std::nth_element(channel.begin(), channel.begin() + used / 2, channel.end());
+        median_in[c] = channel[used / 2];
+      }
+      std::vector<double> steps(used);
+      for (int k = 0; k < used; ++k) steps[k] = cv::norm(median_in - outside[k]);
+      std::nth_element(steps.begin(), steps.begin() + used / 4, steps.end());
+      score = steps[used / 4];  // the lower quartile: the step must hold nearly all round
+    }
+    scored.emplace_back(score, xc);
+    // Appearance-free: the grey step across the outline, its median over the rays (a body
+    // lighter or darker than its surroundings as a whole, whatever its print or its colours:
+    // a two-tone ball on paper matches the paper with one half).
+    std::nth_element(edge_steps.begin(), edge_steps.begin() + used / 2, edge_steps.begin() + used);
+    stepped.emplace_back(std::abs(edge_steps[used / 2]), xc);
+  }
+  // The best by colour and the best by the outline's step, each a radius from the
+  // others of its kind (a fit started there reaches the body within a radius) and a quarter
+  // radius from the other kind's (the same place).
+  std::vector<Vector2d> out;
+  auto take = [&](std::vector<std::pair<double, double>>& by, size_t most) {
+    std::sort(by.begin(), by.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    const size_t before = out.size();
+    for (const auto& [score, xc] : by) {
+      if (score < options.min_contrast || out.size() - before >= most) break;
+      const Vector2d p = geometry.Project(xc, scene.At(xc).z);
+      const double r = RadiusPx(xc, scene.At(xc).z);
+      bool near = false;
+      for (size_t i = 0; i < out.size(); ++i)
+        near = near || (geometry.Project(out[i].x(), out[i].y()) - p).norm() < (i >= before ? r : 0.25 * r);
+      if (!near) out.emplace_back(xc, scene.At(xc).z);
+    }
+  };
+  take(scored, kCandidatesByColour);
+  take(stepped, kCandidatesByStep);
+  return out;
+}
+
+}  // namespace uphill
