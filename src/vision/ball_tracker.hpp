@@ -15,11 +15,15 @@
 //
 // Where it looks: only where the body can be. The first frame, and any frame after the body was
 // lost, is searched along the projection of the scene's centre path x ↦ (x, 0, z(x)) for the
-// predicted outline whose inside differs most from its outside (from the background, once that is
-// known); TrackerOptions::init_uv, a raw pixel near the centre, replaces that search for the first
-// frame. Then frame by frame near the prediction from the last positions (constant acceleration in
-// time). When a fit fails it re-acquires at once, in the same frame: along the path near the
-// prediction, then along the whole path.
+// predicted outlines whose inside differs most from their outside (from the background, once that
+// is known) and those with the strongest grey step across them; a few are fitted per frame, places
+// already refused whose pixels have not changed are skipped, and of the bodies found the one that
+// stands out of its surroundings by the most noise levels is taken (one whose outline the edge fit
+// finds all round before any other). TrackerOptions::init_uv, a raw pixel near the centre, replaces
+// that search for the first frame. Then frame by frame near the prediction from the last positions
+// (constant acceleration in time). When a fit fails it re-acquires at once, in the same frame:
+// along the path near the prediction, then along the whole path. A centre beyond the path's ends
+// [x_low, x_max] is never a body on the rails.
 //
 // The opening: a body at rest from the first frame hides the background under it, so the first
 // frames are measured without it, and a mirror ball's reflections, a print or the table's grain
@@ -28,9 +32,9 @@
 // outline the pixels differ from it, just outside they match it). Finish() measures the opening
 // again once the clip has shown the background: backwards from the first confirmed run to the
 // first frame, each frame predicted from the two after it, and forwards over the frames after
-// the run the background does not confirm. A frame found there but not confirmed, and not found
-// again, is withdrawn (a revision that says not found): the tracker does not report a position
-// the pixels do not support.
+// the run the background does not confirm. A frame found there that the background contradicts
+// (not merely cannot judge, where it was never seen), and not found again, is withdrawn (a
+// revision that says not found): the tracker does not report a position the pixels contradict.
 //
 // How it measures: the outline, smeared over the exposure. Under perspective a sphere of radius
 // R centred at C projects to the boundary of the cone of rays at the angle asin(R/|C − O|) about
@@ -91,7 +95,9 @@
 // under it was seen, in the first frames, counts only once the next frames find it again near it;
 // else it was the table's texture and is withdrawn by a revision); a double cone (refused). Where the
 // body rested since the first frame the background under it is unknown until it leaves: those
-// rays use a background constant along the ray, solved in the fit.
+// rays use a background constant along the ray, solved in the fit; while it stays where it was
+// found, an edge fit that finds its outline all round where the model put it elsewhere (a
+// striped or dotted print holds the model off the limb) measures it instead.
 #pragma once
 
 #include <Eigen/Core>
