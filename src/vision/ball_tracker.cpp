@@ -216,12 +216,15 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
     // fast path (grey contrast, no pattern near the outline: it agrees with the model); where the
     // background under the body was never seen it stands in for the model until it is.
     bool edge_fallback = false;
-    if (outline) {
-      m.needs_model = true;  // the edge fit and the model disagree: not a clip for the fast path
+    auto measured_by_edges = [&](const internal::EdgeFitOutcome& e) {
       const double offset = o.time_offset;
-      o = m.ObserveEdges(*outline);
+      o = m.ObserveEdges(e);
       o.time_offset = offset;
       edge_fallback = true;
+    };
+    if (outline) {
+      m.needs_model = true;  // the edge fit and the model disagree: not a clip for the fast path
+      measured_by_edges(*outline);
     } else if (acquired || fit.rays_without_background > 0) {
       if (acquired) m.edges->Reset();
       const internal::EdgeFitOutcome e = m.edges->Measure(frame, o.x, o.z, kNarrowHalfWidthPx + 1);
@@ -229,12 +232,9 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
       const bool agrees = m.Trusted(e) && apart < kFastMaxDisagreementPx + (fit.rays_without_background > 0 ? 0.5 : 0);
       if (acquired && !agrees) m.needs_model = true;
       if (fit.rays_without_background > 0 && agrees) {
-        const double offset = o.time_offset;
-        o = m.ObserveEdges(e);
-        o.time_offset = offset;
-        edge_fallback = true;
-      } else if (fit.rays_without_background > 0 &&
-                 (m.geometry.Project(q.centre.x(), q.centre.y()) - m.geometry.Project(m.found_at.x(), m.found_at.y())).norm() < kAtRestPx) {
+        measured_by_edges(e);
+      } else if (const Vector2d found_px = m.geometry.Project(m.found_at.x(), m.found_at.y());
+                 fit.rays_without_background > 0 && (m.geometry.Project(q.centre.x(), q.centre.y()) - found_px).norm() < kAtRestPx) {
         // A body at rest whose background was never seen: the model has only the body's inside
         // to go by, and a print (stripes, dots) can hold its outline off the body. The contrast
         // at the outline alone then measures it, where it finds a clean outline that the
@@ -242,12 +242,8 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
         const internal::EdgeFitOutcome w = m.edges->Measure(frame, o.x, o.z, 2 * m.options.search_half_width_px);
         const Vector2d at = m.geometry.Project(w.x, w.z);
         if (m.CleanOutline(w) && (at - Vector2d(o.u, o.v)).norm() > kFastMaxDisagreementPx &&
-            (at - m.geometry.Project(m.found_at.x(), m.found_at.y())).norm() < kAtRestPx) {
-          const double offset = o.time_offset;
-          o = m.ObserveEdges(w);
-          o.time_offset = offset;
-          edge_fallback = true;
-        }
+            (at - found_px).norm() < kAtRestPx)
+          measured_by_edges(w);
       }
     }
     if (acquired) m.found_at = Vector2d(o.x, o.z);

@@ -65,18 +65,16 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
     if (!best || score > best_score) best = Found{fit, q, outline}, best_score = score;
   }
   if (!best) return std::nullopt;
-  {
-    best->anew = true;
-    rejected.Clear();
-    history.clear();
-    // The edge fit measures the frame only where it disagrees with the model: where they agree
-    // the model's fit stands, as everywhere else.
-    const bool disagree = best->outline && (geometry.Project(best->outline->x, best->outline->z) -
-                                            geometry.Project(best->fit.p[internal::kCentreX], best->fit.p[internal::kCentreZ]))
-                                               .norm() > kFastMaxDisagreementPx;
-    if (!disagree) best->outline.reset();
-    return best;
-  }
+  best->anew = true;
+  rejected.Clear();
+  history.clear();
+  // The edge fit measures the frame only where it disagrees with the model: where they agree
+  // the model's fit stands, as everywhere else.
+  const bool disagree = best->outline && (geometry.Project(best->outline->x, best->outline->z) -
+                                          geometry.Project(best->fit.p[internal::kCentreX], best->fit.p[internal::kCentreZ]))
+                                             .norm() > kFastMaxDisagreementPx;
+  if (!disagree) best->outline.reset();
+  return best;
 }
 
 std::vector<Vector2d> BallTracker::Impl::Candidates(const cv::Mat& frame, double gain, double x0, double x1) const {
