@@ -2,7 +2,8 @@
 # Renders the recordings of the sample experiment data/series3-video (data/README.md) with
 # tools/make_video, whose ground truth is exact: per setting (D = 120 … 180 mm) a trial placed just
 # inside the far edge of the rest band of mu = 0.05 (1 s at rest) and one released just beyond it
-# (at rest 0.5 s, then rolls up and falls off); 640 x 360 at 30 frames/s. Also the camera and scene
+# (at rest 0.5 s, then rolls up and falls off); 640 x 360 at 30 frames/s, with the lab's marks in
+# view (tape on the rods at 300/600/900 mm, the crossbar's feet, a ruler). Also the camera and scene
 # files of the camera that filmed them. Seeded: the same files every time. Skips the work when the
 # videos are there.
 #   bash scripts/make-sample-videos.sh [BUILD_DIR]   (default build/release)

@@ -22,7 +22,22 @@ using Eigen::Vector3f;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-enum ObjectId : std::uint8_t { kWall, kTable, kRodMinus, kRodPlus, kCrossbar, kBody, kNone };
+enum ObjectId : std::uint8_t { kWall, kTable, kRuler, kRodMinus, kRodPlus, kTape, kCrossbar, kFoot, kBody, kNone };
+
+// The ruler on the table (ClipApparatus::ruler): 30 mm wide, its near edge at y = kRulerNearY, from
+// x = -20 mm to 1020 mm, with a tick every 10 mm from its far edge (5 mm long, 10 mm every 50 mm,
+// 15 mm every 100 mm), 1 mm wide; x = 0 at O.
+constexpr double kRulerNearY = -0.16, kRulerWidth = 0.03, kTickHalfWidth = 0.0005;
+bool OnRuler(double x, double y) {
+  return y >= kRulerNearY && y <= kRulerNearY + kRulerWidth && x >= -0.02 && x <= 1.02;
+}
+bool OnTick(double x, double y) {
+  const long cm = std::lround(x / 0.01);
+  if (std::abs(x - 0.01 * cm) > kTickHalfWidth) return false;
+  const double length = cm % 10 == 0 ? 0.015 : cm % 5 == 0 ? 0.010 : 0.005;
+  return y >= kRulerNearY + kRulerWidth - length;
+}
+
 
 // Band-limited value noise in [0, 1]: hashed lattice values, quintic interpolation.
 double LatticeValue(long i, long j) {
@@ -92,6 +107,8 @@ struct ClipRenderer::Impl {
   double rail_end;                // axial length of the drawn rods
   Vector3d light;                 // unit, toward the light
   double crossbar_z, crossbar_half_length;
+  double foot_y;                  // the feet stand under the rails: y = ±crossbar_x·tan(α/2)
+  std::vector<double> tape_axial; // the tape marks' distances from O along the rods, m
   double shadow_softness = 0.006;  // m, half width of the penumbra
 
   Impl(const Scene& s, const SceneCalibration& c, const ClipApparatus& a, int n)
@@ -149,46 +166,76 @@ struct ClipRenderer::Impl {
     return lit;
   }
 
-  Rgb Shade(const Vector3d& d, const std::vector<Vector3d>& bodies, ObjectId* id) const {
+  struct Hit {
+    double t = kInf;      // ray parameter (unit ray: distance from the eye, m)
+    ObjectId id = kNone;
+    double axial = 0;     // along a rod, the crossbar or a foot
+    int index = -1;       // which body, rod (0: −y, 1: +y) or foot (0: −y, 1: +y)
+  };
+
+  // The first surface the ray from the eye along d meets.
+  Hit FirstHit(const Vector3d& d, const std::vector<Vector3d>& bodies) const {
     const Vector3d& o = eye;
-    double best = kInf, axial = 0;
-    ObjectId hit = kNone;
-    int body_index = -1;
+    Hit h;
     for (size_t k = 0; k < bodies.size(); ++k) {
       const double t = HitBody(o, d, bodies[k]);
-      if (t < best) best = t, hit = kBody, body_index = static_cast<int>(k);
+      if (t < h.t) h = {t, kBody, 0, static_cast<int>(k)};
     }
+    double s = 0;
     for (int k = 0; k < 2; ++k) {
-      double s = 0;
       const double t = HitCylinder(o, d, Vector3d::Zero(), rail_dir[k], rod_radius, 0.0, rail_end, &s);
-      if (t < best) best = t, hit = k == 0 ? kRodMinus : kRodPlus, axial = s;
+      if (t < h.t) h = {t, OnTape(s) ? kTape : k == 0 ? kRodMinus : kRodPlus, s, k};
     }
     {
-      double s = 0;
       const Vector3d p0(apparatus.crossbar_x, 0, crossbar_z);
       const double t = HitCylinder(o, d, p0, Vector3d::UnitY(), apparatus.crossbar_radius, -crossbar_half_length,
                                    crossbar_half_length, &s);
-      if (t < best) best = t, hit = kCrossbar, axial = s;
+      if (t < h.t) h = {t, kCrossbar, s, -1};
     }
+    if (apparatus.feet)
+      for (double side : {-1.0, 1.0}) {
+        const Vector3d p0(apparatus.crossbar_x, side * foot_y, apparatus.table_z);
+        const double t = HitCylinder(o, d, p0, Vector3d::UnitZ(), apparatus.foot_radius, 0.0, crossbar_z - apparatus.table_z, &s);
+        if (t < h.t) h = {t, kFoot, s, side > 0 ? 1 : 0};
+      }
     if (d.z() < 0) {
       const double t = (apparatus.table_z - o.z()) / d.z();
-      if (t < best) best = t, hit = kTable;
+      if (t < h.t) {
+        const Vector3d p = o + t * d;
+        h = {t, apparatus.ruler && OnRuler(p.x(), p.y()) ? kRuler : kTable, 0, -1};
+      }
     }
     if (d.y() > 0) {
       const double t = (apparatus.wall_y - o.y()) / d.y();
-      if (t < best) best = t, hit = kWall;
+      if (t < h.t) h = {t, kWall, 0, -1};
     }
-    *id = hit;
-    const Vector3d p = o + best * d;
+    return h;
+  }
+
+  // Tape at rod length s (ClipApparatus::tape_marks_x, measured along the rod from O).
+  bool OnTape(double s) const {
+    for (double m : tape_axial)
+      if (std::abs(s - m) <= apparatus.tape_width / 2) return true;
+    return false;
+  }
+
+  Rgb Shade(const Vector3d& d, const std::vector<Vector3d>& bodies, ObjectId* id) const {
+    const Hit h = FirstHit(d, bodies);
+    *id = h.id;
+    const Vector3d p = eye + h.t * d;
     const Vector3d view = -d;
     auto lambert = [&](const Vector3d& n) { return 0.28 + 0.72 * std::max(0.0, n.dot(light)); };
     auto highlight = [&](const Vector3d& n, double shininess) {
       const double nh = std::max(0.0, n.dot((light + view).normalized()));
       return std::pow(nh, shininess);
     };
-    switch (hit) {
+    auto rod_normal = [&]() {
+      const Vector3d& e = rail_dir[h.index];
+      return Vector3d((p - h.axial * e).normalized());
+    };
+    switch (h.id) {
       case kBody: {
-        const Vector3d q = p - bodies[body_index];
+        const Vector3d q = p - bodies[h.index];
         const Vector3d n =
             Vector3d(q.x() / (across * across), q.y() / (along * along), q.z() / (across * across)).normalized();
         const Rgb paint{0.10, 0.14, 0.72};
@@ -198,19 +245,26 @@ struct ClipRenderer::Impl {
       }
       case kRodMinus:
       case kRodPlus: {
-        const Vector3d& e = rail_dir[hit == kRodMinus ? 0 : 1];
-        const Vector3d n = (p - axial * e).normalized();
+        const Vector3d n = rod_normal();
         const Rgb steel{0.50, 0.50, 0.52};
         const double spec = 0.5 * highlight(n, 25);
         return steel * lambert(n) + Rgb{spec, spec, spec};
       }
+      case kTape:  // black vinyl tape: dark, with a dull sheen
+        return Rgb{0.035, 0.035, 0.04} * lambert(rod_normal()) + Rgb{1, 1, 1} * (0.04 * highlight(rod_normal(), 10));
       case kCrossbar: {
-        const Vector3d n = (p - Vector3d(apparatus.crossbar_x, axial, crossbar_z)).normalized();
+        const Vector3d n = (p - Vector3d(apparatus.crossbar_x, h.axial, crossbar_z)).normalized();
         return Rgb{0.22, 0.32, 0.42} * lambert(n);
       }
-      case kTable: {
-        const double texture = TableTexture(p.x(), p.y());
-        return Rgb{0.55, 0.68, 0.80} * (texture * lambert(Vector3d::UnitZ()) * ShadowFactor(p, bodies));
+      case kFoot: {
+        const Vector3d n = Vector3d(p.x() - apparatus.crossbar_x, p.y() - (h.index ? foot_y : -foot_y), 0).normalized();
+        return Rgb{0.22, 0.32, 0.42} * lambert(n);
+      }
+      case kTable:
+      case kRuler: {
+        const double lit = lambert(Vector3d::UnitZ()) * ShadowFactor(p, bodies);
+        if (h.id == kRuler) return (OnTick(p.x(), p.y()) ? Rgb{0.03, 0.03, 0.03} : Rgb{0.20, 0.62, 0.78}) * lit;
+        return Rgb{0.55, 0.68, 0.80} * (TableTexture(p.x(), p.y()) * lit);
       }
       case kWall:
         return Rgb{0.80, 0.82, 0.80} * (0.75 + 0.1 * std::tanh(p.z()));
@@ -250,6 +304,7 @@ struct ClipRenderer::Impl {
             const int uu = u + du, vv = v + dv;
             if (uu >= 0 && vv >= 0 && uu < width && vv < height && ids.at<std::uint8_t>(vv, uu) != id) edge = true;
           }
+        if (id == kRuler) edge = true;  // the ticks, 1 mm wide, are finer than a pixel
         if (edge) {
           static_edge.at<std::uint8_t>(v, u) = 1;
           const Rgb c = Supersample(u, v, none);
@@ -314,6 +369,8 @@ ClipRenderer::ClipRenderer(const Scene& scene, const SceneCalibration& calibrati
   m.light = Vector3d(-0.35, -0.45, 1.0).normalized();
   m.crossbar_z = apparatus.crossbar_x * B - m.rod_radius - apparatus.crossbar_radius;
   m.crossbar_half_length = apparatus.crossbar_x * T + 0.06;
+  m.foot_y = apparatus.crossbar_x * T;
+  for (double x : apparatus.tape_marks_x) m.tape_axial.push_back(x * Vector3d(1, T, B).norm());
 
   std::vector<Vector2d> pixels;
   pixels.reserve(static_cast<size_t>(m.width) * m.height);
@@ -400,6 +457,17 @@ double ClipRenderer::Visibility(double x, double z) const {
     visible += !hidden;
   }
   return static_cast<double>(visible) / n;
+}
+
+bool ClipRenderer::Sees(const Vector3d& point, const std::vector<Vector2d>& centres, double reach) const {
+  const Impl& m = *impl_;
+  if ((m.calibration.pose.rotation * point + m.calibration.pose.translation).z() <= 1e-3) return false;
+  const Vector2d pixel = ProjectApparatusPoint(m.calibration.camera, m.calibration.pose, point);
+  if (!(pixel.x() >= 0 && pixel.y() >= 0 && pixel.x() <= m.width - 1 && pixel.y() <= m.height - 1)) return false;
+  std::vector<Vector3d> bodies;
+  for (const Vector2d& c : centres) bodies.emplace_back(c.x(), 0.0, c.y());
+  const Vector3d d = (point - m.eye).normalized();
+  return (m.eye + m.FirstHit(d, bodies).t * d - point).norm() <= reach;
 }
 
 cv::Mat ToFrame8(const cv::Mat& linear, double gain, double noise_sigma, cv::RNG& rng) {

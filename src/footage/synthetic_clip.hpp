@@ -7,7 +7,8 @@
 // symmetry axis along y) with its centre at (x, 0, z); the two rails as round rods whose axes are
 // the rail lines (the scene's rod radius, or ClipApparatus::min_rod_radius when the scene has
 // line rails or thinner rods, so they are visible), from O to a little beyond the crossbar; the
-// crossbar, a horizontal round bar along y under the rails at x = crossbar_x; a textured table
+// crossbar, a horizontal round bar along y under the rails at x = crossbar_x; optionally the
+// lab's marks (ClipApparatus: tape on the rods, the crossbar's feet, a ruler); a textured table
 // (plane z = table_z) and a plain wall behind (plane y = wall_y). One directional light: Lambert
 // shading with a Blinn–Phong highlight on the body and the rods, a soft shadow of the body on the
 // table.
@@ -54,6 +55,16 @@ struct ClipApparatus {
   // and timing apart from the body's appearance).
   enum class Finish { kGlossy, kMatte, kFlat };
   Finish body_finish = Finish::kGlossy;
+  // What a lab marks and a technician clicks (calibration/README.md, "The apparatus frame and the
+  // points to use"); none by default. Black tape round both rods at these horizontal distances
+  // from O (m); the crossbar's feet, round posts standing on the table under the rails; a yellow
+  // ruler 30 mm wide on the table in front of the rails (its near edge at y = −160 mm), from
+  // x = −20 mm to 1020 mm, a tick every 10 mm, x = 0 at O.
+  std::vector<double> tape_marks_x;
+  double tape_width = 0.008;   // m
+  bool feet = false;
+  double foot_radius = 0.004;  // m
+  bool ruler = false;
 };
 
 // A ready-made setting: the default clip of tools/make_video and of the tests. Sphere of radius
@@ -114,6 +125,11 @@ class ClipRenderer {
   cv::Mat RenderLinear(const std::vector<Eigen::Vector2d>& centres) const;
   // Visible fraction of the outline of the body centred at (x, 0, z).
   double Visibility(double x, double z) const;
+  // Whether `point` (apparatus frame, m) is in plain view with the body at `centres` ((x, z), m):
+  // its pixel is inside the image and the first surface its viewing ray meets is within `reach`
+  // (m) of it. A mark on a rod's axis is seen on the rod's surface, one radius from the axis; a
+  // point hidden behind a rod, the crossbar or the body is not seen.
+  bool Sees(const Eigen::Vector3d& point, const std::vector<Eigen::Vector2d>& centres, double reach) const;
   const SceneCalibration& calibration() const;
 
   struct Impl;

@@ -6,18 +6,23 @@
 // Usage: make_video OUT_DIR [--width 1280 --height 720] [--frames 60] [--fps 30] [--blur 8]
 //        [--noise 2] [--flicker 0.01] [--lossless] [--spheroid] [--boards 12] [--seed 1]
 //        [--D 150] [--x0 MM | --x0-band F] [--mu 0] [--release-time 0] [--seconds S | --until-end]
-//        [--name clip]
+//        [--name clip] [--marks 300,600,900] [--bare]
 // Writes OUT_DIR/NAME.mp4 (H.264; NAME.avi, FFV1, with --lossless), NAME.truth.csv (truth.csv
 // for the default name), cam.json, scene.json, points.csv (the apparatus points of
-// calibration/README.md in view, O, the rails at the crossbar, the feet on the table, marks at
-// 300/600/900 mm, with their exact pixels: the POINTS.csv of `uphill calibrate scene`, and the
-// clicks of the page's end-to-end test), boards/board_NN.png, and prints the `uphill track`
+// calibration/README.md that a person can see in the first frame, O, the rails at the crossbar,
+// the crossbar's feet on the table, the tape marks, with their exact pixels: the POINTS.csv of
+// `uphill calibrate scene`, and the clicks of the page's end-to-end test; a point hidden behind a
+// rod, the crossbar or the ball is left out), boards/board_NN.png, and prints the `uphill track`
 // command for the clip. A trial of an experiment (data/series3-video): the rail separation D, the
 // release position and the rolling resistance μ of the motion (the ODE method when μ > 0), held
 // at rest until --release-time; --x0-band F releases at band.high + F·(band.high − X) of the rest
 // band of μ (F < 0: inside the band, the body stays; F > 0: beyond it, it rolls up and falls off);
 // --until-end makes the clip last until the motion has ended (+0.3 s), or 1 s at rest.
+// The apparatus carries what a lab marks (synthetic_clip.hpp's ClipApparatus): black tape round
+// both rods at --marks (mm from O, horizontally), the crossbar's feet and a ruler on the table;
+// --bare draws none of them.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -45,6 +50,8 @@ struct Flags {
   double D_mm = 150, mu = 0, release_time = 0, seconds = 0;
   std::optional<double> x0_mm, x0_band;
   std::string name = "clip";
+  std::vector<double> marks_mm = {300, 600, 900};
+  bool bare = false;
 };
 
 void Run(const Flags& f) {
@@ -83,6 +90,12 @@ void Run(const Flags& f) {
   settings.noise_sigma = f.noise;
   settings.flicker = f.flicker;
   settings.seed = f.seed;
+  std::vector<double> marks_m;
+  for (double mm : f.marks_mm) marks_m.push_back(mm * 1e-3);
+  if (!f.bare) {
+    setup.apparatus.tape_marks_x = marks_m;
+    setup.apparatus.feet = setup.apparatus.ruler = true;
+  }
   const ClipRenderer renderer(setup.scene, setup.calibration, setup.apparatus);
   std::cout << "x0 = " << setup.x0 * 1e3 << " mm";
   if (const auto band = setup.scene.Rest(f.mu)) std::cout << ", rest band of mu = " << f.mu << ": [" << band->low * 1e3 << ", " << band->high * 1e3 << "] mm";
@@ -97,11 +110,17 @@ void Run(const Flags& f) {
   summary.reasons = {"the camera that rendered the clip: no calibration error"};
   WriteCameraFile((fs::path(f.out) / "cam.json").string(), setup.calibration.camera, summary);
   WriteSceneFile((fs::path(f.out) / "scene.json").string(), setup.calibration, summary);
+  // A point is seen where the first surface on its ray lies within a rod's or a foot's radius of
+  // it (plus 2 mm): on the rod, the tape or the post it marks, not on something in front of it.
+  const double reach =
+      std::max({setup.scene.rod_radius(), setup.apparatus.min_rod_radius, setup.apparatus.foot_radius}) + 0.002;
+  const MotionSample first = motion.At(0);
   std::string points = "name,u,v,x_mm,y_mm,z_mm\n";
   for (const ApparatusPoint& p : VisibleApparatusPoints(
            setup.calibration.camera, setup.calibration.pose,
            ApparatusCalibrationPoints(setup.scene.rails(), setup.apparatus.crossbar_x, setup.apparatus.table_z,
-                                      {0.3, 0.6, 0.9}))) {
+                                      f.bare ? std::vector<double>{} : marks_m))) {
+    if (!renderer.Sees(p.position, {Eigen::Vector2d(first.x, first.z)}, reach)) continue;
     char line[200];
     std::snprintf(line, sizeof line, "%s,%.6f,%.6f,%.6f,%.6f,%.6f\n", p.name.c_str(), p.pixel.x(), p.pixel.y(),
                   p.position.x() * 1e3, p.position.y() * 1e3, p.position.z() * 1e3);
@@ -154,6 +173,8 @@ int main(int argc, char** argv) {
   app.add_option("--seconds", f.seconds, "clip length, s (instead of --frames)");
   app.add_flag("--until-end", f.until_end, "clip lasts until the motion ends (+0.3 s; 1 s when at rest)");
   app.add_option("--name", f.name, "file stem of the clip")->capture_default_str();
+  app.add_option("--marks", f.marks_mm, "tape marks on both rods, mm from O (horizontal)")->delimiter(',')->capture_default_str();
+  app.add_flag("--bare", f.bare, "no tape marks, feet or ruler: the rails and the crossbar alone");
   CLI11_PARSE(app, argc, argv);
   try {
     Run(f);
