@@ -19,10 +19,12 @@
 // is known) and those with the strongest grey step across them; a few are fitted per frame, places
 // already refused whose pixels have not changed are skipped, and of the bodies found the one that
 // stands out of its surroundings by the most noise levels is taken (one whose outline the edge fit
-// finds all round before any other). TrackerOptions::init_uv, a raw pixel near the centre, replaces
-// that search for the first frame. Then frame by frame near the prediction from the last positions
-// (constant acceleration in time). When a fit fails it re-acquires at once, in the same frame:
-// along the path near the prediction, then along the whole path. A centre beyond the path's ends
+// finds all round before any other), none by fewer than kAcquireMinStandOut
+// (internal/tracker_thresholds.hpp). TrackerOptions::init_uv, a raw pixel near the centre,
+// replaces that search for the first frame. Then frame by frame near the prediction from the last
+// positions (constant acceleration in time). When a fit fails it re-acquires at once, in the same
+// frame: along the path near the prediction, where a place more than a radius (and three frames'
+// travel) off the prediction is not the body, then along the whole path. A centre beyond the path's ends
 // [x_low, x_max] is never a body on the rails.
 //
 // The opening: a body at rest from the first frame hides the background under it, so the first

@@ -25,9 +25,10 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
   }
   if (guesses.empty() || !predicted)
     for (const Vector2d& c : Candidates(frame, gain, x_lo, x_hi)) guesses.push_back(c);
-  // Near a prediction the first candidate accepted is the body. Found anew, every candidate is
-  // fitted and the one standing out of its surroundings by the most noise levels is taken: a
-  // patch of the table's texture may fit an outline too, but never by the contrast of a body.
+  // Near a prediction the first candidate accepted within a radius of it is the body. Found
+  // anew, every candidate is fitted and the one standing out of its surroundings by the most
+  // noise levels is taken, if by kAcquireMinStandOut at least: a patch of the table's texture or
+  // a tape mark on a rod may fit an outline too, but not by the contrast of a body.
   std::optional<Found> best;
   double best_score = 0;
   int fitted = 0;
@@ -46,11 +47,19 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
     }
     const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
     if (predicted) {
-      rejected.Clear();
+      // A body rolling on the rails does not leave its predicted path by more than a radius
+      // (and three frames' travel): a place farther off is something else (a reflection, the
+      // rails' crossing).
       if ((geometry.Project(c.x(), c.y()) - geometry.Project(near->centre.x(), near->centre.y())).norm() >
-          2 * RadiusPx(c.x(), c.y()) + 3 * near->velocity.norm() / options.fps / MetresPerPx(c.x(), c.y()))
-        history.clear();
+          RadiusPx(c.x(), c.y()) + 3 * near->velocity.norm() / options.fps / MetresPerPx(c.x(), c.y()))
+        continue;
+      rejected.Clear();
       return Found{fit, q, std::nullopt, false};
+    }
+    const double stand_out = fit.contrast / std::max(noise, fit.noise);
+    if (stand_out < kAcquireMinStandOut) {
+      rejected.Remember(frame, window);
+      continue;
     }
     // Where the background is unknown, a candidate whose outline the edge fit finds all round
     // comes before any other: a print or a reflection can hold the model's outline off a body,
@@ -61,7 +70,7 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
       const internal::EdgeFitOutcome w = edges->Measure(frame, c.x(), c.y(), 2 * options.search_half_width_px);
       if (CleanOutline(w)) outline = w;
     }
-    const double score = fit.contrast / std::max(noise, fit.noise) + (outline ? 1e6 : 0);
+    const double score = stand_out + (outline ? 1e6 : 0);
     if (!best || score > best_score) best = Found{fit, q, outline}, best_score = score;
   }
   if (!best) return std::nullopt;
