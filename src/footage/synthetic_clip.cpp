@@ -442,19 +442,10 @@ double ClipRenderer::Visibility(double x, double z) const {
   int visible = 0;
   for (int k = 0; k < n; ++k) {
     if (image[k].x() < 0 || image[k].y() < 0 || image[k].x() > m.width - 1 || image[k].y() > m.height - 1) continue;
+    // Hidden where the apparatus (a rod, the crossbar, a foot) stands in front of the outline.
     const Vector3d to = points[k] - m.eye;
     const double reach = to.norm();
-    const Vector3d d = to / reach;
-    bool hidden = false;
-    double axial = 0;
-    for (int r = 0; r < 2 && !hidden; ++r)
-      hidden = HitCylinder(m.eye, d, Vector3d::Zero(), m.rail_dir[r], m.rod_radius, 0.0, m.rail_end, &axial) <
-               reach - 1e-6;
-    if (!hidden)
-      hidden = HitCylinder(m.eye, d, Vector3d(m.apparatus.crossbar_x, 0, m.crossbar_z), Vector3d::UnitY(),
-                           m.apparatus.crossbar_radius, -m.crossbar_half_length, m.crossbar_half_length,
-                           &axial) < reach - 1e-6;
-    visible += !hidden;
+    visible += !(m.FirstHit(to / reach, {}).t < reach - 1e-6);
   }
   return static_cast<double>(visible) / n;
 }
