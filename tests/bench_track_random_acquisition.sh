@@ -1,33 +1,46 @@
 #!/usr/bin/env bash
-# A draw of `uphill bench track --random 40 --seed 9998171038873176079` where the search along the
-# path took a tape mark for the body, replayed with --draw (rendered by POV-Ray at test time, about
-# 160 s of CPU, cached in the build tree after). Truth: the renderer's projected centre and
-# uphill::Motion (src/motion), as the benchmark states.
-#   ce3de63a  two-tone spheroid (dark green and cream) on tiles, at rest beside the black tape
-#             mark at 300 mm, then rolling down. kVideoTrackerVersion 17 fitted its outline on the
-#             tape mark in the first frame (it stands out by 8.8 noise levels; the body's cream
-#             half matches the tiles) and stayed there: 42.7 px RMS, 40 of 40 frames silent wrong.
-#             Now a place found anew must stand out by 10 noise levels (kAcquireMinStandOut).
-# Known and left: its last four frames drift 1.1-1.4 px off as the dark half turns into view
-# (silent wrong; docs/track.md lists the hard cases).
+# Draws of `uphill bench track --random 40` where the search along the path, finding the body in
+# the first frame, took something else for it; replayed with --draw (rendered by POV-Ray at test
+# time, about 200 s of CPU, cached in the build tree after). Truth: the renderer's projected
+# centre and uphill::Motion (src/motion), as the benchmark states.
+#   seed 9998171038873176079, ce3de63a: two-tone spheroid (dark green and cream) on tiles, at
+#             rest beside the black tape mark at 300 mm, then rolling down. kVideoTrackerVersion
+#             17 fitted its outline on the tape mark in the first frame (it stands out by 8.8
+#             noise levels; the body's cream half matches the tiles) and stayed there: 42.7 px
+#             RMS, 40 of 40 frames silent wrong. Now a place found anew must stand out by 10
+#             noise levels (kAcquireMinStandOut). Known and left: its last four frames drift
+#             1.1-1.4 px off as the dark half turns into view (silent wrong; docs/track.md lists
+#             the hard cases).
+#   seed 4366590314390829142, 53032858: dotted pink sphere at rest on wood behind a painted rod.
+#             kVideoTrackerVersion 18 started its fit at the highest colour score, 15 px off the
+#             centre (a dot or the highlight lifts one place of the body's plateau of scores), the
+#             fit did not converge, and a place at the path's start was tracked: 554 px RMS, 35
+#             frames silent wrong. Now the search starts at the plateau's centre, and the edge
+#             fit's clean outline measures a body at rest whose background is never seen.
 #   bash tests/bench_track_random_acquisition.sh UPHILL_VISION_PROGRAM CACHE_DIR
 set -euo pipefail
 program="$1"
 cache="$2"
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-"$program" bench track --random 40 --seed 9998171038873176079 --draw ce3de63a \
-  --random-cache "$cache" --json "$out/random.json" > "$out/stdout.txt"
-cat "$out/stdout.txt"
-/usr/bin/python3 - "$out/random.json" <<'PY'
+replay() {  # seed, draw
+  "$program" bench track --random 40 --seed "$1" --draw "$2" --random-cache "$cache" \
+    --json "$out/$2.json" > "$out/$2.txt"
+  cat "$out/$2.txt"
+}
+replay 9998171038873176079 ce3de63a
+replay 4366590314390829142 53032858
+/usr/bin/python3 - "$out" <<'PY'
 import json, sys
-doc = json.load(open(sys.argv[1]))
-(draw,) = doc["draws"]
-assert draw["id"] == "ce3de63a", draw["id"]
-core = draw["core"]
-# Measured: 0.54 px RMS, 38 of 40 frames found, 4 silent wrong (the drift above).
-assert core["px_rms"] is not None and core["px_rms"] <= 0.7, core
-assert core["frames_found"] >= 36, core
-assert core["silent_wrong"] <= 4, core
+# (most px RMS, least frames found, most silent wrong). Measured: ce3de63a 0.54 px, 38 of 40
+# found, 4 silent wrong (the drift above); 53032858 0.048 px, 40 of 40, 0.
+bounds = {"ce3de63a": (0.7, 36, 4), "53032858": (0.1, 40, 0)}
+for name, (most_px, least_found, most_wrong) in bounds.items():
+    (draw,) = json.load(open(f"{sys.argv[1]}/{name}.json"))["draws"]
+    assert draw["id"] == name, draw["id"]
+    core = draw["core"]
+    assert core["px_rms"] is not None and core["px_rms"] <= most_px, (name, core)
+    assert core["frames_found"] >= least_found, (name, core)
+    assert core["silent_wrong"] <= most_wrong, (name, core)
 print("random bench acquisition: ok")
 PY

@@ -10,21 +10,21 @@ namespace uphill {
 std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat& frame, double gain, long f,
                                                                  const std::optional<Prediction>& near) {
   const bool predicted = near.has_value();
-  std::vector<Vector2d> guesses;
+  std::vector<SearchStart> guesses;
   if (f == 0 && options.init_uv) {
     const Vector2d nrm = UndistortPixel(geometry.cal.camera, *options.init_uv);
     const Vector3d ray = geometry.to_apparatus * Vector3d(nrm.x(), nrm.y(), 1.0);
     if (std::abs(ray.y()) > 1e-12) {
       const double s = -geometry.eye.y() / ray.y();
-      if (s > 0) guesses.emplace_back(geometry.eye.x() + s * ray.x(), geometry.eye.z() + s * ray.z());
+      if (s > 0) guesses.push_back({Vector2d(geometry.eye.x() + s * ray.x(), geometry.eye.z() + s * ray.z()), std::nullopt});
     }
   }
   if (predicted) {
     const double reach = 4 * geometry.a + 3 * near->velocity.norm() / options.fps;
-    for (const Vector2d& c : Candidates(frame, gain, near->centre.x() - reach, near->centre.x() + reach)) guesses.push_back(c);
+    for (const SearchStart& c : Candidates(frame, gain, near->centre.x() - reach, near->centre.x() + reach)) guesses.push_back(c);
   }
   if (guesses.empty() || !predicted)
-    for (const Vector2d& c : Candidates(frame, gain, x_lo, x_hi)) guesses.push_back(c);
+    for (const SearchStart& c : Candidates(frame, gain, x_lo, x_hi)) guesses.push_back(c);
   // Near a prediction the first candidate accepted within a radius of it is the body. Found
   // anew, every candidate is fitted and the one standing out of its surroundings by the most
   // noise levels is taken, if by kAcquireMinStandOut at least: a patch of the table's texture or
@@ -32,46 +32,48 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
   std::optional<Found> best;
   double best_score = 0;
   int fitted = 0;
-  for (const Vector2d& guess : guesses) {
+  const int budget = f == 0 && !predicted ? kAcquireFitsFirstFrame : kAcquireFitsPerFrame;
+  for (const SearchStart& place : guesses) {
     // Without a prediction a candidate's fit depends on its window of the frame alone.
-    const cv::Rect window = predicted ? cv::Rect() : BodyRegion(guess, Vector2d::Zero());
+    const cv::Rect window = predicted ? cv::Rect() : BodyRegion(place.at, Vector2d::Zero());
     if (!predicted && rejected.Unchanged(frame, window)) continue;
-    if (++fitted > kAcquireFitsPerFrame) break;
-    const Vector2d v = predicted ? near->velocity : Vector2d::Zero();
-    const FitRequest q = Request(guess, v, predicted && history.size() >= 2, 2 * options.search_half_width_px,
+    bool body_here = false;
+    for (const std::optional<Vector2d>& guess : {std::optional<Vector2d>(place.at), place.again}) {
+      if (!guess || body_here || fitted >= budget) continue;
+      ++fitted;
+      const Vector2d v = predicted ? near->velocity : Vector2d::Zero();
+      const FitRequest q = Request(*guess, v, predicted && history.size() >= 2, 2 * options.search_half_width_px,
                                    predicted ? near->acceleration : Vector2d::Zero());
-    const FitOutcome fit = Measure({frame, {0, 0}, gain}, q, Search::kAcquiring);
-    if (!Accept(fit, kAcquireAgreement)) {
-      if (!predicted) rejected.Remember(frame, window);
-      continue;
+      const FitOutcome fit = Measure({frame, {0, 0}, gain}, q, Search::kAcquiring);
+      if (!Accept(fit, kAcquireAgreement)) continue;
+      const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
+      if (predicted) {
+        // A body rolling on the rails does not leave its predicted path by more than a radius
+        // (and three frames' travel): a place farther off is something else (a reflection, the
+        // rails' crossing).
+        if ((geometry.Project(c.x(), c.y()) - geometry.Project(near->centre.x(), near->centre.y())).norm() >
+            RadiusPx(c.x(), c.y()) + 3 * near->velocity.norm() / options.fps / MetresPerPx(c.x(), c.y()))
+          continue;
+        rejected.Clear();
+        return Found{fit, q, std::nullopt, false};
+      }
+      const double stand_out = fit.contrast / std::max(noise, fit.noise);
+      if (stand_out < kAcquireMinStandOut) continue;
+      body_here = true;
+      // Where the background is unknown, a candidate whose outline the edge fit finds all round
+      // comes before any other: a print or a reflection can hold the model's outline off a body,
+      // a patch of the table has no such outline.
+      std::optional<internal::EdgeFitOutcome> outline;
+      if (fit.rays_without_background > 0) {
+        edges->Reset();
+        const internal::EdgeFitOutcome w = edges->Measure(frame, c.x(), c.y(), 2 * options.search_half_width_px);
+        if (CleanOutline(w)) outline = w;
+      }
+      const double score = stand_out + (outline ? 1e6 : 0);
+      if (!best || score > best_score) best = Found{fit, q, outline}, best_score = score;
     }
-    const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
-    if (predicted) {
-      // A body rolling on the rails does not leave its predicted path by more than a radius
-      // (and three frames' travel): a place farther off is something else (a reflection, the
-      // rails' crossing).
-      if ((geometry.Project(c.x(), c.y()) - geometry.Project(near->centre.x(), near->centre.y())).norm() >
-          RadiusPx(c.x(), c.y()) + 3 * near->velocity.norm() / options.fps / MetresPerPx(c.x(), c.y()))
-        continue;
-      rejected.Clear();
-      return Found{fit, q, std::nullopt, false};
-    }
-    const double stand_out = fit.contrast / std::max(noise, fit.noise);
-    if (stand_out < kAcquireMinStandOut) {
-      rejected.Remember(frame, window);
-      continue;
-    }
-    // Where the background is unknown, a candidate whose outline the edge fit finds all round
-    // comes before any other: a print or a reflection can hold the model's outline off a body,
-    // a patch of the table has no such outline.
-    std::optional<internal::EdgeFitOutcome> outline;
-    if (fit.rays_without_background > 0) {
-      edges->Reset();
-      const internal::EdgeFitOutcome w = edges->Measure(frame, c.x(), c.y(), 2 * options.search_half_width_px);
-      if (CleanOutline(w)) outline = w;
-    }
-    const double score = stand_out + (outline ? 1e6 : 0);
-    if (!best || score > best_score) best = Found{fit, q, outline}, best_score = score;
+    if (!predicted && !body_here) rejected.Remember(frame, window);
+    if (fitted >= budget) break;
   }
   if (!best) return std::nullopt;
   best->anew = true;
@@ -86,7 +88,7 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
   return best;
 }
 
-std::vector<Vector2d> BallTracker::Impl::Candidates(const cv::Mat& frame, double gain, double x0, double x1) const {
+std::vector<BallTracker::Impl::SearchStart> BallTracker::Impl::Candidates(const cv::Mat& frame, double gain, double x0, double x1) const {
   x0 = std::max(x0, x_lo);
   x1 = std::min(x1, x_hi);
   if (!(x1 > x0)) return {};
@@ -158,9 +160,13 @@ std::vector<Vector2d> BallTracker::Impl::Candidates(const cv::Mat& frame, double
   }
   // The best by colour and the best by the outline's step, each a radius from the
   // others of its kind (a fit started there reaches the body within a radius) and a quarter
-  // radius from the other kind's (the same place).
-  std::vector<Vector2d> out;
-  auto take = [&](std::vector<std::pair<double, double>>& by, size_t most) {
+  // radius from the other kind's (the same place). A body's colour score is a plateau, about as
+  // high wherever the outline stays on the body's colour with its outside off it, and a print's
+  // dot or a highlight can lift any place of it: where the plateau's centre lies a quarter radius
+  // or more from its highest place, it is a second start.
+  const std::vector<std::pair<double, double>> colour_along = scored;  // in x order
+  std::vector<SearchStart> out;
+  auto take = [&](std::vector<std::pair<double, double>>& by, size_t most, bool plateau) {
     std::sort(by.begin(), by.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
     const size_t before = out.size();
     for (const auto& [score, xc] : by) {
@@ -169,13 +175,30 @@ std::vector<Vector2d> BallTracker::Impl::Candidates(const cv::Mat& frame, double
       const double r = RadiusPx(xc, scene.At(xc).z);
       bool near = false;
       for (size_t i = 0; i < out.size(); ++i)
-        near = near || (geometry.Project(out[i].x(), out[i].y()) - p).norm() < (i >= before ? r : 0.25 * r);
-      if (!near) out.emplace_back(xc, scene.At(xc).z);
+        near = near || (geometry.Project(out[i].at.x(), out[i].at.y()) - p).norm() < (i >= before ? r : 0.25 * r);
+      if (near) continue;
+      SearchStart place{Vector2d(xc, scene.At(xc).z), std::nullopt};
+      const double centre = plateau ? PlateauCentre(colour_along, xc) : xc;
+      if ((geometry.Project(centre, scene.At(centre).z) - p).norm() >= 0.25 * r) place.again = Vector2d(centre, scene.At(centre).z);
+      out.push_back(place);
     }
   };
-  take(scored, kCandidatesByColour);
-  take(stepped, kCandidatesByStep);
+  take(scored, kCandidatesByColour, true);
+  take(stepped, kCandidatesByStep, false);
   return out;
+}
+
+// The score-weighted mean x of the run of places, along the path, around the one at `peak` whose
+// scores stay within kPlateauShare of its score.
+double BallTracker::Impl::PlateauCentre(const std::vector<std::pair<double, double>>& along, double peak) {
+  const auto at = std::find_if(along.begin(), along.end(), [&](const auto& s) { return s.second == peak; });
+  const double floor = kPlateauShare * at->first;
+  auto first = at, last = at;
+  while (first != along.begin() && std::prev(first)->first >= floor) --first;
+  while (std::next(last) != along.end() && std::next(last)->first >= floor) ++last;
+  double weight = 0, sum = 0;
+  for (auto s = first; s != std::next(last); ++s) weight += s->first, sum += s->first * s->second;
+  return sum / weight;
 }
 
 }  // namespace uphill

@@ -249,7 +249,15 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // Candidates along the path between x0 and x1: the best kCandidatesByColour by the predicted
   // outline's inside against its outside (against the background where it is known), then the
   // best kCandidatesByStep by the grey step across the outline.
-  std::vector<Vector2d> Candidates(const cv::Mat& frame, double gain, double x0, double x1) const;
+  // A place to start a fit at, and a second start where a fit from the first does not find a
+  // body (the centre of a colour candidate's plateau).
+  struct SearchStart {
+    Vector2d at;
+    std::optional<Vector2d> again;
+  };
+  std::vector<SearchStart> Candidates(const cv::Mat& frame, double gain, double x0, double x1) const;
+  // The centre of the plateau of colour scores ((score, x) in x order) around the place x = peak.
+  static double PlateauCentre(const std::vector<std::pair<double, double>>& along, double peak);
 
   // Quality in [0, 1]: the share of the visible outline's rays that agree with the fit, lowered
   // when those fit worse than the pixel noise allows and when the body stands out of the

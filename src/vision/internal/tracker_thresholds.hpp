@@ -67,6 +67,14 @@ struct TrackerThresholds {
   // within a few frames.
   static constexpr std::size_t kCandidatesByColour = 12, kCandidatesByStep = 4;
   static constexpr int kAcquireFitsPerFrame = 5;
+  // In the first frame every candidate and its second start are fitted: a body at rest is there
+  // from the start, and the body's own place may rank below a patch of the table that fits an
+  // outline too (the best of them is taken, by its contrast).
+  static constexpr int kAcquireFitsFirstFrame = 2 * static_cast<int>(kCandidatesByColour + kCandidatesByStep);
+  // The share of a colour candidate's score down to which its neighbours along the path belong to
+  // its plateau (Candidates): the places whose outline stays on a body score within about 20 % of
+  // each other, those whose outline crosses its limb less.
+  static constexpr double kPlateauShare = 0.8;
   // CleanOutline: the share of the edge fit's rays within a pixel of its outline, and their RMS,
   // px, for the edge fit to stand in for a model fit without background (a print's stripes near
   // the limb scatter the edges by about 0.35 px and keep about 80 % of them on the outline; a
