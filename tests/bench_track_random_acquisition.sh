@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Draws of `uphill bench track --random 40` where the search along the path, finding the body in
-# the first frame, took something else for it; replayed with --draw (rendered by POV-Ray at test
-# time, about 200 s of CPU, cached in the build tree after). Truth: the renderer's projected
+# the first frame, took something else for it or missed it; replayed with --draw (rendered by POV-Ray at test
+# time, about 210 s of CPU, cached in the build tree after). Truth: the renderer's projected
 # centre and uphill::Motion (src/motion), as the benchmark states.
 #   seed 9998171038873176079, ce3de63a: two-tone spheroid (dark green and cream) on tiles, at
 #             rest beside the black tape mark at 300 mm, then rolling down. kVideoTrackerVersion
@@ -17,6 +17,11 @@
 #             fit did not converge, and a place at the path's start was tracked: 554 px RMS, 35
 #             frames silent wrong. Now the search starts at the plateau's centre, and the edge
 #             fit's clean outline measures a body at rest whose background is never seen.
+#   seed 11339591480978857371, bed4dec5: dotted spheroid at rest on tiles, 640x360. Its step
+#             candidate, on its centre, lay 7 px (under a quarter radius) from its colour
+#             candidate and was dropped as the same place; the fit from the colour candidate
+#             stopped 2.3 px off, standing out too little: found in 0 of 40 frames. Now only a
+#             place within the search's half-width of the other kind's is the same.
 #   bash tests/bench_track_random_acquisition.sh UPHILL_VISION_PROGRAM CACHE_DIR
 set -euo pipefail
 program="$1"
@@ -30,11 +35,13 @@ replay() {  # seed, draw
 }
 replay 9998171038873176079 ce3de63a
 replay 4366590314390829142 53032858
+replay 11339591480978857371 bed4dec5
 /usr/bin/python3 - "$out" <<'PY'
 import json, sys
 # (most px RMS, least frames found, most silent wrong). Measured: ce3de63a 0.54 px, 38 of 40
-# found, 4 silent wrong (the drift above); 53032858 0.048 px, 40 of 40, 0.
-bounds = {"ce3de63a": (0.7, 36, 4), "53032858": (0.1, 40, 0)}
+# found, 4 silent wrong (the drift above); 53032858 0.048 px, 40 of 40, 0; bed4dec5 0.089 px,
+# 27 of 40, 0 (the first 13 frames' fits stand out by under 10 noise levels).
+bounds = {"ce3de63a": (0.7, 36, 4), "53032858": (0.1, 40, 0), "bed4dec5": (0.15, 25, 0)}
 for name, (most_px, least_found, most_wrong) in bounds.items():
     (draw,) = json.load(open(f"{sys.argv[1]}/{name}.json"))["draws"]
     assert draw["id"] == name, draw["id"]

@@ -158,9 +158,10 @@ std::vector<BallTracker::Impl::SearchStart> BallTracker::Impl::Candidates(const 
     std::nth_element(edge_steps.begin(), edge_steps.begin() + used / 2, edge_steps.begin() + used);
     stepped.emplace_back(std::abs(edge_steps[used / 2]), xc);
   }
-  // The best by colour and the best by the outline's step, each a radius from the
-  // others of its kind (a fit started there reaches the body within a radius) and a quarter
-  // radius from the other kind's (the same place). A body's colour score is a plateau, about as
+  // The best by colour and the best by the outline's step, each a radius from the others of its
+  // kind (a fit started there reaches the body within a radius) and the search's half-width from
+  // the other kind's (a fit started there sees the same outline; one started a quarter radius
+  // off a printed body's centre may not reach it). A body's colour score is a plateau, about as
   // high wherever the outline stays on the body's colour with its outside off it, and a print's
   // dot or a highlight can lift any place of it: where the plateau's centre lies a quarter radius
   // or more from its highest place, it is a second start.
@@ -175,7 +176,7 @@ std::vector<BallTracker::Impl::SearchStart> BallTracker::Impl::Candidates(const 
       const double r = RadiusPx(xc, scene.At(xc).z);
       bool near = false;
       for (size_t i = 0; i < out.size(); ++i)
-        near = near || (geometry.Project(out[i].at.x(), out[i].at.y()) - p).norm() < (i >= before ? r : 0.25 * r);
+        near = near || (geometry.Project(out[i].at.x(), out[i].at.y()) - p).norm() < (i >= before ? r : options.search_half_width_px);
       if (near) continue;
       SearchStart place{Vector2d(xc, scene.At(xc).z), std::nullopt};
       const double centre = plateau ? PlateauCentre(colour_along, xc) : xc;
