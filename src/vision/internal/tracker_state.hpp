@@ -246,15 +246,15 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // body is found anew or far from the prediction.
   std::optional<Found> Acquire(const cv::Mat& frame, double gain, long f, const std::optional<Prediction>& near);
 
-  // Candidates along the path between x0 and x1: the best kCandidatesByColour by the predicted
-  // outline's inside against its outside (against the background where it is known), then the
-  // best kCandidatesByStep by the grey step across the outline.
   // A place to start a fit at, and a second start where a fit from the first does not find a
   // body (the centre of a colour candidate's plateau).
   struct SearchStart {
     Vector2d at;
     std::optional<Vector2d> again;
   };
+  // Candidates along the path between x0 and x1: the best kCandidatesByColour by the predicted
+  // outline's inside against its outside (against the background where it is known), then the
+  // best kCandidatesByStep by the grey step across the outline.
   std::vector<SearchStart> Candidates(const cv::Mat& frame, double gain, double x0, double x1) const;
   // The centre of the plateau of colour scores ((score, x) in x order) around the place x = peak.
   static double PlateauCentre(const std::vector<std::pair<double, double>>& along, double peak);
