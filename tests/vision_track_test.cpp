@@ -182,6 +182,38 @@ TEST_F(DefaultView, RowTimesOfARollingShutterHoldOnFramesWithoutTimestamps) {
   EXPECT_LE(run.errors.rms_uv, 0.15);  // measured: 0.095 px
 }
 
+// A rolling shutter asked to be measured (--readout auto) on a clip whose ball never moves shows
+// no shear: the readout is then taken as half a frame, with the standard deviation of a value
+// uniform over 0 … 1/fps (a video's rows are all read within its frame time), and every row's
+// time carries it. Truth: those closed forms, t = frame/fps + v·readout/height.
+TEST_F(DefaultView, AReadoutThatCannotBeMeasuredIsHalfAFrameWithItsRange) {
+  ClipSettings s;
+  s.frames = 8;
+  s.release_time = 10;  // at rest throughout
+  const Motion motion(setup_->scene, setup_->x0);
+  TrackVideoOptions options;
+  options.tracker.measure_readout = true;
+  const ClipRun run = RenderAndTrack(*renderer_, setup_->scene, motion, s, "rest_rows.avi", options);
+  EXPECT_EQ(run.track.measured_readout_frames, 0);
+  EXPECT_DOUBLE_EQ(run.track.readout, 0.5 / 30);
+  ASSERT_TRUE(run.track.readout_u.has_value());
+  EXPECT_NEAR(*run.track.readout_u, 1 / (30 * std::sqrt(12.0)), 1e-12);
+  int checked = 0;
+  for (const TrackRow& r : run.track.rows) {
+    if (!r.ball.found) continue;
+    EXPECT_NEAR(r.t, r.frame / 30.0 + r.ball.v * (0.5 / 30) / 720, 1e-4) << "frame " << r.frame;
+    ++checked;
+  }
+  EXPECT_EQ(checked, s.frames);
+  const std::string csv = (TempDir() / "rest_rows.csv").string();
+  WriteTrack(csv, run.track, {"rest_rows.avi", "cam.json", "scene.json", "sphere"});
+  std::ifstream side_in(csv + ".json");
+  const nlohmann::json side = nlohmann::json::parse(side_in);
+  EXPECT_EQ(side["models"]["rolling_shutter"], "not measurable (too little shear): half a frame assumed");
+  EXPECT_NEAR(side["readout_u_s"].get<double>(), 1 / (30 * std::sqrt(12.0)), 1e-12);
+  EXPECT_EQ(side["image_height_px"], 720);
+}
+
 TEST_F(DefaultView, InitialGuessAndLostBallKeepTheirRows) {
   // Released beyond X: it rolls up the rails and drops between them; the last frames have no ball.
   const double x_eq = *setup_->scene.x_eq(), x_max = setup_->scene.x_max();

@@ -81,7 +81,7 @@
 //    so each parameter takes the largest variance over ℓ ∈ {0 (independent), span/256 … span
 //    (×2 steps), ∞ (one bias)}: a worst case over the nuisance ℓ, conservative by design
 //    (systematic_length says which ℓ it was).
-//    A measured rolling shutter's readout (Track::row_delay_u, from the track's sidecar) adds to
+//    A rolling shutter's readout measured or assumed (Track::row_delay_u, from the sidecar) adds to
 //    it: every frame's time is uncertain by v_i·row_delay_u, one error shared by all frames, so
 //    position i by ẋ_i·v_i·row_delay_u (ẋ_i = −∂x/∂t0), a rank-one covariance added at every ℓ.
 //  - u = sqrt(se_statistical² + se_systematic²) (the residuals also hold part of the bias: a

@@ -210,10 +210,20 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
   }
   result.readout = tracker_options.readout;
   result.readout_asked = tracker_options.measure_readout;
-  if (const auto r = tracker.ReadoutEstimate()) {
-    result.readout = r->seconds;
-    result.measured_readout_frames = r->frames;
-    result.readout_u = r->u;
+  const auto measured = tracker.ReadoutEstimate();
+  if (measured) {
+    result.readout = measured->seconds;
+    result.measured_readout_frames = measured->frames;
+    result.readout_u = measured->u;
+  } else if (tracker_options.measure_readout) {
+    // A rolling shutter whose shear the clip never showed: its readout lies between 0 and the
+    // frame time (a video's rows are read within one frame), so half a frame ± the spread of that
+    // range (uniform: 1/(fps·√12)). Taking 0 put every time early by up to a frame; analyse-track
+    // carries the uncertainty into t0 (readout_u_s).
+    result.readout = 0.5 / tracker_options.fps;
+    result.readout_u = 1 / (tracker_options.fps * std::sqrt(12.0));
+  }
+  if (result.readout > 0 && result.readout_asked) {
     // Every frame's time with the clip's readout: a frame measured before it was known, or with
     // the estimate the clip had reached, still has its centre where the body was when the
     // centre's row was exposed (the shear about that row leaves it in place).
@@ -323,8 +333,8 @@ void WriteTrack(const std::string& csv_path, const TrackResult& result, const Tr
   side["models"] = {
       {"exposure", result.exposure ? "given" : result.measured_exposure ? "measured" : "assumed half a frame"},
       {"rolling_shutter", result.measured_readout_frames > 0 ? "measured"
+                          : result.readout_asked             ? "not measurable (too little shear): half a frame assumed"
                           : result.readout > 0               ? "given"
-                          : result.readout_asked             ? "not measurable (too little shear): global assumed"
                                                              : "global"},
       {"frames_by_edge_fit", found - outline_model},
       {"frames_by_outline_model", outline_model}};

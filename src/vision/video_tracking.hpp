@@ -52,10 +52,12 @@ struct TrackResult {
   // the smear, the rolling shutter's readout, the transfer curve.
   std::optional<double> exposure, measured_exposure;
   int measured_exposure_frames = 0;
-  double readout = 0;  // as used: given, or measured (measured_readout_frames > 0)
+  // As used: given, or measured (measured_readout_frames > 0), or, asked for and not measurable,
+  // half a frame (readout_u then 1/(fps·√12), the spread of the range 0 … 1/fps).
+  double readout = 0;
   int measured_readout_frames = 0;
   bool readout_asked = false;       // --readout auto: to be measured (it may not have been)
-  std::optional<double> readout_u;  // s, the measured readout's standard uncertainty
+  std::optional<double> readout_u;  // s, the measured (or assumed) readout's standard uncertainty
   int image_height = 0;             // px, the rows the readout spans
   VideoTransfer transfer = VideoTransfer::kSrgb;
   std::vector<long> exposure_changes;  // frames where the exposure jumped
