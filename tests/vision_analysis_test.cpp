@@ -285,6 +285,37 @@ TEST(TrackAnalysis, BallThatNeverMoves) {
   EXPECT_NE(a.fit.unavailable.find("never moves"), std::string::npos);
 }
 
+// A sharp tracker (0.02 mm of noise) and the default stated u_x (0.5 mm: a 2.5 mm band): a ball
+// released late in the clip moves by less than the band. Its mean is no rest position; the
+// analysis finds the move against the tracker's own error at rest (the floor, 0.08 px at
+// 12.7 mm / 30 px) and says so. Truth: uphill::Motion, which made the track; the same clip with
+// the ball never released stays a rest.
+TEST(TrackAnalysis, ABallReleasedLateInTheClipMovesWithinTheBandAndIsNotAtRest) {
+  const Scene scene = Ball();
+  Recording r = Released(20e-3, 2.0 + 0.44);  // 0.06 s of motion at the clip's end
+  r.fps = 120, r.duration = 0.5, r.noise = 0.02e-3, r.seed = 3;
+  const Motion truth(scene, r.x0, r.motion);
+  const double moved = std::abs(truth.At(0.06).x - r.x0);
+  ASSERT_GT(moved, 0.3e-3);  // the case: a real move, within the 2.5 mm band
+  ASSERT_LT(moved, 2.4e-3);
+  const TrackAnalysis a = AnalyseTrack(Record(scene, r), scene);
+  SCOPED_TRACE(TrackAnalysisTable(a));
+  EXPECT_FALSE(a.rest);
+  ASSERT_TRUE(a.release);
+  EXPECT_EQ(a.direction, truth.At(0.06).x > r.x0 ? 1 : -1);
+  ExpectWithin(a.release->x.value, r.x0, a.release->x.u, 4, "position before the move");
+  EXPECT_NEAR(a.release->t.value, r.t0, 0.04);  // the last frame before the move is detected
+  EXPECT_FALSE(a.fit.available);
+  EXPECT_NE(a.fit.unavailable.find("less than the stated band"), std::string::npos) << a.fit.unavailable;
+
+  Recording still = r;
+  still.t0 = 1e9;
+  const TrackAnalysis b = AnalyseTrack(Record(scene, still), scene);
+  ASSERT_TRUE(b.rest);
+  EXPECT_EQ(b.direction, 0);
+  ExpectWithin(b.rest->x.value, r.x0, b.rest->x.u, 4, "position at rest");
+}
+
 TEST(TrackAnalysis, EmptyAndLostTracksAreErrors) {
   const Scene scene = Ball();
   Track empty;

@@ -40,6 +40,11 @@ AnalysisScore ScoreAnalysis(const std::string& track_csv, const FootageCondition
   }
   if (!a.fit.available) {
     s.kind = a.fit.unavailable;
+    // The release's position (the mean of the frames before the move) is still a stated x0.
+    if (a.release && a.release->x.u) {
+      s.kind = "release only (" + a.fit.unavailable + ")";
+      s.pulls.push_back({"x0", a.release->x.value - c.x0, *a.release->x.u});
+    }
     return s;
   }
   s.kind = "fit " + a.fit.fitted;

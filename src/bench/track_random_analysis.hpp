@@ -24,8 +24,9 @@ struct AnalysisPull {
 };
 
 struct AnalysisScore {
-  // "rest", "fit g", "fit mu", or why there are no pulls ("a push: not modelled", the analysis'
-  // own reason, "no track").
+  // "rest", "fit g", "fit mu", "release only (why no fit)" (x0 alone, from the frames before the
+  // move), or why there are no pulls ("a push: not modelled", the analysis' own reason, "no
+  // track").
   std::string kind;
   std::vector<AnalysisPull> pulls;
 };

@@ -29,6 +29,22 @@ void RequireOptions(const TrackAnalysisOptions& o) {
     throw InputError("tracker_blur", "must be >= 0 (the tracker's systematic error per pixel of motion per frame)");
 }
 
+// The first frame of a move that stays inside the stated band (k·u_x) but leaves, for
+// `confirm_frames` in a row, k times the wander a ball at rest shows in this track: the larger of
+// the tracker's systematic error at rest (floor_m, m) and the frames' own jitter (the robust SD
+// of successive differences over √2). Unset when the track shows no such move, or gives no scale
+// (floor_m and the jitter both 0).
+std::optional<int> Creep(const std::vector<double>& x, double floor_m, const TrackAnalysisOptions& o) {
+  if (x.size() < 3) return std::nullopt;
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < x.size(); ++i) steps.push_back(x[i] - x[i - 1]);
+  const double centre = Median(steps);
+  for (double& d : steps) d = std::abs(d - centre);
+  const double wander = std::max(floor_m, 1.4826 * Median(steps) / std::sqrt(2.0));
+  if (!(wander > 0)) return std::nullopt;
+  return FirstDeparture(x, false, o.band_sigmas * wander, o.confirm_frames, o.reference_frames);
+}
+
 }  // namespace
 
 const FittedParameter* TrackFit::Parameter(const std::string& name) const {
@@ -112,6 +128,23 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
   // Release.
   const std::optional<int> out = FirstDeparture(s.x, false, band, o.confirm_frames, o.reference_frames);
   if (!out) {
+    if (const std::optional<int> creep = Creep(s.x, floor_m, o)) {
+      // Within the stated band, yet beyond what the tracker's own error lets a ball at rest
+      // wander: the ball moved (released late in the clip, or creeping). Its mean is no rest
+      // position; the frames before the move are its release.
+      const auto [x, sd] = stationary(0, *creep);
+      if (*creep >= 3) a.scatter_at_rest = sd;
+      a.release = TrackEvent{"release", {s.t[*creep - 1], std::nullopt}, x,
+                             "creeps: the last frame before x moved by more than " + Printf("%g", o.band_sigmas) +
+                                 " times the tracker's error at rest, t = " + Printf("%.6g", s.t[*creep - 1]) +
+                                 " s; position the mean of the " + std::to_string(*creep) + " frames before"};
+      a.direction = s.x[*creep] > x.value ? 1 : -1;
+      a.fit.unavailable = "the ball moves, but by less than the stated band (" + Mm(band) +
+                          ") in this track: too little motion to fit";
+      a.notes.push_back("the ball moves from t = " + Printf("%.6g", s.t[*creep]) +
+                        " s on, within the stated band: it is not at rest (no measured Y)");
+      return a;
+    }
     const auto [x, sd] = stationary(0, n);
     a.scatter_at_rest = sd;
     a.rest = TrackEvent{"comes to rest", {s.t[0], std::nullopt}, x,

@@ -23,7 +23,13 @@
 //    fitted as x_r after a changepoint t_r and x_r + c·(t_r − t)² before (least squares, t_r
 //    profiled over the frame times): x_r ± its standard error from the scatter, t_r. This is a
 //    measured Y for the fit report. A ball that never leaves its band is at rest from the first
-//    frame: rest (the mean ± scatter/√n), no release, no fit.
+//    frame: rest (the mean ± scatter/√n), no release, no fit, unless it creeps: within the band,
+//    it leaves k times the wander a ball at rest shows in this track (the tracker's systematic
+//    error at rest below, or the frames' jitter, the robust SD of successive differences over
+//    √2, if larger) with the same confirmation. The k·σ band, σ the stated u_x (0.5 mm by
+//    default), is far wider than a tracker's error at rest (0.02–0.1 mm), so a ball released late
+//    in the clip stays within it. A creeping ball gets a release (the frames before the move),
+//    no rest and no fit.
 //    Every position estimate at rest (release, rest) adds the tracker's systematic error in
 //    quadrature to its scatter: the frames at rest share one bias, which averaging does not
 //    reduce; tracker_floor_px at the body's scale (Body::across over the median outline radius
