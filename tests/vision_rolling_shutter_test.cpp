@@ -158,9 +158,10 @@ double PxPerMetreAlongTheMotion(const ShearedClip& clip) {
 }
 
 // The solve converges: started 1.5 px off along the motion (most of the window's half width) it
-// ends within 0.03 px of the true centre, as it does started at the truth (measured: 0.016 and
-// 0.008 px from the fit started at the truth, itself 0.004 px from the truth; the same after 3
-// iterations as after 20: what is left comes from the rays' windows, placed around the start).
+// ends within 0.04 px of the true centre, as it does started at the truth (measured: 0.014 to
+// 0.027 px from the fit started at the truth; the same after 3 iterations as after 20: what is
+// left comes from the rays' windows and the limb profile's depths, both placed around the start;
+// without the limb profile 0.008 to 0.016 px).
 // Truth: the centre the brute-force picture of a global shutter was rendered with. With the rays'
 // colours held and their span not removed from the Jacobian (version 9's) the fit ends 0.9 px
 // short with the background known and about 1 px with it unknown.
@@ -178,7 +179,7 @@ void ExpectConvergence(bool background_known) {
                           clip.geometry.Project(from_truth.p[kCentreX], from_truth.p[kCentreZ])).norm();
     std::printf("  started %+.1f px off: ends %.4f px from the truth, %.4f px from the fit started there\n",
                 1.5 * sign, clip.CentreErrorPx(from_off), apart);
-    EXPECT_LT(clip.CentreErrorPx(from_off), 0.03);
+    EXPECT_LT(clip.CentreErrorPx(from_off), 0.04);
   }
 }
 

@@ -47,7 +47,8 @@
 // blur came out 0.2 px ahead of the mid-exposure), so a pixel sees the body for a fraction of its exposure: the
 // coverage of internal/smeared_outline.hpp, blurred by the optics' point spread. Rays from the
 // predicted centre across the predicted smeared outline are sampled in linear light and the
-// model I = (1 − c)·g·B + c·F (c·S·F on a long smear, S the body's shading learnt at rest,
+// model I = (1 − c)·g·B + c·(F + h·G) (h the limb's shading profile √(2·depth/radius), G its
+// amplitude per ray; c·S·F on a long smear, S the body's shading learnt at rest,
 // lit by a lamp overhead whose distance is fitted frame by frame: internal/body_shading.hpp) is
 // fitted with Ceres to all of them at once (centre and smear; per-ray Cauchy loss: a painted
 // band's edges, highlights, the shadow and the crossbar do not fit one limb colour and drop

@@ -213,6 +213,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
     Vector2d origin, dir;
     double s0, s1;
     double limb;  // a point surely inside the body (if the prediction holds), px along the ray
+    double shift;  // px along the ray of the predicted outline (a rolling shutter's shear), else 0
   };
   std::vector<Ray> rays;
   std::vector<Vector2d> anchors;
@@ -234,6 +235,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
     ray.s1 = along + q.half_width_px + margin_out + shift;
     ray.limb = -(inward + q.half_width_px + 1.5 * g.sigma_px + 0.3) + shift;
     ray.origin = image[k];
+    ray.shift = shift;
     // Inside the picture (with a pixel for the interpolation) and clear of the occluder.
     bool usable = true;
     for (double s : {ray.s0, 0.5 * (ray.s0 + ray.s1), ray.s1}) {
@@ -280,6 +282,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
       d.y() *= g.s;
       samples.dirs.push_back(d.normalized());
       samples.along.push_back(2 * t - 1);
+      if (!shaded && q.limb_profile) samples.limb_depth.push_back(std::min(1.0, std::sqrt(2 * std::max(0.0, ray.shift - (ray.s0 + t * length)) / radius_px)));
       if (rolling) samples.rows.push_back(p.y() - q.reference_row);
       samples.image.push_back(SampleLinear(bgr, background.table(), p.x() - view.origin.x, p.y() - view.origin.y));
       if (known && background.Known(p.x(), p.y())) samples.back.push_back(background.At(p.x(), p.y()) * gain);
@@ -302,6 +305,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
             if (!v.empty()) v.erase(v.begin(), v.begin() + j + 1);
           };
           cut(samples.dirs), cut(samples.along), cut(samples.image), cut(samples.back), cut(samples.rows);
+          cut(samples.limb_depth);
           break;
         }
     }

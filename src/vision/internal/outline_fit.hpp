@@ -8,13 +8,18 @@
 // near rail's band (the occluder) is not used: hidden edges are not edges.
 //
 // Model of a ray's samples i (linear RGB, 3 residuals each):
-//   I_i = (1 − c_i)·g·B_i + c_i·F_k
+//   I_i = (1 − c_i)·g·B_i + c_i·(F_k + h_i·G_k)
 // c_i the coverage of the sample's viewing ray, g·B_i the background at the sample (the
-// background model times this frame's gain) and F_k the body's colour at this ray's limb, a
-// nuisance solved in closed form for every evaluation (variable projection, with Kaufman's
-// Jacobian: the derivative at the colours held, less its part in the span of the colours' design;
-// it drops only a term proportional to the residuals). On a smear longer than a quarter radius,
-// once the body's shading is learnt (body_shading.hpp), the body's term is c_i·S_i·F_k instead:
+// background model times this frame's gain), F_k the body's colour at this ray's limb and G_k
+// the amplitude of its shading profile inside the limb, h_i = min(1, √(2d_i/r)) (d_i the
+// sample's depth inside the predicted outline, r the outline's radius: the surface turns toward
+// the camera as √(2d/r) there, so the shading of a matte body changes fastest right at its
+// outline, and a limb colour alone put the edge off it). F_k and G_k are nuisances solved in
+// closed form for every evaluation (variable projection, with Kaufman's Jacobian: the derivative
+// at the colours held, less its part in the span of the colours' design; it drops only a term
+// proportional to the residuals); h_i is taken at the fit's start and held. On a smear longer than a quarter radius,
+// once the body's shading is learnt (body_shading.hpp), the body's term is c_i·S_i·F_k instead
+// (no h_i: S_i holds the shading):
 // S_i its mean relative colour over the part of it that passed over the sample, evaluated at the
 // fit's start and held through the solve (each sample's mean shading basis is taken once there,
 // and S_i under any lamp follows from it: BodyShading::FromBasis). The shading is read as lit by a lamp at a finite
@@ -81,6 +86,9 @@ struct FitRequest {
   bool fit_edge_shift = true;           // false: b held at 0 (the tracker's passes that place the centre)
   double light_inverse_distance = 0;    // 1/m: the lamp's, prior mean (BodyShading::LitFrom)
   bool fit_light = true;                // false: held at its prior mean (a first pass)
+  // false: no limb profile (h_i·G_k above): the search for a body found anew, where its freedom
+  // lets a patch of the table fit an outline as well as the body does.
+  bool limb_profile = true;
   // Ceres iterations at most. With Kaufman's Jacobian the step shrinks about four-fold per
   // iteration: from a coarse search 3 (more add nothing; fewer can stop on a wrong place under a
   // rolling shutter's shear); a narrow pass after a coarse search in 2; a

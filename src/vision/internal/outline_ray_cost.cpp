@@ -16,27 +16,40 @@ void ThinOut(RaySamples* s, int most) {
     for (int j = 0; j < most; ++j) v[j] = v[static_cast<size_t>(std::lround(static_cast<double>(j) * (n - 1) / (most - 1)))];
     v.resize(most);
   };
-  keep(s->dirs), keep(s->along), keep(s->image), keep(s->back), keep(s->rows);
+  keep(s->dirs), keep(s->along), keep(s->image), keep(s->back), keep(s->rows), keep(s->limb_depth);
 }
 
 // Per-ray linear least squares for what is not geometry, given the coverages c_i:
-//   known background:  I_i = (1 − c_i)·(σ0 + σ1·t_i)·B_i + c_i·S_i·F   (σ: the body's shadow and
-//                      the light's unevenness on this ray, weakly held at 1; F the body's colour)
-//   unknown:           I_i = (1 − c_i)·(B0 + B1·t_i) + c_i·S_i·F         (per channel)
+//   known background:  I_i = (1 − c_i)·(σ0 + σ1·t_i)·B_i + c_i·(S_i·F + h_i·G)   (σ: the body's
+//                      shadow and the light's unevenness on this ray, weakly held at 1; F the
+//                      body's colour)
+//   unknown:           I_i = (1 − c_i)·(B0 + B1·t_i) + c_i·(S_i·F + h_i·G)         (per channel)
 // t_i the sample's position along the window; S_i (per channel) the body's relative colour over
 // the part of it that passed over the sample (smeared_outline.hpp, body_shading.hpp) on a shaded
-// ray, else 1 (F is then the limb's colour). Returns the background term of each sample and F.
+// ray, else 1 (F is then the limb's colour); h_i the limb's shading profile (RaySamples::
+// limb_depth, 0 on a shaded ray), G its amplitude, weakly held at 0. Returns the background term
+// of each sample, F and G.
+inline constexpr int kKnownColours = 8;  // σ0, σ1, F (3), G (3)
+inline constexpr int kUnknownColours = 4;  // per channel: B0, B1, F, G
 struct RayColours {
   std::vector<cv::Vec3d> back;  // (σ0 + σ1·t)·B, or B0 + B1·t, per sample
-  cv::Vec3d body;
+  cv::Vec3d body, limb_gradient;  // F and G
   bool ok = false;
   // The inverse of the solve's normal matrix (priors included): known background, over
-  // (σ0, σ1, F); unknown, over (B0, B1, F) of each channel. ProjectedGram needs them.
-  Eigen::Matrix<double, 5, 5> known_inverse;
-  std::array<Eigen::Matrix3d, 3> unknown_inverse;
+  // (σ0, σ1, F, G); unknown, over (B0, B1, F, G) of each channel. ProjectedGram needs them.
+  Eigen::Matrix<double, kKnownColours, kKnownColours> known_inverse;
+  std::array<Eigen::Matrix4d, 3> unknown_inverse;
   // The design's own Gram matrix AᵀA (the normal matrix without the priors), likewise.
-  Eigen::Matrix<double, 5, 5> known_design;
-  std::array<Eigen::Matrix3d, 3> unknown_design;
+  Eigen::Matrix<double, kKnownColours, kKnownColours> known_design;
+  std::array<Eigen::Matrix4d, 3> unknown_design;
+
+  // The body's colour at sample i (F, or S_i·F, plus h_i·G), or the background where the solve
+  // failed.
+  cv::Vec3d BodyAt(const RaySamples& ray, const std::vector<cv::Vec3d>& shade, size_t i) const {
+    if (!ok) return back[i];
+    const cv::Vec3d f = shade.empty() ? body : body.mul(shade[i]);
+    return ray.limb_depth.empty() ? f : f + ray.limb_depth[i] * limb_gradient;
+  }
 };
 
 namespace {
@@ -48,14 +61,18 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
   out.back.resize(n);
   // The body's column of sample i in channel ch.
   const auto body = [&](size_t i, int ch) { return shade.empty() ? c[i] : c[i] * shade[i][ch]; };
+  const auto limb = [&](size_t i) { return ray.limb_depth.empty() ? 0.0 : c[i] * ray.limb_depth[i]; };
+  // G ~ N(0, kLimbGradientPrior): it has a say only where the samples ask for it.
+  const double wg = (noise / kLimbGradientPrior) * (noise / kLimbGradientPrior);
   if (!ray.back.empty()) {
-    Eigen::Matrix<double, 5, 5> a = Eigen::Matrix<double, 5, 5>::Zero();
-    Eigen::Matrix<double, 5, 1> y = Eigen::Matrix<double, 5, 1>::Zero();
-    // The normal equations of the rows (u·B_ch, u·t·B_ch, k_ch at 2 + ch) of every sample and
-    // channel, summed by their structure (u = 1 − c, t the position along the ray, k the body's
-    // column).
+    constexpr int K = kKnownColours;
+    Eigen::Matrix<double, K, K> a = Eigen::Matrix<double, K, K>::Zero();
+    Eigen::Matrix<double, K, 1> y = Eigen::Matrix<double, K, 1>::Zero();
+    // The normal equations of the rows (u·B_ch, u·t·B_ch, k_ch at 2 + ch, l at 5 + ch) of every
+    // sample and channel, summed by their structure (u = 1 − c, t the position along the ray, k
+    // the body's column, l the limb profile's).
     for (size_t i = 0; i < n; ++i) {
-      const double u = 1 - c[i], t = ray.along[i];
+      const double u = 1 - c[i], t = ray.along[i], l = limb(i);
       double bb = 0, bi = 0;
       for (int ch = 0; ch < 3; ++ch) {
         const double b = ray.back[i][ch], image = ray.image[i][ch], k = body(i, ch);
@@ -65,6 +82,11 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
         a(1, 2 + ch) += u * t * b * k;
         a(2 + ch, 2 + ch) += k * k;
         y(2 + ch) += k * image;
+        a(0, 5 + ch) += u * b * l;
+        a(1, 5 + ch) += u * t * b * l;
+        a(2 + ch, 5 + ch) += k * l;
+        a(5 + ch, 5 + ch) += l * l;
+        y(5 + ch) += l * image;
       }
       a(0, 0) += u * u * bb;
       a(0, 1) += u * u * t * bb;
@@ -72,41 +94,44 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
       y(0) += u * bi;
       y(1) += u * t * bi;
     }
-    a(1, 0) = a(0, 1);
-    for (int k = 2; k < 5; ++k) a(k, 0) = a(0, k), a(k, 1) = a(1, k);
+    for (int r = 0; r < K; ++r)
+      for (int col = 0; col < r; ++col) a(r, col) = a(col, r);
     out.known_design = a;
     // σ = 1 ± 1 %: a soft shadow or uneven light, not a dark pattern taken for a shadowed table.
     const double w = (noise / kShadowPrior) * (noise / kShadowPrior);
     a(0, 0) += w, y(0) += w, a(1, 1) += w;
-    const Eigen::LDLT<Eigen::Matrix<double, 5, 5>> ldlt(a);
-    const Eigen::Matrix<double, 5, 1> x = ldlt.solve(y);
-    if (!x.allFinite() || a.diagonal().tail<3>().minCoeff() < 1e-9) {
+    for (int ch = 0; ch < 3; ++ch) a(5 + ch, 5 + ch) += wg;
+    const Eigen::LDLT<Eigen::Matrix<double, K, K>> ldlt(a);
+    const Eigen::Matrix<double, K, 1> x = ldlt.solve(y);
+    if (!x.allFinite() || a.diagonal().segment<3>(2).minCoeff() < 1e-9) {
       for (size_t i = 0; i < n; ++i) out.back[i] = ray.back[i];
       return out;
     }
     for (size_t i = 0; i < n; ++i) out.back[i] = (x(0) + x(1) * ray.along[i]) * cv::Vec3d(ray.back[i]);
     out.body = cv::Vec3d(x(2), x(3), x(4));
-    out.known_inverse = ldlt.solve(Eigen::Matrix<double, 5, 5>::Identity());
+    out.limb_gradient = cv::Vec3d(x(5), x(6), x(7));
+    out.known_inverse = ldlt.solve(Eigen::Matrix<double, K, K>::Identity());
     out.ok = true;
     return out;
   }
-  // Per channel: (B0, B1, F); the design is the same for the three unless the body is shaded.
+  // Per channel: (B0, B1, F, G); the design is the same for the three unless the body is shaded.
   const int designs = shade.empty() ? 1 : 3;
   cv::Vec3d mean(0, 0, 0);
   for (size_t i = 0; i < n; ++i) mean += cv::Vec3d(ray.image[i]);
   mean /= static_cast<double>(n);
   for (int design = 0; design < designs; ++design) {
-    Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
-    Eigen::Matrix3d y = Eigen::Matrix3d::Zero();  // column per channel
+    Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
+    Eigen::Matrix<double, 4, 3> y = Eigen::Matrix<double, 4, 3>::Zero();  // column per channel
     for (size_t i = 0; i < n; ++i) {
-      const Eigen::Vector3d row(1 - c[i], (1 - c[i]) * ray.along[i], body(i, design));
+      const Eigen::Vector4d row(1 - c[i], (1 - c[i]) * ray.along[i], body(i, design), limb(i));
       a += row * row.transpose();
       for (int ch = 0; ch < 3; ++ch) y.col(ch) += row * static_cast<double>(ray.image[i][ch]);
     }
-    const Eigen::Matrix3d without_priors = a;
+    const Eigen::Matrix4d without_priors = a;
     a(1, 1) += 1e-6 * (a(0, 0) + 1e-12);
-    const Eigen::LDLT<Eigen::Matrix3d> ldlt(a);
-    const Eigen::Matrix3d x = ldlt.solve(y);
+    a(3, 3) += wg;
+    const Eigen::LDLT<Eigen::Matrix4d> ldlt(a);
+    const Eigen::Matrix<double, 4, 3> x = ldlt.solve(y);
     if (!x.allFinite() || a(2, 2) < 1e-9 || ldlt.rcond() < 1e-9) {
       for (size_t i = 0; i < n; ++i) out.back[i] = mean;
       out.ok = false;
@@ -115,7 +140,8 @@ RayColours SolveColours(const RaySamples& ray, const std::vector<double>& c, con
     for (int ch = design; ch < (designs == 1 ? 3 : design + 1); ++ch) {
       for (size_t i = 0; i < n; ++i) out.back[i][ch] = x(0, ch) + x(1, ch) * ray.along[i];
       out.body[ch] = x(2, ch);
-      out.unknown_inverse[ch] = ldlt.solve(Eigen::Matrix3d::Identity());
+      out.limb_gradient[ch] = x(3, ch);
+      out.unknown_inverse[ch] = ldlt.solve(Eigen::Matrix4d::Identity());
       out.unknown_design[ch] = without_priors;
     }
   }
@@ -142,22 +168,24 @@ Eigen::Matrix<double, P + 1, P + 1> ProjectedGram(const RaySamples& ray, const s
   const size_t n = c.size();
   const bool known = !ray.back.empty();
   const auto body = [&](size_t i, int ch) { return shade.empty() ? c[i] : c[i] * shade[i][ch]; };
+  const auto limb = [&](size_t i) { return ray.limb_depth.empty() ? 0.0 : c[i] * ray.limb_depth[i]; };
+  constexpr int K = kKnownColours, U = kUnknownColours;
   MatrixP jj = MatrixP::Zero();                           // J₀ᵀJ₀
-  Eigen::Matrix<double, 5, P> aj = decltype(aj)::Zero();  // AᵀJ₀ (known background: 5 colour unknowns)
+  Eigen::Matrix<double, K, P> aj = decltype(aj)::Zero();  // AᵀJ₀ (known background)
   VectorP jr = VectorP::Zero();                           // J₀ᵀr
-  Eigen::Matrix<double, 5, 1> ar = decltype(ar)::Zero();  // Aᵀr (known background)
-  std::array<Eigen::Matrix<double, 3, P>, 3> aj_ch{};     // per channel (unknown background)
-  std::array<Eigen::Vector3d, 3> ar_ch{};
+  Eigen::Matrix<double, K, 1> ar = decltype(ar)::Zero();  // Aᵀr (known background)
+  std::array<Eigen::Matrix<double, U, P>, 3> aj_ch{};     // per channel (unknown background)
+  std::array<Eigen::Vector4d, 3> ar_ch{};
   for (auto& m : aj_ch) m.setZero();
   for (auto& v : ar_ch) v.setZero();
   double rr = 0;
   for (size_t i = 0; i < n; ++i) {
     const VectorP g = gradient(i);
     const cv::Vec3d& B = colours.back[i];
-    const cv::Vec3d F = !colours.ok ? B : shade.empty() ? colours.body : colours.body.mul(shade[i]);
-    const double u = 1 - c[i], t = ray.along[i];
+    const cv::Vec3d F = colours.BodyAt(ray, shade, i);
+    const double u = 1 - c[i], t = ray.along[i], l = limb(i);
     double kk = 0, kr = 0, bk = 0, br = 0;
-    double body_k[3];
+    double body_k[3], limb_k[3];
     for (int ch = 0; ch < 3; ++ch) {
       const double r = residuals[3 * i + ch], k = -(F[ch] - B[ch]) * inv_noise;
       kk += k * k, kr += k * r, rr += r * r;
@@ -167,12 +195,14 @@ Eigen::Matrix<double, P + 1, P + 1> ProjectedGram(const RaySamples& ray, const s
         const double b = ray.back[i][ch];
         bk += b * k, br += b * r;
         body_k[ch] = a_body * k;
+        limb_k[ch] = l * k;
         ar(2 + ch) += a_body * r;
+        ar(5 + ch) += l * r;
       } else {
-        const double w[3] = {u * k, u * t * k, a_body * k};
-        for (int a = 0; a < 3; ++a)
+        const double w[U] = {u * k, u * t * k, a_body * k, l * k};
+        for (int a = 0; a < U; ++a)
           for (int b = 0; b < P; ++b) aj_ch[ch](a, b) += w[a] * g(b);
-        ar_ch[ch] += Eigen::Vector3d(u, u * t, a_body) * r;
+        ar_ch[ch] += Eigen::Vector4d(u, u * t, a_body, l) * r;
       }
     }
     // By hand: Eigen's rank updates do not unroll at this size, and this loop is the pass.
@@ -182,8 +212,8 @@ Eigen::Matrix<double, P + 1, P + 1> ProjectedGram(const RaySamples& ray, const s
       jr(a) += kr * g(a);
     }
     if (colours.ok && known) {
-      const double w[5] = {u * bk, u * t * bk, body_k[0], body_k[1], body_k[2]};
-      for (int a = 0; a < 5; ++a)
+      const double w[K] = {u * bk, u * t * bk, body_k[0], body_k[1], body_k[2], limb_k[0], limb_k[1], limb_k[2]};
+      for (int a = 0; a < K; ++a)
         for (int b = 0; b < P; ++b) aj(a, b) += w[a] * g(b);
       ar(0) += u * br, ar(1) += u * t * br;
     }
@@ -191,12 +221,12 @@ Eigen::Matrix<double, P + 1, P + 1> ProjectedGram(const RaySamples& ray, const s
   for (int a = 0; a < P; ++a)
     for (int b = 0; b < a; ++b) jj(a, b) = jj(b, a);
   if (colours.ok && known) {
-    const Eigen::Matrix<double, 5, P> h = colours.known_inverse * aj;
+    const Eigen::Matrix<double, K, P> h = colours.known_inverse * aj;
     jj += -aj.transpose() * h - h.transpose() * aj + h.transpose() * colours.known_design * h;
     jr -= h.transpose() * ar;
   } else if (colours.ok) {
     for (int ch = 0; ch < 3; ++ch) {
-      const Eigen::Matrix<double, 3, P> h = colours.unknown_inverse[ch] * aj_ch[ch];
+      const Eigen::Matrix<double, U, P> h = colours.unknown_inverse[ch] * aj_ch[ch];
       jj += -aj_ch[ch].transpose() * h - h.transpose() * aj_ch[ch] + h.transpose() * colours.unknown_design[ch] * h;
       jr -= h.transpose() * ar_ch[ch];
     }
@@ -340,7 +370,7 @@ void RayCost::Residuals(const std::vector<double>& c, const std::vector<cv::Vec3
   for (size_t i = 0; i < n; ++i) {
     const cv::Vec3d I = ray_.image[i];
     const cv::Vec3d& B = colours.back[i];
-    const cv::Vec3d F = !colours.ok ? B : shade.empty() ? colours.body : colours.body.mul(shade[i]);
+    const cv::Vec3d F = colours.BodyAt(ray_, shade, i);
     for (int ch = 0; ch < 3; ++ch) residuals[3 * i + ch] = (I[ch] - B[ch] - c[i] * (F[ch] - B[ch])) * inv_noise_;
   }
   if (solved) *solved = std::move(colours);

@@ -49,6 +49,7 @@ FitOutcome BallTracker::Impl::Measure(const internal::FrameView& view, FitReques
   // edges, may have taken a spurious one (and then failed the inlier share a new body needs).
   q.fit_edge_shift = false;
   q.fit_light = false;
+  q.limb_profile = search == Search::kTracking;
   // The row delay is read from the last pass only.
   const bool estimate_row_delay = q.estimate_row_delay;
   q.estimate_row_delay = false;
