@@ -121,14 +121,15 @@ double FittedReadout(const ShearedClip& clip, double readout) {
 }
 
 // A phone's 25 ms: estimated at the truth, the truth (measured 25.2 ms); at a global shutter (0),
-// one Gauss–Newton step away, an estimate near it (measured 24.4 ms), and at that estimate (as the
-// tracker does frame after frame), the truth again (measured 25.2 ms).
+// one Gauss–Newton step away, an estimate near it (measured 26.4 ms: the limb profile's depths,
+// held at the unsheared start, add to the step's error; 24.4 ms without it), and at that estimate
+// (as the tracker does frame after frame), the truth again (measured 25.0 ms).
 TEST(RollingShutter, ReadoutOfAPhoneIsFoundFromAGlobalShutter) {
   constexpr double kReadout = 0.025;
   const ShearedClip clip(kReadout);
   EXPECT_NEAR(FittedReadout(clip, kReadout), kReadout, 0.02 * kReadout);
   const double first = FittedReadout(clip, 0);
-  EXPECT_NEAR(first, kReadout, 0.05 * kReadout);
+  EXPECT_NEAR(first, kReadout, 0.08 * kReadout);
   EXPECT_NEAR(FittedReadout(clip, first), kReadout, 0.02 * kReadout);
 }
 

@@ -58,11 +58,18 @@ std::string ModelsOfSidecar(const std::string& path) {
   return out;
 }
 
+// The radius, in standard deviations per axis, of the circle that holds 95 % of a 2-D normal
+// error: sqrt(−2·ln 0.05).
+constexpr double kCoverage95 = 2.4477;
+
 // One tracker's score on one draw.
 struct Score {
   int in_view = 0;       // frames with the body at least half visible
   int found = 0;         // of those, with a position
   int silent_wrong = 0;  // positions > 1 px from the truth, or where no body is in view
+  // Of the frames found in view with a stated uncertainty u, those within 2.45 u of the truth
+  // (the 95 % circle of an error of standard deviation u on each image axis).
+  int stated = 0, within_stated = 0;
   double px_rms = NAN, px_p95 = NAN, mm_rms = NAN;
   std::string models = "-", refusal;
 };
@@ -87,6 +94,7 @@ Score ScoreOf(const TrackerOutput& out, const std::vector<ClipTruth>& truth, con
     if (!in_view) continue;
     ++s.found;
     px.push_back(error);
+    if (std::isfinite(f.uncertainty_px)) ++s.stated, s.within_stated += error <= kCoverage95 * f.uncertainty_px;
     const double tm = std::max(0.0, f.t - release_time);
     if (tm <= motion.end_time()) {
       const double dx = (f.x - motion.At(tm).x) * 1e3;
@@ -125,7 +133,8 @@ ordered_json ScoreJson(const Score& s) {
   const auto number = [](double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(); };
   return {{"px_rms", number(s.px_rms)},   {"px_p95", number(s.px_p95)},         {"mm_rms_x", number(s.mm_rms)},
           {"frames_in_view", s.in_view},  {"frames_found", s.found},            {"silent_wrong", s.silent_wrong},
-          {"models", s.models},           {"refusal", s.refusal}};
+          {"frames_with_u", s.stated},    {"within_95_of_u", s.within_stated},  {"models", s.models},
+          {"refusal", s.refusal}};
 }
 
 std::vector<cv::Mat> Decode(const std::string& video) {
@@ -183,7 +192,7 @@ TrackerOutput TrackWithCore(const DecodedClip& clip) {
   WriteTrack(csv, result, {clip.video, "", "", ""});
   out.models = ModelsOfSidecar(csv + ".json");
   for (const TrackRow& row : result.rows)
-    out.frames.push_back({row.ball.found, row.ball.u, row.ball.v, NAN, row.ball.x, row.t});
+    out.frames.push_back({row.ball.found, row.ball.u, row.ball.v, row.ball.found ? row.u_px : NAN, row.ball.x, row.t});
   return out;
 }
 
@@ -266,19 +275,24 @@ void RunTrackRandom(const TrackRandomOptions& o, std::ostream& out) {
       << "silent wrong frames):\n";
   for (const bool core : {true, false}) {
     std::vector<double> rms;
-    int in_view = 0, found = 0, wrong = 0, refused = 0;
+    int in_view = 0, found = 0, wrong = 0, refused = 0, stated = 0, within = 0;
     for (const Draw& d : draws) {
       const Score& s = core ? d.core : d.baseline;
       rms.push_back(s.px_rms);
       in_view += s.in_view, found += s.found, wrong += s.silent_wrong, refused += !s.refusal.empty();
+      stated += s.stated, within += s.within_stated;
     }
     const char* name = core ? "core" : "baseline";
     out << "  " << name << ": median " << Fixed("%.3f px", Quantile(rms, 0.5)) << ", p95 "
         << Fixed("%.3f px", Quantile(rms, 0.95)) << ", found " << found << "/" << in_view << ", silent wrong "
-        << wrong << (refused ? ", refused " + std::to_string(refused) : "") << "\n";
+        << wrong << (refused ? ", refused " + std::to_string(refused) : "");
+    if (stated > 0)
+      out << "; its stated u_px holds the truth within 2.45 u (95 % expected) in " << within << " of " << stated
+          << Fixed(" frames (%.1f %%)", 100.0 * within / stated);
+    out << "\n";
     summary[name] = {{"px_rms_median", Quantile(rms, 0.5)}, {"px_rms_p95", Quantile(rms, 0.95)},
                      {"frames_in_view", in_view}, {"frames_found", found}, {"silent_wrong", wrong},
-                     {"refused", refused}};
+                     {"refused", refused}, {"frames_with_u", stated}, {"within_95_of_u", within}};
   }
   // analyse-track over the draws: per quantity, the draws scored, those within 3 stated u, and
   // the RMS pull; a rest position's |error| too (the goal: 0.02 mm on a sharp clip).

@@ -19,10 +19,27 @@
 #include "io/output_paths.hpp"
 #include "model/environment_error.hpp"
 #include "model/input_error.hpp"
+#include "internal/track_series.hpp"
 #include "vision/library_logs.hpp"
+#include "vision/track_analysis.hpp"
 
 namespace uphill {
 namespace {
+
+// TrackRow::u_px and u_x of every row where the ball was found.
+void AddUncertainties(double body_across, std::vector<TrackRow>* rows) {
+  std::vector<double> t, u, v;
+  std::vector<TrackRow*> found;
+  for (TrackRow& r : *rows)
+    if (r.ball.found) t.push_back(r.t), u.push_back(r.ball.u), v.push_back(r.ball.v), found.push_back(&r);
+  const std::vector<double> speed = internal::PixelsPerFrame(t, u, v);
+  const TrackAnalysisOptions error_model;
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    TrackRow& r = *found[i];
+    r.u_px = error_model.tracker_floor_px + error_model.tracker_blur * speed[i];
+    r.u_x = r.ball.radius_px > 0 ? r.u_px * body_across / r.ball.radius_px : 0.0;
+  }
+}
 
 double ThreadCpuSeconds() {
   timespec ts;
@@ -242,6 +259,7 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
     for (TrackRow& r : result.rows)
       if (r.frame >= *changed) r.ball = BallObservation{};
   }
+  AddUncertainties(scene.body().across, &result.rows);
   int found = 0, last_found = -1;
   for (const TrackRow& r : result.rows)
     if (r.ball.found) ++found, last_found = r.frame;
@@ -284,14 +302,15 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
 
 void WriteTrack(const std::string& csv_path, const TrackResult& result, const TrackSources& sources) {
   std::ostringstream csv;
-  csv << "frame,t,u,v,radius_px,x,z,quality\n";
+  csv << "frame,t,u,v,radius_px,x,z,quality,u_px,u_x\n";
   char line[256];
   for (const TrackRow& r : result.rows) {
     if (r.ball.found)
-      std::snprintf(line, sizeof line, "%d,%.6f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", r.frame, r.t, r.ball.u, r.ball.v,
-                    r.ball.radius_px, r.ball.x * 1e3, r.ball.z * 1e3, std::max(1e-4, r.ball.quality));
+      std::snprintf(line, sizeof line, "%d,%.6f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", r.frame, r.t, r.ball.u,
+                    r.ball.v, r.ball.radius_px, r.ball.x * 1e3, r.ball.z * 1e3, std::max(1e-4, r.ball.quality), r.u_px,
+                    r.u_x * 1e3);
     else
-      std::snprintf(line, sizeof line, "%d,%.6f,,,,,,0\n", r.frame, r.t);
+      std::snprintf(line, sizeof line, "%d,%.6f,,,,,,0,,\n", r.frame, r.t);
     csv << line;
   }
   int found = 0;

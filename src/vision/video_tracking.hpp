@@ -35,6 +35,13 @@ struct TrackRow {
   int frame = 0;
   double t = 0;  // s
   BallObservation ball;
+  // Where the ball was found: the standard uncertainty of its centre, in raw pixels (each image
+  // axis) and along the path (m). The tracker's systematic error as analyse-track takes it
+  // (TrackAnalysisOptions: tracker_floor_px + tracker_blur × the pixels the centre moves per frame
+  // interval, from the found frames before and after), in metres at the body's scale (Body::
+  // across over radius_px). The fit's own scatter is not added. `uphill bench track --random`
+  // states how often the truth lies within it.
+  double u_px = 0, u_x = 0;
 };
 
 struct TrackResult {
@@ -85,7 +92,7 @@ struct TrackSources {
   std::string video, camera, scene, body;
 };
 
-// Writes the CSV (header `frame,t,u,v,radius_px,x,z,quality`; x z in mm) and the sidecar, each
+// Writes the CSV (header `frame,t,u,v,radius_px,x,z,quality,u_px,u_x`; x z u_x in mm) and the sidecar, each
 // atomically, creating the CSV's folder if needed. Throws EnvironmentError when a file cannot be
 // written.
 void WriteTrack(const std::string& csv_path, const TrackResult& result, const TrackSources& sources);

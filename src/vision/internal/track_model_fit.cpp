@@ -143,14 +143,12 @@ std::optional<FitErrors> AddErrorParts(const Series& s, const std::vector<int>& 
     in.x(i) = s.x[use[i]];
   }
   // The motion blur grows with the image speed: pixels per frame interval, from the neighbours.
-  std::vector<double> steps;
-  for (std::size_t k = 1; k < use.size(); ++k) steps.push_back(s.t[use[k]] - s.t[use[k - 1]]);
-  const double frame = Median(steps);
+  std::vector<double> t, u, v;
+  for (int i : use) t.push_back(s.t[i]), u.push_back(s.u[i]), v.push_back(s.v[i]);
+  const std::vector<double> speed = PixelsPerFrame(t, u, v);
   fit->metres_per_pixel = MetresPerPixel(s, use);
   for (int i = 0; i < n; ++i) {
-    const int a = use[std::max(i - 1, 0)], b = use[std::min(i + 1, n - 1)];
-    const double speed = std::hypot(s.u[b] - s.u[a], s.v[b] - s.v[a]) / (s.t[b] - s.t[a]) * frame;
-    in.systematic(i) = fit->metres_per_pixel * (o.tracker_floor_px + o.tracker_blur * (std::isfinite(speed) ? speed : 0.0));
+    in.systematic(i) = fit->metres_per_pixel * (o.tracker_floor_px + o.tracker_blur * speed[i]);
     fit->systematic.push_back(in.systematic(i));
   }
   if (fit->metres_per_pixel == 0.0)

@@ -34,6 +34,25 @@ inline double Median(std::vector<double> v) {
   return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + mid));
 }
 
+// The image speed at each of the frames (t, u, v) in time order, px per frame interval (the
+// median Δt): the move between its neighbours i − 1 and i + 1 (one-sided at the ends) over their
+// time apart. 0 for a single frame.
+inline std::vector<double> PixelsPerFrame(const std::vector<double>& t, const std::vector<double>& u,
+                                          const std::vector<double>& v) {
+  const int n = static_cast<int>(t.size());
+  std::vector<double> speed(n, 0.0);
+  if (n < 2) return speed;
+  std::vector<double> steps;
+  for (int i = 1; i < n; ++i) steps.push_back(t[i] - t[i - 1]);
+  const double frame = Median(steps);
+  for (int i = 0; i < n; ++i) {
+    const int a = std::max(i - 1, 0), b = std::min(i + 1, n - 1);
+    const double s = std::hypot(u[b] - u[a], v[b] - v[a]) / (t[b] - t[a]) * frame;
+    speed[i] = std::isfinite(s) ? s : 0.0;
+  }
+  return speed;
+}
+
 // Mean and sample standard deviation of v[begin, end).
 inline std::pair<double, double> MeanAndSd(const std::vector<double>& v, int begin, int end) {
   const int n = end - begin;
