@@ -41,8 +41,8 @@ struct Track {
   std::vector<TrackFrame> frames;
   // The standard uncertainty of a rolling shutter's row delay (measured, or assumed where it
   // could not be), s per row: a frame's time t = timestamp + v·readout/H is then uncertain by
-  // v·row_delay_u, in every frame alike (one readout). From the sidecar's readout_u_s / image_height_px (ReadTrackFile); 0: none (a
-  // global shutter, or a readout given).
+  // v·row_delay_u, in every frame alike (one readout). From the sidecar's readout_u_s /
+  // image_height_px (ReadTrackFile); 0: none (a global shutter, or a readout given).
   double row_delay_u = 0;
 
   std::size_t found_count() const;

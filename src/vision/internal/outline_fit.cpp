@@ -282,7 +282,10 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
       d.y() *= g.s;
       samples.dirs.push_back(d.normalized());
       samples.along.push_back(2 * t - 1);
-      if (!shaded && q.limb_profile) samples.limb_depth.push_back(std::min(1.0, std::sqrt(2 * std::max(0.0, ray.shift - (ray.s0 + t * length)) / radius_px)));
+      if (!shaded && q.limb_profile) {
+        const double depth = std::max(0.0, ray.shift - (ray.s0 + t * length));  // px inside the outline
+        samples.limb_depth.push_back(std::min(1.0, std::sqrt(2 * depth / radius_px)));
+      }
       if (rolling) samples.rows.push_back(p.y() - q.reference_row);
       samples.image.push_back(SampleLinear(bgr, background.table(), p.x() - view.origin.x, p.y() - view.origin.y));
       if (known && background.Known(p.x(), p.y())) samples.back.push_back(background.At(p.x(), p.y()) * gain);
