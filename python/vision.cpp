@@ -23,40 +23,45 @@ py::dict CameraToPython(const CameraIntrinsics& c) {
 }
 
 // Columns of a track: one element per frame; a frame without the ball has found = False and NaN
-// in u, v, radius_px, x, z (never interpolated), quality 0.
+// in u, v, radius_px, x, z, u_px, u_x (never interpolated), quality 0. u_px, u_x are NaN too where
+// the track states no uncertainty.
 struct TrackColumns {
   py::array_t<std::int64_t> frame;
   py::array_t<bool> found;
-  py::array_t<double> t, u, v, radius_px, x, z, quality;
+  py::array_t<double> t, u, v, radius_px, x, z, quality, u_px, u_x;
   explicit TrackColumns(std::size_t n)
-      : frame(static_cast<py::ssize_t>(n)), found(static_cast<py::ssize_t>(n)), t(static_cast<py::ssize_t>(n)),
-        u(static_cast<py::ssize_t>(n)), v(static_cast<py::ssize_t>(n)), radius_px(static_cast<py::ssize_t>(n)),
-        x(static_cast<py::ssize_t>(n)), z(static_cast<py::ssize_t>(n)), quality(static_cast<py::ssize_t>(n)) {}
-  void Set(std::size_t i, long frame_number, double time, bool is_found, double pu, double pv, double pr, double px,
-           double pz, double q) {
+      : frame(Size(n)), found(Size(n)), t(Size(n)), u(Size(n)), v(Size(n)), radius_px(Size(n)), x(Size(n)),
+        z(Size(n)), quality(Size(n)), u_px(Size(n)), u_x(Size(n)) {}
+  static py::ssize_t Size(std::size_t n) { return static_cast<py::ssize_t>(n); }
+  void Set(std::size_t i, const TrackFrame& f) {
     const double missing = std::nan("");
-    frame.mutable_at(i) = frame_number;
-    found.mutable_at(i) = is_found;
-    t.mutable_at(i) = time;
-    u.mutable_at(i) = is_found ? pu : missing;
-    v.mutable_at(i) = is_found ? pv : missing;
-    radius_px.mutable_at(i) = is_found ? pr : missing;
-    x.mutable_at(i) = is_found ? px : missing;
-    z.mutable_at(i) = is_found ? pz : missing;
-    quality.mutable_at(i) = is_found ? q : 0.0;
+    const auto found_only = [&](double value) { return f.found ? value : missing; };
+    const bool stated = f.found && (f.u_px > 0 || f.u_x > 0);
+    frame.mutable_at(i) = f.frame;
+    found.mutable_at(i) = f.found;
+    t.mutable_at(i) = f.t;
+    u.mutable_at(i) = found_only(f.u);
+    v.mutable_at(i) = found_only(f.v);
+    radius_px.mutable_at(i) = found_only(f.radius_px);
+    x.mutable_at(i) = found_only(f.x);
+    z.mutable_at(i) = found_only(f.z);
+    quality.mutable_at(i) = f.found ? f.quality : 0.0;
+    u_px.mutable_at(i) = stated ? f.u_px : missing;
+    u_x.mutable_at(i) = stated ? f.u_x : missing;
   }
   py::dict ToDict() const {
     py::dict d;
     d["frame"] = frame, d["t"] = t, d["found"] = found, d["u"] = u, d["v"] = v, d["radius_px"] = radius_px;
-    d["x"] = x, d["z"] = z, d["quality"] = quality;
+    d["x"] = x, d["z"] = z, d["quality"] = quality, d["u_px"] = u_px, d["u_x"] = u_x;
     return d;
   }
 };
 
 constexpr const char* kTrackColumnsDoc =
     "frame (int), t (s), found (bool), u, v (raw pixels), radius_px, x, z (m, apparatus frame), quality "
-    "(0..1); a frame without the ball keeps its element with found = False, NaN positions and quality 0 "
-    "(never interpolated)";
+    "(0..1), u_px (raw pixels, each image axis) and u_x (m, along the rails): the standard uncertainty of the "
+    "centre (NaN where the track states none); a frame without the ball keeps its element with found = False, "
+    "NaN positions and quality 0 (never interpolated)";
 
 }  // namespace
 
@@ -67,8 +72,7 @@ void BindVision(py::module_& m) {
         const Track track = ReadTrackFile(path);
         TrackColumns c(track.frames.size());
         for (std::size_t i = 0; i < track.frames.size(); ++i) {
-          const TrackFrame& f = track.frames[i];
-          c.Set(i, f.frame, f.t, f.found, f.u, f.v, f.radius_px, f.x, f.z, f.quality);
+          c.Set(i, track.frames[i]);
         }
         return c.ToDict();
       },
@@ -121,7 +125,11 @@ void BindVision(py::module_& m) {
         TrackColumns c(result.rows.size());
         for (std::size_t i = 0; i < result.rows.size(); ++i) {
           const TrackRow& r = result.rows[i];
-          c.Set(i, r.frame, r.t, r.ball.found, r.ball.u, r.ball.v, r.ball.radius_px, r.ball.x, r.ball.z, r.ball.quality);
+          TrackFrame f;
+          f.frame = r.frame, f.t = r.t, f.found = r.ball.found, f.quality = r.ball.quality;
+          f.u = r.ball.u, f.v = r.ball.v, f.radius_px = r.ball.radius_px, f.x = r.ball.x, f.z = r.ball.z;
+          f.u_px = r.u_px, f.u_x = r.u_x;
+          c.Set(i, f);
         }
         py::dict d = c.ToDict();
         d["fps"] = result.fps;

@@ -522,6 +522,9 @@ TEST_F(TrackApiTest, RestPositionBecomesY) {
     const auto& row = truth.at(f["frame"].get<std::size_t>());
     EXPECT_NEAR(f["u"].get<double>(), std::stod(row[4]), 0.5);
     EXPECT_NEAR(f["v"].get<double>(), std::stod(row[5]), 0.5);
+    // With its standard uncertainty along the rails (the track CSV's u_x, in the experiment's unit).
+    EXPECT_GT(f["u_x"].get<double>(), 0.0);
+    EXPECT_LT(f["u_x"].get<double>(), 0.5);
   }
   auto [accepted, state] = Send("POST", "/api/rows/" + std::to_string(id) + "/accept-y", {{"version", State()["version"]}});
   ASSERT_EQ(accepted, 200) << state.dump();

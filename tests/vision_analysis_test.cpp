@@ -561,6 +561,25 @@ TEST(TrackTable, ReadsFramesLostFramesAndExtraColumns) {
   EXPECT_EQ(t.found_count(), 2u);
 }
 
+// The uncertainty columns `uphill track` writes after quality (u_px in px, u_x in mm), read by name
+// wherever they stand after the leading columns; a track without them states none (0).
+TEST(TrackTable, ReadsEachPositionsUncertaintyWhereTheTrackStatesIt) {
+  const Track t = Parse(
+      "frame,t,u,v,radius_px,x,z,quality,note,u_x,u_px\n"
+      "0,0.5,100.25,200.5,30,12.5,-3,0.95,a,0.021,0.083\n"
+      "1,0.51,,,,,,0,b,,\n");
+  ASSERT_EQ(t.frames.size(), 2u);
+  EXPECT_DOUBLE_EQ(t.frames[0].u_px, 0.083);
+  EXPECT_DOUBLE_EQ(t.frames[0].u_x, 0.021e-3);
+  EXPECT_EQ(t.frames[1].u_px, 0.0);
+  EXPECT_EQ(Parse("frame,t,u,v,radius_px,x,z,quality\n0,0.5,100,200,30,12.5,-3,0.95\n").frames[0].u_x, 0.0);
+  const std::string h = "frame,t,u,v,radius_px,x,z,quality,u_px,u_x\n";
+  EXPECT_NE(ErrorOf(h + "0,0,1,1,30,1,1,1,,0.02\n").find("row 2, column u_px: is empty in a frame with a position"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(h + "0,0,1,1,30,1,1,1,0.08,-0.02\n").find("row 2, column u_x: must be >= 0"), std::string::npos);
+  EXPECT_NE(ErrorOf(h + "0,0,1,1,30,1,1,1,inf,0.02\n").find("row 2, column u_px"), std::string::npos);
+}
+
 TEST(TrackTable, BadRowsNameFileRowAndColumn) {
   const std::string h = "frame,t,u,v,radius_px,x,z,quality\n";
   EXPECT_EQ(ErrorOf("frame,t,u,v,x,z,quality\n0,0,1,1,1,1,1\n").substr(0, 12), "t.csv, row 1");

@@ -36,6 +36,20 @@ Track FromTable(const CsvTable& table) {
     throw InputError(table.source + ", row 1",
                      "the header must start with frame,t,u,v,radius_px,x,z,quality (a track written by uphill track)");
   enum { kFrame, kT, kU, kV, kRadius, kX, kZ, kQuality };
+  // The optional uncertainty columns, by name after the leading ones (-1: absent).
+  const auto optional_column = [&](const std::string& name) {
+    const auto at = std::find(table.header.begin() + static_cast<long>(columns.size()), table.header.end(), name);
+    return at == table.header.end() ? -1 : static_cast<int>(at - table.header.begin());
+  };
+  const int u_px_column = optional_column("u_px"), u_x_column = optional_column("u_x");
+  // A standard uncertainty in the column's unit (px, or mm): filled, finite and >= 0.
+  const auto uncertainty = [&](const CsvRow& row, int column) {
+    if (column < 0) return 0.0;
+    Require(!Blank(row.cells[column]), table, row, column, "is empty in a frame with a position");
+    const double u = Number(table, row, column);
+    Require(u >= 0.0, table, row, column, "must be >= 0, a standard uncertainty (got " + row.cells[column] + ")");
+    return u;
+  };
   Track track;
   track.source = table.source;
   for (const CsvRow& row : table.rows) {
@@ -76,6 +90,8 @@ Track FromTable(const CsvTable& table) {
       f.x = Number(table, row, kX) * 1e-3;
       f.z = Number(table, row, kZ) * 1e-3;
       f.found = f.quality > 0.0;
+      f.u_px = uncertainty(row, u_px_column);
+      f.u_x = uncertainty(row, u_x_column) * 1e-3;
     }
     track.frames.push_back(f);
   }

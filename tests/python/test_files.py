@@ -158,6 +158,10 @@ def test_track_csv_of_the_program_reads_back(clip, tmp_path):
     # The CSV prints x, z in mm and pixels with a fixed number of decimals.
     assert np.max(np.abs(from_cli["x"] - run["x"])) < 1e-6
     assert np.max(np.abs(from_cli["u"] - run["u"])) < 1e-3
+    # Every found position carries its standard uncertainty, the same from the CSV as from the call.
+    assert (run["u_px"][run["found"]] > 0).all() and (run["u_x"][run["found"]] > 0).all()
+    assert np.max(np.abs(from_cli["u_px"] - run["u_px"])) < 1e-4
+    assert np.max(np.abs(from_cli["u_x"] - run["u_x"])) < 1e-7  # 4 decimals of a mm
     camera = uphill.read_camera(str(clip / "cam.json"))
     pose = uphill.read_scene_calibration(str(clip / "scene.json"))
     assert camera["width"] == pose["camera"]["width"] and camera["fx"] == pytest.approx(pose["camera"]["fx"])
@@ -176,3 +180,4 @@ def test_lost_frames_stay_missing(tmp_path):
     np.testing.assert_array_equal(t["found"], [True, False, True])
     assert np.isnan(t["x"][1]) and t["quality"][1] == 0
     assert t["x"][2] == pytest.approx(0.301) and t["t"][1] == 0.04
+    assert np.isnan(t["u_px"]).all() and np.isnan(t["u_x"]).all()  # this track states no uncertainty

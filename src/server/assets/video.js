@@ -561,7 +561,7 @@ function renderTrack() {
     const img = el('img', { alt: `frame ${f.frame}`, src: `/api/video/frame?video=${encodeURIComponent(V.video)}&frame=${f.frame}&format=jpeg` });
     const outline = svg('svg', { viewBox: `-0.5 -0.5 ${t.width} ${t.height}`, preserveAspectRatio: 'xMinYMin meet' });
     if (f.u !== null) outline.append(svg('circle', { cx: f.u, cy: f.v, r: f.radius_px, 'vector-effect': 'non-scaling-stroke' }));
-    fig.append(img, outline, el('figcaption', {}, `${f.t.toFixed(2)} s` + (f.x === null ? ' (not found)' : `, x = ${fmt(f.x, d)}`)));
+    fig.append(img, outline, el('figcaption', {}, `${f.t.toFixed(2)} s` + (f.x === null ? ' (not found)' : `, x = ${fmt(f.x, d)}` + (f.u_x === null ? '' : ` ± ${fmt(f.u_x, d)}`) + ` ${S.unit}`)));
     strip.append(fig);
   }
 }

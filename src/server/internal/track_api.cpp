@@ -125,7 +125,8 @@ ordered_json TrackRowVideo(const ExperimentStore& store, const StoreSnapshot& sn
                      {"u", f.found ? ordered_json(f.u) : ordered_json(nullptr)},
                      {"v", f.found ? ordered_json(f.v) : ordered_json(nullptr)},
                      {"radius_px", f.found ? ordered_json(f.radius_px) : ordered_json(nullptr)},
-                     {"x", f.found ? ordered_json(L(f.x)) : ordered_json(nullptr)}});
+                     {"x", f.found ? ordered_json(L(f.x)) : ordered_json(nullptr)},
+                     {"u_x", f.found && f.u_x > 0 ? ordered_json(L(f.u_x)) : ordered_json(nullptr)}});
   }
   out["strip"] = strip;
   return out;
