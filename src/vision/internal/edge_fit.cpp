@@ -15,15 +15,22 @@ using Eigen::Vector3d;
 constexpr double kStep = 0.5;             // px between profile samples
 constexpr double kNarrowHalfWidth = 2.5;  // px, second pass around the first fit
 constexpr double kInlierPx = 1.0;         // |residual| below this: inlier
-constexpr double kMinGradient = 2.0;      // grey levels per px: weaker is no edge
+constexpr double kMinGradient = 2.0;      // levels per px: weaker is no edge
+// An edge is read in hue where its grey edge is weak (a gradient peak below kWeakGreyEdge levels
+// per px) and the colour step across the ray exceeds the grey step kHueEdge times: a blue ball on
+// a green cloth of its grey. Where the grey edge is clear, a hue edge is more often a print's or
+// a reflection's (tuned on random scenes, docs/track.md).
+constexpr double kWeakGreyEdge = 6.0, kHueEdge = 4.0;
+constexpr int kEndSamples = 4;  // samples at each end of a ray that give its inside and outside colours
+const cv::Vec3f kLuminance(0.0722f, 0.7152f, 0.2126f);  // B, G, R: Rec. 709 luminance
 
-double Bilinear(const cv::Mat& img, double x, double y) {
+cv::Vec3f Bilinear(const cv::Mat& img, double x, double y) {
   const int i = static_cast<int>(std::floor(x)), j = static_cast<int>(std::floor(y));
-  const double fx = x - i, fy = y - j;
-  const float* r0 = img.ptr<float>(j);
-  const float* r1 = img.ptr<float>(j + 1);
-  const double top = r0[i] + fx * (r0[i + 1] - r0[i]);
-  const double bottom = r1[i] + fx * (r1[i + 1] - r1[i]);
+  const float fx = static_cast<float>(x - i), fy = static_cast<float>(y - j);
+  const cv::Vec3f* r0 = img.ptr<cv::Vec3f>(j);
+  const cv::Vec3f* r1 = img.ptr<cv::Vec3f>(j + 1);
+  const cv::Vec3f top = r0[i] + fx * (r0[i + 1] - r0[i]);
+  const cv::Vec3f bottom = r1[i] + fx * (r1[i + 1] - r1[i]);
   return top + fy * (bottom - top);
 }
 
@@ -57,20 +64,21 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
                                 cv::Point(static_cast<int>(std::ceil(u1 + pad)), static_cast<int>(std::ceil(v1 + pad)))) &
                        full;
   if (roi.width < 8 || roi.height < 8) return fit;
-  // Linear luminance (Rec. 709 weights on the decoded channels), scaled to 0..255 so that the
-  // thresholds read in 8-bit levels: only in linear light is a blurred edge's ramp a straight
-  // blend whose middle is the outline at mid-exposure.
-  cv::Mat smooth(roi.size(), CV_32F);
+  // The decoded channels in linear light, scaled to 0..255 so that the thresholds read in 8-bit
+  // levels: only in linear light is a blurred edge's ramp a straight blend whose middle is the
+  // outline at mid-exposure. Smoothed once; the luminance (Rec. 709) is their weighted sum.
+  cv::Mat smooth(roi.size(), CV_32FC3);
   for (int y = 0; y < roi.height; ++y) {
     const std::uint8_t* in = bgr.ptr<std::uint8_t>(roi.y + y) + 3 * roi.x;
-    float* out = smooth.ptr<float>(y);
-    for (int x = 0; x < roi.width; ++x, in += 3) out[x] = luminance_[0][in[0]] + luminance_[1][in[1]] + luminance_[2][in[2]];
+    cv::Vec3f* out = smooth.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < roi.width; ++x, in += 3) out[x] = {linear_[in[0]], linear_[in[1]], linear_[in[2]]};
   }
   cv::GaussianBlur(smooth, smooth, cv::Size(7, 7), 1.0);
 
   const int samples = 2 * static_cast<int>(std::ceil(half_width / kStep)) + 1;
   const double start = -(samples / 2) * kStep;
-  std::vector<double> profile(samples), gradient(samples);
+  std::vector<cv::Vec3f> colours(samples);
+  std::vector<double> luminance(samples), profile(samples), gradient(samples);
   std::vector<Vector2d> edges;
   std::vector<double> contrasts;
   std::vector<int> signs;
@@ -94,16 +102,40 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
     ++fit.attempted;
     for (int i = 0; i < samples; ++i) {
       const Vector2d p = first + (i * kStep) * dir;
-      profile[i] = Bilinear(smooth, p.x() - roi.x, p.y() - roi.y);
+      colours[i] = Bilinear(smooth, p.x() - roi.x, p.y() - roi.y);
+      luminance[i] = kLuminance.dot(colours[i]);
     }
-    // Gradient (outward) and its strongest peak of the expected polarity.
+    // Gradient (outward) of `profile` and its strongest peak of the expected polarity.
     int best = -1;
     double best_g = 0;
-    std::fill(gradient.begin(), gradient.end(), 0.0);
-    for (int i = 1; i + 1 < samples; ++i) {
-      gradient[i] = (profile[i + 1] - profile[i - 1]) / (2 * kStep);
-      const double signed_g = polarity_ == 0 ? std::abs(gradient[i]) : polarity_ * gradient[i];
-      if (i >= 2 && i + 2 < samples && signed_g > best_g) best_g = signed_g, best = i;
+    const auto strongest = [&](int expected) {
+      best = -1, best_g = 0;
+      std::fill(gradient.begin(), gradient.end(), 0.0);
+      for (int i = 1; i + 1 < samples; ++i) {
+        gradient[i] = (profile[i + 1] - profile[i - 1]) / (2 * kStep);
+        const double signed_g = expected == 0 ? std::abs(gradient[i]) : expected * gradient[i];
+        if (i >= 2 && i + 2 < samples && signed_g > best_g) best_g = signed_g, best = i;
+      }
+    };
+    profile = luminance;
+    strongest(polarity_);
+    // Where the grey edge is weak (a peak below kWeakGreyEdge) and the colours across the ray
+    // differ mostly in hue (the colour step between the window's ends, Δ = outside − inside, more
+    // than kHueEdge times the grey step), the edge is read along Δ/|Δ| instead, in which it rises
+    // outward by |Δ|. A blend of two colours is a blend along Δ, so the ramp's middle stays the
+    // outline at mid-exposure.
+    bool by_hue = false;
+    if (best_g < kWeakGreyEdge) {
+      cv::Vec3f delta(0, 0, 0);
+      for (int i = 0; i < kEndSamples; ++i) delta += colours[samples - 1 - i] - colours[i];
+      delta *= 1.0f / kEndSamples;
+      const double hue_step = cv::norm(delta);
+      by_hue = hue_step > kHueEdge * std::abs(kLuminance.dot(delta));
+      if (by_hue) {
+        delta *= static_cast<float>(1 / hue_step);
+        for (int i = 0; i < samples; ++i) profile[i] = delta.dot(colours[i]);
+        strongest(1);
+      }
     }
     if (best < 0 || best_g < kMinGradient) continue;
     // Centroid of the gradient above half its peak: the middle of the edge's ramp. For a sharp
@@ -122,8 +154,11 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
     }
     const double along = start + (moment / weight) * kStep;
     edges.push_back(image[k] + along * dir);
-    contrasts.push_back(profile[std::min(samples - 1, hi + 3)] - profile[std::max(0, lo - 3)]);
-    signs.push_back(sign);
+    // The grey step across the edge (what the fast path's trust reads), and its sign; 0 for an
+    // edge read in hue, which says nothing of the grey polarity.
+    const double grey_step = luminance[std::min(samples - 1, hi + 3)] - luminance[std::max(0, lo - 3)];
+    contrasts.push_back(grey_step);
+    signs.push_back(by_hue ? 0 : sign);
   }
   fit.edge_points = static_cast<int>(edges.size());
   if (fit.edge_points < 8) return fit;
@@ -149,28 +184,27 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
   if (!solution.finite || !InFront(solution.x, solution.z)) return fit;
 
   double sum2 = 0;
-  int votes = 0;
+  int votes = 0, voters = 0;  // the grey edges' polarity
   for (size_t k = 0; k < problem.rays.size(); ++k) {
     const double res = EdgeRayResidualPx(problem, problem.rays[k], solution.x, solution.z, solution.bias);
     if (std::abs(res) < kInlierPx) {
       ++fit.inliers;
       sum2 += res * res;
       votes += signs[k];
+      voters += signs[k] != 0;
     }
   }
   fit.ok = fit.inliers >= 3;
   fit.x = solution.x;
   fit.z = solution.z;
   fit.rms_px = fit.inliers ? std::sqrt(sum2 / fit.inliers) : 0;
-  if (polarity_ == 0 && fit.inliers > 0) polarity_ = votes >= 0 ? 1 : -1;
+  if (polarity_ == 0 && voters > 0) polarity_ = votes >= 0 ? 1 : -1;
   return fit;
 }
 
 EdgeFit::EdgeFit(const OutlineGeometry& geometry, int points, Transfer transfer) : geometry_(geometry), points_(points) {
   const std::array<float, 256> linear = LinearTable(transfer);
-  constexpr double kWeights[3] = {0.0722, 0.7152, 0.2126};  // B, G, R: Rec. 709 luminance
-  for (int c = 0; c < 3; ++c)
-    for (int k = 0; k < 256; ++k) luminance_[c][k] = static_cast<float>(255.0 * kWeights[c] * linear[k]);
+  for (int k = 0; k < 256; ++k) linear_[k] = 255.0f * linear[k];
 }
 
 EdgeFitOutcome EdgeFit::Measure(const cv::Mat& bgr, double x, double z, double half_width) {

@@ -3,10 +3,14 @@
 //
 // Rays from the predicted centre's image cross `points` tangent points of the predicted outline
 // (the cone of rays tangent to the body, outline_fit.hpp's OutlineGeometry). Along each, the
-// frame's luminance in linear light (each channel decoded by the camera's transfer curve,
-// linear_light.hpp, weighted as Rec. 709, on a 0..255 scale; smoothed by a Gaussian of σ = 1 px)
-// is sampled every half pixel over ±half_width; the edge is the centroid of the gradient above
-// half its strongest peak of the expected polarity. In linear light a motion-blurred edge is a
+// frame's colour in linear light (each channel decoded by the camera's transfer curve,
+// linear_light.hpp, on a 0..255 scale; smoothed by a Gaussian of σ = 1 px) is sampled every half
+// pixel over ±half_width and read in one channel: the luminance (Rec. 709 weights), or, where its
+// grey edge is weak (a gradient below 6 levels per px) and the colours at the ray's two ends
+// differ mostly in hue (a colour step more than 4 times the grey step: a blue ball on a green
+// cloth as grey as it), the colour along their difference. The edge is the centroid of that
+// channel's gradient above half its strongest peak of the expected polarity (an edge read in hue
+// rises outward by construction). In linear light a motion-blurred edge is a
 // blend of body and background whose ramp runs straight across the edge's sweep, so that
 // centroid is the outline at mid-exposure (up to the outline's curvature over the sweep, about
 // blur²/(16·radius) at the sides, the same on opposite sides); in the camera's encoded grey the
@@ -16,7 +20,8 @@
 // narrow pass (±2.5 px) around the first fit when it moved more than a pixel or lost edges.
 //
 // What it assumes, and the tracker checks before trusting it (ball_tracker.cpp, "fast path"):
-// the body differs from its surroundings in luminance all round, the motion blur is short
+// the body differs from its surroundings in luminance all round (the median grey step; the
+// edges themselves may be read in hue), the motion blur is short
 // against the radius, the body has no inner edges near its outline, the shutter is global. Where
 // these hold it is within about 0.1 px RMS (docs/benchmarks.md, `uphill bench track`), at a
 // cost of one small solve (3 parameters, ≤ 97 residuals) per frame; where they do
@@ -60,7 +65,7 @@ class EdgeFit {
 
   const OutlineGeometry& geometry_;
   int points_;
-  std::array<std::array<float, 256>, 3> luminance_;  // per channel: its share of linear luminance, 0..255
+  std::array<float, 256> linear_;  // each 8-bit code's linear value, 0..255
   int polarity_ = 0;  // sign of the grey step from inside to outside the body; 0: unknown
 };
 
