@@ -26,6 +26,14 @@
 namespace uphill {
 namespace {
 
+// A single position's error beyond the tracker's systematic part (the edge bias that neighbouring
+// frames share, TrackAnalysisOptions' model): px on each image axis. On 5 seeds of random
+// ray-traced scenes (196 scenes, 6226 frames within a pixel of the truth) the truth lay within
+// 2.45 hypot(systematic, this) in 94.6 % of the frames, where the systematic part alone held 86 %:
+// much of the rest is a steady bias of a few tenths of a pixel on one axis of a scene, which the
+// frames' own scatter does not show.
+constexpr double kPositionScatterPx = 0.10;
+
 // TrackRow::u_px and u_x of every row where the ball was found.
 void AddUncertainties(double body_across, std::vector<TrackRow>* rows) {
   std::vector<double> t, u, v;
@@ -36,7 +44,7 @@ void AddUncertainties(double body_across, std::vector<TrackRow>* rows) {
   const TrackAnalysisOptions error_model;
   for (std::size_t i = 0; i < found.size(); ++i) {
     TrackRow& r = *found[i];
-    r.u_px = error_model.tracker_floor_px + error_model.tracker_blur * speed[i];
+    r.u_px = std::hypot(error_model.tracker_floor_px + error_model.tracker_blur * speed[i], kPositionScatterPx);
     r.u_x = r.ball.radius_px > 0 ? r.u_px * body_across / r.ball.radius_px : 0.0;
   }
 }

@@ -36,11 +36,12 @@ struct TrackRow {
   double t = 0;  // s
   BallObservation ball;
   // Where the ball was found: the standard uncertainty of its centre, in raw pixels (each image
-  // axis) and along the path (m). The tracker's systematic error as analyse-track takes it
-  // (TrackAnalysisOptions: tracker_floor_px + tracker_blur × the pixels the centre moves per frame
-  // interval, from the found frames before and after), in metres at the body's scale (Body::
-  // across over radius_px). The fit's own scatter is not added. `uphill bench track --random`
-  // states how often the truth lies within it.
+  // axis) and along the path (m, at the body's scale: Body::across over radius_px). The tracker's
+  // systematic error as analyse-track takes it (TrackAnalysisOptions: tracker_floor_px +
+  // tracker_blur × the pixels the centre moves per frame interval, from the found frames before
+  // and after) and, in quadrature, a single position's scatter beyond it, 0.10 px (calibrated on
+  // random ray-traced scenes: video_tracking.cpp). `uphill bench track --random` states how often
+  // the truth lies within 2.45 u_px (95 % expected).
   double u_px = 0, u_x = 0;
 };
 
