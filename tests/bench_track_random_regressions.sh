@@ -12,6 +12,14 @@
 #             candidate's outline outranked it; now the search walks down the candidates)
 # and the rest position analyse-track takes from each (the report's Y) now states an uncertainty
 # that holds the truth: within 3 u (before: u = scatter/sqrt(n) alone, pulls of 30 and more).
+# And of `--random 8 --seed 8865490429367052905`:
+#   fa10df48  banded sphere on paper, 960x540, at the fall-off point: it drops through the gap
+#             after 20 frames. kVideoTrackerVersion 23 went on reporting it between the rods for
+#             the 20 frames after (a disc there meets the rods' edges as the body did); now a fit
+#             whose ends along the rods do not stand out of the table is not the body
+#             (path_end_steps.hpp), and no frame after the fall is reported. Known and left: the
+#             20 frames before it are found 1.5-35 px off (the body sits so deep between the rods
+#             that little of its outline shows).
 #   bash tests/bench_track_random_regressions.sh UPHILL_VISION_PROGRAM CACHE_DIR
 set -euo pipefail
 program="$1"
@@ -38,5 +46,19 @@ for name, (most_px, least_found) in bounds.items():
     assert analysis["kind"] == "rest", (name, analysis)
     (y,) = analysis["pulls"]
     assert y["u"] > 0 and abs(y["error"]) <= 3 * y["u"], (name, y)
-print("random bench regressions: ok")
 PY
+"$program" bench track --random 8 --seed 8865490429367052905 --draw fa10df48 \
+  --random-cache "$cache" --json "$out/fallen.json" > "$out/fallen.txt"
+cat "$out/fallen.txt"
+/usr/bin/python3 - "$cache/8865490429367052905" <<'PY'
+import csv, glob, json, os, sys
+root = sys.argv[1]
+(clip,) = [os.path.dirname(c) for c in glob.glob(root + "/*/condition.json")
+           if json.load(open(c))["name"] == "random-fa10df48"]
+gone = {int(r["frame"]) for r in csv.DictReader(open(clip + "/truth.csv")) if not r["u"]}
+track = list(csv.DictReader(open(root + "/tracks/fa10df48/core.csv")))
+assert len(gone) == 20, len(gone)  # the renderer's frames without the body: 20 to 39
+reported = [int(r["frame"]) for r in track if int(r["frame"]) in gone and r["u"]]
+assert not reported, ("a position reported after the body fell", reported)
+PY
+echo "random bench regressions: ok"

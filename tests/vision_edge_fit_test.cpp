@@ -1,7 +1,6 @@
 // The fast path's edge locator (src/vision/internal/edge_fit.hpp) on frames drawn here. Truth:
-// each pixel's share of a 16×16 grid of sub-pixel viewing rays that meet the sphere (a
-// ray–sphere intersection through UndistortPixels, not the locator's tangent-cone geometry),
-// blended in linear light and encoded as sRGB; the centre drawn is the centre to find.
+// the sphere ray-cast by ray_cast_ball_support.hpp (not the locator's tangent-cone geometry); the
+// centre drawn is the centre to find.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -10,6 +9,7 @@
 
 #include "internal/edge_fit.hpp"
 #include "outline_geometry_support.hpp"
+#include "ray_cast_ball_support.hpp"
 
 namespace uphill::internal {
 namespace {
@@ -19,36 +19,10 @@ using Eigen::Vector3d;
 
 constexpr double kRadius = 0.0127;  // m: a 1-inch ball, about 19 px across its radius here
 
-double SrgbEncode(double linear) {
-  return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1 / 2.4) - 0.055;
-}
-
 // The sphere at (x, 0, z) in front of a plain background: body and background colours in linear
-// RGB (0..1), drawn as 8-bit BGR.
+// RGB (0..1).
 cv::Mat DrawBall(const OutlineGeometry& g, double x, double z, const Vector3d& body_rgb, const Vector3d& back_rgb) {
-  constexpr int kSub = 16;
-  const Vector2d centre = g.Project(x, z);
-  cv::Mat frame(g.cal.camera.height, g.cal.camera.width, CV_8UC3);
-  const Vector3d eye = CameraCentre(g.cal.pose), c(x, 0, z);
-  for (int v = 0; v < frame.rows; ++v)
-    for (int u = 0; u < frame.cols; ++u) {
-      double share = 0;
-      if ((Vector2d(u, v) - centre).norm() < 40) {
-        std::vector<Vector2d> raw;
-        for (int i = 0; i < kSub; ++i)
-          for (int j = 0; j < kSub; ++j) raw.emplace_back(u - 0.5 + (i + 0.5) / kSub, v - 0.5 + (j + 0.5) / kSub);
-        for (const Vector2d& m : UndistortPixels(g.cal.camera, raw)) {
-          const Vector3d ray = (g.to_apparatus * Vector3d(m.x(), m.y(), 1)).normalized();
-          const Vector3d to_c = c - eye;
-          share += (to_c - to_c.dot(ray) * ray).norm() < kRadius;
-        }
-        share /= kSub * kSub;
-      }
-      const Vector3d rgb = share * body_rgb + (1 - share) * back_rgb;
-      for (int ch = 0; ch < 3; ++ch)
-        frame.at<cv::Vec3b>(v, u)[2 - ch] = static_cast<std::uint8_t>(std::lround(255 * SrgbEncode(rgb[ch])));
-    }
-  return frame;
+  return DrawBallOver(g, kRadius, x, z, &body_rgb, [&](int, int) { return back_rgb; });
 }
 
 double Luminance(const Vector3d& rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }

@@ -318,7 +318,9 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
     // Far from the prediction is a jump to something else unless the search confirms it.
     const double off = (m.geometry.Project(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]) -
                         m.geometry.Project(centre.x(), centre.y())).norm();
-    if (m.Accept(fit, 0.45) && off < std::max(4.0, 0.5 * m.RadiusPx(centre.x(), centre.y()) + step_px)) return finish(fit, q, false);
+    if (m.Accept(fit, 0.45) && off < std::max(4.0, 0.5 * m.RadiusPx(centre.x(), centre.y()) + step_px) &&
+        m.EndsStandOut({frame, {0, 0}, gain}, fit, q))
+      return finish(fit, q, false);
   }
   // (Re)acquire: near the prediction, else along the whole path.
   std::optional<Impl::Prediction> near;

@@ -93,7 +93,9 @@
 // these on real video.
 //
 // Hard cases: the near rail hides the lower edge (masked); the body leaves the frame or drops
-// between the rails (lost: found = false, quality 0; the next frames search the path again); a
+// between the rails (lost: found = false, quality 0; the next frames search the path again; a
+// model fit whose outline's ends along the rods do not stand out of the table is not a body,
+// internal/path_end_steps.hpp, since the rods' edges meet a disc anywhere between them); a
 // frame with no body anywhere (not found, never invented: a body found anew before the background
 // under it was seen, in the first frames, counts only once the next frames find it again near it;
 // else it was the table's texture and is withdrawn by a revision); a double cone (refused). Where the

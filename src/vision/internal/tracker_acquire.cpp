@@ -45,7 +45,7 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
       const FitRequest q = Request(*guess, v, predicted && history.size() >= 2, 2 * options.search_half_width_px,
                                    predicted ? near->acceleration : Vector2d::Zero());
       const FitOutcome fit = Measure({frame, {0, 0}, gain}, q, Search::kAcquiring);
-      if (!Accept(fit, kAcquireAgreement)) continue;
+      if (!Accept(fit, kAcquireAgreement) || !EndsStandOut({frame, {0, 0}, gain}, fit, q)) continue;
       const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
       if (predicted) {
         // A body rolling on the rails does not leave its predicted path by more than a radius

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "path_end_steps.hpp"
 #include "tracker_state.hpp"
 
 namespace uphill {
@@ -34,6 +35,23 @@ FitRequest BallTracker::Impl::Request(const Vector2d& centre, const Vector2d& ve
   }
   if (q.smear.norm() < 0.25 * m_per_px) q.smear = PathTangent(centre.x()) * 0.25 * m_per_px;
   return q;
+}
+
+bool BallTracker::Impl::EndsStandOut(const internal::FrameView& view, const FitOutcome& f, const FitRequest& q) const {
+  const Vector2d c(f.p[internal::kCentreX], f.p[internal::kCentreZ]);
+  const Vector2d at = geometry.Project(c.x(), c.y());
+  // The rods' direction, not the centre path's: near the fall-off point the centre sinks between
+  // the rods, and its path's direction in the picture points into them.
+  const Vector2d along = Vector2d(1, scene.rails().tan_theta).normalized() * MetresPerPx(c.x(), c.y());
+  const Vector2d tangent_px = (geometry.Project(c.x() + along.x(), c.y() + along.y()) - at).normalized();
+  // The predicted smear, not the fitted one: a fit off the body may take any smear.
+  const Vector2d smear_px = geometry.Project(c.x() + 0.5 * q.smear.x(), c.y() + 0.5 * q.smear.y()) -
+                            geometry.Project(c.x() - 0.5 * q.smear.x(), c.y() - 0.5 * q.smear.y());
+  const internal::PathEndSteps ends =
+      internal::MeasurePathEndSteps(geometry, view, background->table(), c.x(), c.y(), tangent_px, smear_px);
+  for (const double step : {ends.leading, ends.trailing})
+    if (step >= 0 && step < kEndsMinStandOut * NoiseLevel(f)) return false;
+  return true;
 }
 
 FitOutcome BallTracker::Impl::Measure(const internal::FrameView& view, FitRequest q, Search search,

@@ -173,7 +173,8 @@ void BallTracker::Impl::RecoverOpening() {
       const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
       const double off = (geometry.Project(c.x(), c.y()) - geometry.Project(predicted.x(), predicted.y())).norm();
       after = next;
-      bool accepted = Accept(fit, 0.45) && off < std::max(4.0, 0.5 * RadiusPx(c.x(), c.y()) + step_px);
+      bool accepted = Accept(fit, 0.45) && off < std::max(4.0, 0.5 * RadiusPx(c.x(), c.y()) + step_px) &&
+                      EndsStandOut(view(k), fit, q);
       BallObservation o;
       if (accepted) {
         o = Observe(fit, q);

@@ -189,6 +189,9 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   FitRequest Request(const Vector2d& centre, const Vector2d& velocity, bool moving_known, double half_width,
                      const Vector2d& acceleration = Vector2d::Zero()) const;
 
+  // A fit's noise level: the clip's, once a frame was accepted; before that the fit's own
+  // residual RMS where larger (see Accept).
+  double NoiseLevel(const FitOutcome& f) const { return noises.empty() ? std::max(noise, f.noise) : noise; }
   // A fit is a body when enough rays agree with it, the body stands out of the background by
   // several noise levels, and its inlier rays fit within a few noise levels. `agreement`: the
   // share of the fitted rays that must be inliers (less near the prediction, where a painted
@@ -197,12 +200,17 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // times it): the levels are then the fit's own residual RMS, so that a body found where it is
   // is not refused for the guess. And the centre must lie on the path (OnPath).
   bool Accept(const FitOutcome& f, double agreement) const {
-    const double level = noises.empty() ? std::max(noise, f.noise) : noise;
+    const double level = NoiseLevel(f);
     const double misfit = f.misfit * noise / level;
     return f.ok && f.inliers >= std::max(10.0, 0.25 * options.rays) && f.inliers >= agreement * f.rays_fitted &&
            f.contrast >= options.min_contrast && f.contrast >= 6 * level && misfit < 3 &&
            OnPath(f.p[internal::kCentreX], f.p[internal::kCentreZ]);
   }
+  // Whether the fitted outline's ends along the rods (path_end_steps.hpp) each stand out of what
+  // lies beyond them by kEndsMinStandOut noise levels (the levels Accept takes), where the
+  // picture shows them: the rods' edges run along the path and meet a disc anywhere between
+  // them, so only the ends say that a body is there.
+  bool EndsStandOut(const internal::FrameView& view, const FitOutcome& f, const FitRequest& q) const;
   // Whether a centre lies on the rails' range [x_low, x_max], within a pixel: beyond x_max the
   // body has fallen between the rails, and a fit there is the table where it was (the background
   // under it never seen), not the body.
