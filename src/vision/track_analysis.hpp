@@ -81,7 +81,9 @@
 //  - systematic (se_systematic): the tracker's error of one position, 1σ, in raw pixels, is
 //    tracker_floor_px + tracker_blur × (pixels the centre moves in one frame interval, from the
 //    track's u, v), turned into metres by the track's own scale (the median |Δ(x, z)|/|Δ(u, v)|
-//    over steps of ≥ 5 px: the scene's projection as the tracker applied it). Errors at
+//    over steps of ≥ 5 px: the scene's projection as the tracker applied it; a centre that never
+//    moves 5 px, a far camera looking along the rails, takes its widest step from the first frame
+//    if that reaches 1 px). Errors at
 //    positions x_i, x_j are correlated as exp(−|x_i − x_j|/ℓ): equal at the same place (the
 //    frames at rest share one bias, which no number of frames averages away). ℓ is not known,
 //    so each parameter takes the largest variance over ℓ ∈ {0 (independent), span/256 … span
