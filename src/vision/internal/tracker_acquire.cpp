@@ -26,11 +26,17 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
   if (guesses.empty() || !predicted)
     for (const SearchStart& c : Candidates(frame, gain, x_lo, x_hi)) guesses.push_back(c);
   // Near a prediction the first candidate accepted within a radius of it is the body. Found
-  // anew, every candidate is fitted and the one standing out of its surroundings by the most
-  // noise levels is taken, if by kAcquireMinStandOut at least: a patch of the table's texture or
-  // a tape mark on a rod may fit an outline too, but not by the contrast of a body.
-  std::optional<Found> best;
-  double best_score = 0;
+  // anew, every candidate is fitted, and of the plausible fits (accepted, their ends standing out
+  // along the rods) the best is taken if it stands out of its surroundings by
+  // kAcquireMinStandOut noise levels at least: a patch of the table's texture or a tape mark on
+  // a rod may fit an outline too, but not by the contrast of a body.
+  struct Plausible {
+    FitOutcome fit;
+    FitRequest request;
+    size_t place;
+  };
+  std::vector<Plausible> plausible;
+  std::vector<cv::Rect> windows;
   int fitted = 0;
   const int budget = f == 0 && !predicted ? kAcquireFitsFirstFrame : kAcquireFitsPerFrame;
   for (const SearchStart& place : guesses) {
@@ -57,24 +63,45 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
         rejected.Clear();
         return Found{fit, q, std::nullopt, false};
       }
-      const double stand_out = fit.contrast / std::max(noise, fit.noise);
-      if (stand_out < kAcquireMinStandOut) continue;
       body_here = true;
-      // Where the background is unknown, a candidate whose outline the edge fit finds all round
-      // comes before any other: a print or a reflection can hold the model's outline off a body,
-      // a patch of the table has no such outline.
-      std::optional<internal::EdgeFitOutcome> outline;
-      if (fit.rays_without_background > 0) {
-        edges->Reset();
-        const internal::EdgeFitOutcome w = edges->Measure(frame, c.x(), c.y(), 2 * options.search_half_width_px);
-        if (CleanOutline(w)) outline = w;
-      }
-      const double score = stand_out + (outline ? 1e6 : 0);
-      if (!best || score > best_score) best = Found{fit, q, outline}, best_score = score;
+      plausible.push_back({fit, q, windows.size()});
     }
-    if (!predicted && !body_here) rejected.Remember(frame, window);
+    if (!predicted) windows.push_back(window);
     if (fitted >= budget) break;
   }
+  // The frame's noise level: the lowest residual any plausible fit reached (and at least the
+  // clip's). Every place of one frame has the same pixel noise; a body's print or reflections
+  // only add to its own fit's residuals.
+  double frame_noise = noise;
+  if (noises.empty() && !plausible.empty())
+    frame_noise = std::max(noise, std::min_element(plausible.begin(), plausible.end(), [](const Plausible& a, const Plausible& b) {
+                                    return a.fit.noise < b.fit.noise;
+                                  })->fit.noise);
+  std::optional<Found> best;
+  double best_score = 0;
+  std::vector<bool> body_at(windows.size(), false);
+  for (const Plausible& p : plausible) {
+    // Where the background is unknown, the edge fit looks for the body's outline: a print or a
+    // reflection can hold the model's outline off a body, a patch of the table has no such
+    // outline.
+    std::optional<internal::EdgeFitOutcome> outline;
+    if (p.fit.rays_without_background > 0) {
+      edges->Reset();
+      outline = edges->Measure(frame, p.fit.p[internal::kCentreX], p.fit.p[internal::kCentreZ], 2 * options.search_half_width_px);
+    }
+    const bool found_outline = outline && OutlineFound(*outline), clean = outline && CleanOutline(*outline);
+    // Its stand-out in its own fit's noise levels, or, where its outline was found (a printed
+    // body's own residuals hold its print), in the frame's.
+    const double stand_out = p.fit.contrast / std::max(noise, p.fit.noise);
+    if (stand_out < kAcquireMinStandOut && !(found_outline && p.fit.contrast / frame_noise >= kAcquireMinStandOut)) continue;
+    body_at[p.place] = true;
+    // A clean outline all round comes before any other, then an outline found where it was
+    // looked for, then the stand-out.
+    const double score = stand_out + (clean ? 1e6 : 0) + (found_outline ? 1e3 : 0);
+    if (!best || score > best_score) best = Found{p.fit, p.request, clean ? outline : std::nullopt}, best_score = score;
+  }
+  for (size_t k = 0; k < windows.size(); ++k)
+    if (!body_at[k]) rejected.Remember(frame, windows[k]);
   if (!best) return std::nullopt;
   best->anew = true;
   rejected.Clear();

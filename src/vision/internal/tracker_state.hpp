@@ -249,9 +249,9 @@ struct BallTracker::Impl : internal::TrackerThresholds {
     bool anew = false;
   };
   // The search: the initial guess in frame 0 (TrackerOptions::init_uv), the candidates near the
-  // prediction `near` (the first one accepted is the body), else along the whole path (the one
-  // that stands out of its surroundings by the most noise levels). Clears the history when the
-  // body is found anew or far from the prediction.
+  // prediction `near` (the first one accepted is the body), else along the whole path (one whose
+  // outline the edge fit finds, then the one that stands out of its surroundings by the most
+  // noise levels). Clears the history when the body is found anew or far from the prediction.
   std::optional<Found> Acquire(const cv::Mat& frame, double gain, long f, const std::optional<Prediction>& near);
 
   // A place to start a fit at, and a second start where a fit from the first does not find a
@@ -285,6 +285,15 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   }
 
   BallObservation ObserveEdges(const internal::EdgeFitOutcome& e) const;
+
+  // An edge fit whose edges, where it found them, lie on the body's outline: most of them within
+  // a pixel of it (kOutlineFoundShare), their scatter below half a pixel, in contrast well above
+  // the noise. Looser than CleanOutline: a print's stripes hide the limb's grey step on a third
+  // of the rays, but not the outline's place.
+  bool OutlineFound(const internal::EdgeFitOutcome& e) const {
+    return e.ok && e.inliers >= 0.35 * kEdgePoints && e.inliers >= kOutlineFoundShare * e.edge_points &&
+           e.contrast >= kFastMinContrast && e.rms_px <= kCleanOutlineRmsPx;
+  }
 
   // An edge fit that found the body's outline all round: most of its rays within a pixel of it,
   // their scatter below half a pixel, in contrast well above the noise. Looser than Trusted (the
