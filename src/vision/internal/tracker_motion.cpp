@@ -75,14 +75,26 @@ void BallTracker::Impl::Remember(long f, double t, const BallObservation& o) {
   if (history.size() > kHistory) history.pop_front();
 }
 
-bool BallTracker::Impl::VelocityAround(long f, double t, Vector2d* velocity, Vector2d* acceleration) const {
+// The accepted centres of the frames within four of frame f (f's own left out), and how many of
+// them lie before it.
+namespace {
+std::vector<internal::TimedCentre> CentresAround(const std::map<long, BallTracker::Impl::Sample>& samples, long f,
+                                                        int* before) {
   std::vector<internal::TimedCentre> near;
-  int before = 0, after = 0;
+  *before = 0;
   for (auto it = samples.lower_bound(f - 4); it != samples.end() && it->first <= f + 4; ++it) {
     if (it->first == f) continue;
     near.push_back({it->second.t, Vector2d(it->second.x, it->second.z)});
-    (it->first < f ? before : after)++;
+    *before += it->first < f;
   }
+  return near;
+}
+}  // namespace
+
+bool BallTracker::Impl::VelocityAround(long f, double t, Vector2d* velocity, Vector2d* acceleration) const {
+  int before = 0;
+  const std::vector<internal::TimedCentre> near = CentresAround(samples, f, &before);
+  const int after = static_cast<int>(near.size()) - before;
   if (before < 2 || after < 2) return false;
   const auto fit = internal::MotionFit::Through(near);
   if (!fit) return false;
@@ -90,6 +102,15 @@ bool BallTracker::Impl::VelocityAround(long f, double t, Vector2d* velocity, Vec
   *velocity = state.velocity;
   *acceleration = state.acceleration;
   return true;
+}
+
+std::optional<Vector2d> BallTracker::Impl::CentreAround(long f, double t) const {
+  int before = 0;
+  const std::vector<internal::TimedCentre> near = CentresAround(samples, f, &before);
+  if (near.size() < 3) return std::nullopt;
+  const auto fit = internal::MotionFit::Through(near);
+  if (!fit) return std::nullopt;
+  return fit->At(t).centre;
 }
 
 bool BallTracker::Impl::BackgroundKnownAround(const Vector2d& centre) const {

@@ -84,8 +84,14 @@ void BallTracker::Impl::FitAgain(bool all) {
       continue;
     }
     if (!motion) velocity = acceleration = Vector2d::Zero();
-    FitRequest q = Request(it->centre, velocity, motion, kNarrowHalfWidthPx + 1.5, acceleration);
-    // Started at the frame's own fit, within a pixel or so.
+    // Started at the frame's own fit, within a pixel or so; or, where the frames around it put
+    // the body more than a pixel from it (the search's fit in a body's first frame, started
+    // far off), where they put it.
+    Vector2d start = it->centre;
+    if (const std::optional<Vector2d> around = CentreAround(it->frame, it->t);
+        around && (geometry.Project(around->x(), around->y()) - geometry.Project(start.x(), start.y())).norm() > 1)
+      start = *around;
+    FitRequest q = Request(start, velocity, motion, kNarrowHalfWidthPx + 1.5, acceleration);
     q.iterations = kStartedNearIterations;
     q.estimate_row_delay = false;  // measured when the frame was first fitted
     const FitOutcome fit = Measure({it->window, it->origin, it->gain}, q, Search::kTracking, kStartedNearIterations);

@@ -314,6 +314,9 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // around it (a parabola in time through up to four on each side); false with fewer than two on
   // each side.
   bool VelocityAround(long f, double t, Vector2d* velocity, Vector2d* acceleration) const;
+  // The centre at time t of frame f from the accepted centres of the frames around it (up to four
+  // on each side, three at least on either); nullopt with fewer.
+  std::optional<Vector2d> CentreAround(long f, double t) const;
 
   // Whether the background is known everywhere around the body centred at `centre` (its region,
   // on a 12 × 12 lattice of the band's pixels).
