@@ -75,11 +75,11 @@ void BallTracker::Impl::Remember(long f, double t, const BallObservation& o) {
   if (history.size() > kHistory) history.pop_front();
 }
 
+namespace {
 // The accepted centres of the frames within four of frame f (f's own left out), and how many of
 // them lie before it.
-namespace {
 std::vector<internal::TimedCentre> CentresAround(const std::map<long, BallTracker::Impl::Sample>& samples, long f,
-                                                        int* before) {
+                                                 int* before) {
   std::vector<internal::TimedCentre> near;
   *before = 0;
   for (auto it = samples.lower_bound(f - 4); it != samples.end() && it->first <= f + 4; ++it) {
