@@ -188,8 +188,8 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
   if (m.scene_changed_at) return {};
 
   // A frame the model measured. `acquired`: the body was found anew (not near the prediction).
-  // `outline`: an edge fit that found a body at rest all round where the model, without the
-  // background, put it elsewhere (the acquisition below); it measures the frame.
+  // `outline`: an edge fit that found a body's outline where the model, without the background,
+  // put it elsewhere (the acquisition below); it measures the frame.
   auto finish = [&](const FitOutcome& fit, const FitRequest& q, bool acquired,
                     const std::optional<internal::EdgeFitOutcome>& outline = std::nullopt) {
     const bool needs_model_before = m.needs_model;

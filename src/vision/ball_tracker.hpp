@@ -19,8 +19,10 @@
 // is known) and those with the strongest grey step across them; a few are fitted per frame, places
 // already refused whose pixels have not changed are skipped, and of the bodies found the one that
 // stands out of its surroundings by the most noise levels is taken (one whose outline the edge fit
-// finds all round before any other), none by fewer than kAcquireMinStandOut
-// (internal/tracker_thresholds.hpp). TrackerOptions::init_uv, a raw pixel near the centre,
+// finds all round before any other, then one where the edges it finds lie on the outline; such a
+// body's contrast is weighed against the frame's noise, which its print does not raise), none by
+// fewer than kAcquireMinStandOut (internal/tracker_thresholds.hpp). Where the edge fit found the
+// outline and the model put the body elsewhere, the edge fit measures that frame. TrackerOptions::init_uv, a raw pixel near the centre,
 // replaces that search for the first frame. Then frame by frame near the prediction from the last
 // positions (constant acceleration in time). When a fit fails it re-acquires at once, in the same
 // frame: along the path near the prediction, where a place more than a radius (and three frames'

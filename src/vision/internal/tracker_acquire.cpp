@@ -96,9 +96,10 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
     if (stand_out < kAcquireMinStandOut && !(found_outline && p.fit.contrast / frame_noise >= kAcquireMinStandOut)) continue;
     body_at[p.place] = true;
     // A clean outline all round comes before any other, then an outline found where it was
-    // looked for, then the stand-out.
+    // looked for, then the stand-out. Where the outline was found it measures the frame if the
+    // model put the body elsewhere (below).
     const double score = stand_out + (clean ? 1e6 : 0) + (found_outline ? 1e3 : 0);
-    if (!best || score > best_score) best = Found{p.fit, p.request, clean ? outline : std::nullopt}, best_score = score;
+    if (!best || score > best_score) best = Found{p.fit, p.request, found_outline ? outline : std::nullopt}, best_score = score;
   }
   for (size_t k = 0; k < windows.size(); ++k)
     if (!body_at[k]) rejected.Remember(frame, windows[k]);

@@ -240,7 +240,8 @@ struct BallTracker::Impl : internal::TrackerThresholds {
     Vector2d centre, velocity, acceleration;
   };
   // A body found by the search: its fit and request, the edge fit that measures it instead
-  // (a body at rest whose clean outline the model, without the background, missed), and whether
+  // (a body whose outline the edge fit found where the model, without the background, put it
+  // elsewhere), and whether
   // it was found anew (not near the prediction).
   struct Found {
     FitOutcome fit;
