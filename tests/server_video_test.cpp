@@ -232,7 +232,11 @@ TEST_F(UploadTest, UploadIsStoredWholeOrNotAtAll) {
   const std::string half = head + clip.substr(0, clip.size() / 2);
   ASSERT_EQ(::send(cut, half.data(), half.size(), MSG_NOSIGNAL), static_cast<ssize_t>(half.size()));
   ::close(cut);
-  // The event: the staging folder is gone (the server reads the close and cleans up).
+  // The event: the staging folder is gone (the server reads the close and cleans up). The server
+  // may not have opened it yet when the socket closes: first its staging folder is let appear
+  // (it may also come and go between two looks, hence the short limit, whose result is not
+  // asserted), then it must be gone.
+  WaitUntil([&] { return Leftovers() != std::vector<std::string>{"trial1.mp4"}; }, std::chrono::seconds(2));
   EXPECT_TRUE(WaitUntil([&] { return Leftovers() == std::vector<std::string>{"trial1.mp4"}; }));
   EXPECT_EQ(Leftovers(), std::vector<std::string>{"trial1.mp4"});
   // Only application/octet-stream is an upload.
