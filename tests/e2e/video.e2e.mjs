@@ -202,7 +202,8 @@ try {
   assert.ok(Math.abs(restY - truthX) < 2, `rest Y ${restY} mm, drawn at ${truthX} mm`);
   await shot('video-3-track.png');
   await click('#t-accept');
-  await page.waitForFunction(() => document.querySelector('#body tr td:nth-child(4)')?.textContent !== '');
+  // The Y cell reads "from video" until the server has stored the accepted Y: wait for a number.
+  await page.waitForFunction(() => /^[0-9.]+$/.test(document.querySelector('#body tr td:nth-child(4)')?.textContent ?? ''));
   const state = await (await page.request.get(url + 'api/state')).json();
   assert.ok(Math.abs(Number(state.rows[0].Y) - restY) <= 0.05 + 1e-9, `Y ${state.rows[0].Y} accepted (shown ${restY})`);
 
