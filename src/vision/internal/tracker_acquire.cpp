@@ -51,7 +51,10 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
       const FitRequest q = Request(*guess, v, predicted && history.size() >= 2, 2 * options.search_half_width_px,
                                    predicted ? near->acceleration : Vector2d::Zero());
       const FitOutcome fit = Measure({frame, {0, 0}, gain}, q, Search::kAcquiring);
-      if (!Accept(fit, kAcquireAgreement) || !EndsStandOut({frame, {0, 0}, gain}, fit, q)) continue;
+      // Found anew, a fit is plausible at the clip's noise level too: a print's stripes raise a
+      // body's own residuals to several times the pixel noise (its outline decides, below).
+      const bool plausible_fit = Accept(fit, kAcquireAgreement) || (!predicted && Accept(fit, kAcquireAgreement, noise));
+      if (!plausible_fit || !EndsStandOut({frame, {0, 0}, gain}, fit, q)) continue;
       const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
       if (predicted) {
         // A body rolling on the rails does not leave its predicted path by more than a radius

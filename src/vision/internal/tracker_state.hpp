@@ -199,8 +199,9 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // accepted the clip's noise is not known (`noise` is a guess, and a 1080p phone clip's is three
   // times it): the levels are then the fit's own residual RMS, so that a body found where it is
   // is not refused for the guess. And the centre must lie on the path (OnPath).
-  bool Accept(const FitOutcome& f, double agreement) const {
-    const double level = NoiseLevel(f);
+  bool Accept(const FitOutcome& f, double agreement) const { return Accept(f, agreement, NoiseLevel(f)); }
+  // The same at a given noise level.
+  bool Accept(const FitOutcome& f, double agreement, double level) const {
     const double misfit = f.misfit * noise / level;
     return f.ok && f.inliers >= std::max(10.0, 0.25 * options.rays) && f.inliers >= agreement * f.rays_fitted &&
            f.contrast >= options.min_contrast && f.contrast >= 6 * level && misfit < 3 &&
@@ -288,12 +289,15 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   BallObservation ObserveEdges(const internal::EdgeFitOutcome& e) const;
 
   // An edge fit whose edges, where it found them, lie on the body's outline: most of them within
-  // a pixel of it (kOutlineFoundShare), their scatter below half a pixel, in contrast well above
-  // the noise. Looser than CleanOutline: a print's stripes hide the limb's grey step on a third
-  // of the rays, but not the outline's place.
+  // a pixel of it (kOutlineFoundShare), or most of the rays searched with half of all the rays at
+  // least (kOutlineMostRays); their scatter below half a pixel, in contrast well above the noise.
+  // Looser than CleanOutline: a print's stripes hide the limb's grey step on a third of the rays,
+  // or put a stronger edge beside it on a quarter of them, but not the outline's place.
   bool OutlineFound(const internal::EdgeFitOutcome& e) const {
-    return e.ok && e.inliers >= 0.35 * kEdgePoints && e.inliers >= kOutlineFoundShare * e.edge_points &&
-           e.contrast >= kFastMinContrast && e.rms_px <= kCleanOutlineRmsPx;
+    const bool most_found = e.inliers >= kOutlineFoundShare * e.edge_points;
+    const bool most_rays = e.inliers >= kOutlineMostRays * kEdgePoints && e.inliers >= kOutlineMostSearched * e.attempted;
+    return e.ok && e.inliers >= 0.35 * kEdgePoints && (most_found || most_rays) && e.contrast >= kFastMinContrast &&
+           e.rms_px <= kCleanOutlineRmsPx;
   }
 
   // An edge fit that found the body's outline all round: most of its rays within a pixel of it,

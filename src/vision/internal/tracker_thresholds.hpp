@@ -93,6 +93,12 @@ struct TrackerThresholds {
   // (a striped ball: 0.89, of only 0.58 of its rays), those on a patch of the table or the rods
   // 0.57–0.77 but for one place of a chrome ball's reflection, which was clean all round too.
   static constexpr double kOutlineFoundShare = 0.8;
+  // OutlineFound's other way: the share of all the edge fit's rays, and of those searched, within
+  // a pixel of the outline. A striped ball's stripes put their edge beside the limb on a quarter
+  // of its rays (0.76 of the edges found on it, 0.71 of the rays searched, half of all); on the
+  // first frames of 103 random scenes one place off a body reached both, a two-tone spheroid's
+  // 3 px off its centre.
+  static constexpr double kOutlineMostRays = 0.5, kOutlineMostSearched = 0.7;
   // A body within this of where it was found anew, px, is still at rest there: an edge fit's
   // centre on a printed body scatters by a few tenths of a pixel, a rolling body leaves the
   // place within a few frames.
