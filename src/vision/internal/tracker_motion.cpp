@@ -130,9 +130,15 @@ void BallTracker::Impl::WatchScene(long f) {
   if (residual >= 0) {
     double usual = -1;
     if (scene_residuals.size() >= 5) {
-      std::vector<double> r = scene_residuals;
-      std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
-      usual = std::max(r[r.size() / 2], kUsualResidualFloor);
+      // The frames where the encoder copied the background tell nothing of its noise: the usual
+      // level is that of the others, and nothing is judged before a few of them were seen.
+      std::vector<double> r;
+      for (double v : scene_residuals)
+        if (v > 0) r.push_back(v);
+      if (static_cast<int>(r.size()) >= kConfirmFrames) {
+        std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
+        usual = std::max(r[r.size() / 2], kUsualResidualFloor);
+      }
     }
     if (usual > 0 && residual > kSceneChangeFactor * usual + 0.01) {
       if (scene_suspect++ == 0) scene_suspect_from = f;

@@ -31,6 +31,9 @@ struct TrackerThresholds {
   static constexpr double kSceneChangeFactor = 4;
   // The usual level is never taken below this: H.264 copies static blocks exactly, so the first
   // frames of a clip can show no residual at all, and the first key frame would look like a change.
+  // So those frames do not count toward the usual level, and it is first taken from
+  // kConfirmFrames others: at a phone's bit rate the encoder copies a still background until
+  // the next key frame, which re-encodes a dark cloth 2-4 % off (and the frames after it copy that).
   static constexpr double kUsualResidualFloor = 0.005;
   // Frames that confirm a scene or exposure change: one odd frame (a flash, a dropped frame) is not.
   static constexpr int kConfirmFrames = 3;
