@@ -8,6 +8,7 @@
 #include <optional>
 #include <opencv2/imgproc.hpp>
 
+#include "internal/near_rail_band.hpp"
 #include "internal/tracker_state.hpp"
 #include "model/input_error.hpp"
 
@@ -45,33 +46,11 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
   m.x_lo = scene.x_low() + 1e-6 * span;
   m.x_hi = scene.x_max() - 1e-6 * span;
 
-  // The near rail (on the camera's side) in front of the body: its band in the image, widened
-  // by 2.5 px for the point spread and the sampling.
+  // The near rail (on the camera's side) in front of the body: its band in the image.
   const int width = calibration.camera.width, height = calibration.camera.height;
-  m.occluder = cv::Mat::zeros(height, width, CV_8U);
-  const double rod = scene.rod_radius() > 0 ? scene.rod_radius() : options.rail_radius;
-  const double side = g.eye.y() < 0 ? -1.0 : 1.0;
-  const Rails& rails = scene.rails();
-  const Vector3d axis(1, side * rails.tan_half_alpha, rails.tan_theta);
-  std::vector<cv::Point> polyline;
-  double max_halfwidth = 0;
-  const double x_end = 1.5 * scene.x_max() + 0.2;
-  // Only where the lens model holds: beyond its reach a rail point far outside the picture would
-  // be drawn inside it (a k3 < 0 lens folds back, and a band across the picture would hide most
-  // of the body's outline).
   m.lens_reach = LensModelReach(calibration.camera);
-  for (int i = 0; i <= 400; ++i) {
-    const Vector3d p = axis * (x_end * i / 400.0);
-    const Vector3d pc = calibration.pose.rotation * p + calibration.pose.translation;
-    if (pc.z() <= 0.05 || !m.WithinLens(pc)) continue;
-    const Vector2d q = ProjectCameraPoint(calibration.camera, pc);
-    if (std::abs(q.x()) > 1e5 || std::abs(q.y()) > 1e5) continue;
-    polyline.emplace_back(static_cast<int>(std::lround(q.x() * 16)), static_cast<int>(std::lround(q.y() * 16)));
-    max_halfwidth = std::max(max_halfwidth, rod * calibration.camera.fx / pc.z());
-  }
-  if (polyline.size() >= 2)
-    cv::polylines(m.occluder, polyline, false, cv::Scalar(1),
-                  std::max(1, static_cast<int>(std::ceil(2 * (max_halfwidth + 2.5)))), cv::LINE_8, 4);
+  m.occluder = internal::DrawNearRailBand(scene, g, scene.rod_radius() > 0 ? scene.rod_radius() : options.rail_radius,
+                                          [&m](const Vector3d& pc) { return m.WithinLens(pc); }, m.x_lo, m.x_hi);
   g.occluder = &m.occluder;
   m.shading = std::make_unique<internal::BodyShading>(g.s);
   g.shading = m.shading.get();

@@ -160,9 +160,9 @@ std::vector<BallTracker::Impl::SearchStart> BallTracker::Impl::Candidates(const 
       }
       ++used;
     }
-    // A third of the outline at least: the near rail's band is drawn at the rod's widest (where
-    // the rail passes nearest the camera, even outside the picture), and from a low camera it
-    // hides up to half of a body's outline that the rod itself barely covers.
+    // A third of the outline at least: the near rail's band is drawn at the rod's widest
+    // (near_rail_band.hpp), and from a low camera it hides up to half of a body's outline that
+    // the rod itself barely covers.
     if (used < n / 3) continue;
     double score;
     if (static_cast<int>(bg_in.size()) >= used * 3 / 4) {

@@ -1,0 +1,92 @@
+#include "near_rail_band.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "vision/camera.hpp"
+
+namespace uphill::internal {
+namespace {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+constexpr double kMarginPx = 2.5;  // the point spread and the sampling
+constexpr int kRailSamples = 400;
+// The body's outline is usable at a place where a third of these rays clear the band (the
+// search's rule, Candidates in tracker_acquire.cpp), looked for at this many places.
+constexpr int kOutlineRays = 32, kPlacesAlongPath = 48;
+
+struct RailTrace {
+  std::vector<cv::Point> line;  // 1/16 px
+  double widest_px = 0, widest_in_picture_px = 0;
+};
+
+RailTrace TraceNearRail(const Scene& scene, const SceneCalibration& cal, double rod, double side,
+                        const std::function<bool(const Vector3d&)>& within_lens) {
+  const Rails& rails = scene.rails();
+  const Vector3d axis(1, side * rails.tan_half_alpha, rails.tan_theta);
+  const double x_end = 1.5 * scene.x_max() + 0.2;
+  const double width = cal.camera.width, height = cal.camera.height;
+  RailTrace trace;
+  for (int i = 0; i <= kRailSamples; ++i) {
+    const Vector3d pc = cal.pose.rotation * (axis * (x_end * i / kRailSamples)) + cal.pose.translation;
+    // Only where the lens model holds: beyond its reach a rail point far outside the picture would
+    // be drawn inside it (a k3 < 0 lens folds back).
+    if (pc.z() <= 0.05 || !within_lens(pc)) continue;
+    const Vector2d q = ProjectCameraPoint(cal.camera, pc);
+    if (std::abs(q.x()) > 1e5 || std::abs(q.y()) > 1e5) continue;
+    trace.line.emplace_back(static_cast<int>(std::lround(q.x() * 16)), static_cast<int>(std::lround(q.y() * 16)));
+    const double half_width = rod * cal.camera.fx / pc.z(), reach = half_width + kMarginPx;
+    trace.widest_px = std::max(trace.widest_px, half_width);
+    if (q.x() > -reach && q.y() > -reach && q.x() < width + reach && q.y() < height + reach)
+      trace.widest_in_picture_px = std::max(trace.widest_in_picture_px, half_width);
+  }
+  return trace;
+}
+
+cv::Mat Draw(const RailTrace& trace, double half_width, const cv::Size& size) {
+  cv::Mat band = cv::Mat::zeros(size, CV_8U);
+  if (trace.line.size() >= 2)
+    cv::polylines(band, trace.line, false, cv::Scalar(1), std::max(1, static_cast<int>(std::ceil(2 * (half_width + kMarginPx)))),
+                  cv::LINE_8, 4);
+  return band;
+}
+
+// Whether at no place along the path a third of the body's outline rays (their samples just
+// outside the outline, in the picture) clear the band.
+bool HidesPathEverywhere(const cv::Mat& band, const OutlineGeometry& g, const Scene& scene, double x_lo, double x_hi,
+                         const std::function<bool(const Vector3d&)>& within_lens) {
+  for (int i = 0; i < kPlacesAlongPath; ++i) {
+    const double x = x_lo + (x_hi - x_lo) * (i + 0.5) / kPlacesAlongPath, z = scene.At(x).z;
+    if (!within_lens(g.cal.pose.rotation * Vector3d(x, 0, z) + g.cal.pose.translation)) continue;
+    std::vector<Vector3d> points = g.OutlinePoints(x, z, kOutlineRays);
+    points.emplace_back(x, 0, z);
+    const std::vector<Vector2d> image = ProjectApparatusPoints(g.cal.camera, g.cal.pose, points);
+    int clear = 0;
+    for (int k = 0; k < kOutlineRays; ++k) {
+      const Vector2d out = image[k] + 3.0 * (image[k] - image.back()).normalized();
+      const int u = static_cast<int>(std::lround(out.x())), v = static_cast<int>(std::lround(out.y()));
+      clear += u >= 0 && v >= 0 && u < band.cols && v < band.rows && !band.at<std::uint8_t>(v, u);
+    }
+    if (clear >= kOutlineRays / 3) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+cv::Mat DrawNearRailBand(const Scene& scene, const OutlineGeometry& geometry, double rod,
+                         const std::function<bool(const Vector3d&)>& within_lens, double x_lo, double x_hi) {
+  const double side = geometry.eye.y() < 0 ? -1.0 : 1.0;
+  const RailTrace trace = TraceNearRail(scene, geometry.cal, rod, side, within_lens);
+  const cv::Size size(geometry.cal.camera.width, geometry.cal.camera.height);
+  cv::Mat band = Draw(trace, trace.widest_px, size);
+  if (trace.widest_in_picture_px < trace.widest_px && HidesPathEverywhere(band, geometry, scene, x_lo, x_hi, within_lens))
+    band = Draw(trace, trace.widest_in_picture_px, size);
+  return band;
+}
+
+}  // namespace uphill::internal
