@@ -34,6 +34,7 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
     FitOutcome fit;
     FitRequest request;
     size_t place;
+    bool accepted;  // by Accept as a body near a prediction would be; else only its outline can make it one
   };
   std::vector<Plausible> plausible;
   std::vector<cv::Rect> windows;
@@ -51,10 +52,12 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
       const FitRequest q = Request(*guess, v, predicted && history.size() >= 2, 2 * options.search_half_width_px,
                                    predicted ? near->acceleration : Vector2d::Zero());
       const FitOutcome fit = Measure({frame, {0, 0}, gain}, q, Search::kAcquiring);
-      // Found anew, a fit is plausible at the clip's noise level too: a print's stripes raise a
-      // body's own residuals to several times the pixel noise (its outline decides, below).
-      const bool plausible_fit = Accept(fit, kAcquireAgreement) || (!predicted && Accept(fit, kAcquireAgreement, noise));
-      if (!plausible_fit || !EndsStandOut({frame, {0, 0}, gain}, fit, q)) continue;
+      // Found anew, a fit is plausible at the clip's noise level too, and with fewer rays agreeing:
+      // a print's stripes raise a body's own residuals to several times the pixel noise, its dots
+      // near the limb cost rays. Such a fit is the body only where its outline is found (below).
+      const bool accepted = Accept(fit, kAcquireAgreement);
+      if (!accepted && (predicted || !Accept(fit, kAcquireLooseAgreement, noise))) continue;
+      if (!EndsStandOut({frame, {0, 0}, gain}, fit, q)) continue;
       const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
       if (predicted) {
         // A body rolling on the rails does not leave its predicted path by more than a radius
@@ -66,8 +69,8 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
         rejected.Clear();
         return Found{fit, q, std::nullopt, false};
       }
-      body_here = true;
-      plausible.push_back({fit, q, windows.size()});
+      body_here = accepted;
+      plausible.push_back({fit, q, windows.size(), accepted});
     }
     if (!predicted) windows.push_back(window);
     if (fitted >= budget) break;
@@ -96,6 +99,7 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
     // Its stand-out in its own fit's noise levels, or, where its outline was found (a printed
     // body's own residuals hold its print), in the frame's.
     const double stand_out = p.fit.contrast / std::max(noise, p.fit.noise);
+    if (!p.accepted && !found_outline) continue;
     if (stand_out < kAcquireMinStandOut && !(found_outline && p.fit.contrast / frame_noise >= kAcquireMinStandOut)) continue;
     body_at[p.place] = true;
     // A clean outline all round comes before any other, then an outline found where it was

@@ -58,6 +58,9 @@ struct TrackerThresholds {
   // spheroid with a painted band over a rod: 58 % of them), while a patch of the table that
   // happens to fit an outline is told apart by its contrast (the candidates' best is taken).
   static constexpr double kAcquireAgreement = 0.55;
+  // The same where the edge fit finds the body's outline there (OutlineFound): a dotted ball's
+  // dots near the limb left 0.53 of its rays agreeing with a fit on its centre.
+  static constexpr double kAcquireLooseAgreement = 0.45;
   // Noise levels by which a body found anew (not near a prediction) stands out of its
   // surroundings at least (its limb's contrast against what lies behind it): on 80 random scenes
   // every fit that landed on the body stood out by 10.9 or more, and two in three of those that
