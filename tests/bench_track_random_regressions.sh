@@ -50,11 +50,13 @@ PY
 "$program" bench track --random 8 --seed 8865490429367052905 --draw fa10df48 \
   --random-cache "$cache" --json "$out/fallen.json" > "$out/fallen.txt"
 cat "$out/fallen.txt"
-/usr/bin/python3 - "$cache/8865490429367052905" <<'PY'
+/usr/bin/python3 - "$cache/8865490429367052905" "$out/fallen.json" <<'PY'
 import csv, glob, json, os, sys
 root = sys.argv[1]
+# The clip of this run's generator (a cache can also hold one drawn by an older generator).
+(draw,) = json.load(open(sys.argv[2]))["draws"]
 (clip,) = [os.path.dirname(c) for c in glob.glob(root + "/*/condition.json")
-           if json.load(open(c))["name"] == "random-fa10df48"]
+           if json.load(open(c))["name"] == "random-fa10df48" and json.load(open(c))["generator"] == draw["condition"]["generator"]]
 gone = {int(r["frame"]) for r in csv.DictReader(open(clip + "/truth.csv")) if not r["u"]}
 track = list(csv.DictReader(open(root + "/tracks/fa10df48/core.csv")))
 assert len(gone) == 20, len(gone)  # the renderer's frames without the body: 20 to 39

@@ -1,13 +1,18 @@
 // The random scenes of `uphill bench track --random` (src/bench/track_random_draw.hpp): a draw is
-// a pure function of its seed, and every drawn quantity lies in the range RandomSceneRanges
-// states. Truth: the ranges struct itself, PhoneBitRate for the bit rate, and uphill::Motion
-// (src/motion) for "coming to rest" (the motion's own events say whether and when it rests).
+// a pure function of its seed, down to its encoded pictures, and every drawn quantity lies in the
+// range RandomSceneRanges states. Truth: the ranges struct itself, PhoneBitRate for the bit rate,
+// uphill::Motion (src/motion) for "coming to rest" (the motion's own events say whether and when
+// it rests), and for the encoder the same frames in, decoded by OpenCV.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <filesystem>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 #include <set>
+#include <unistd.h>
 
 #include "bench/track_random_draw.hpp"
 #include "footage/video_encoder.hpp"
@@ -29,6 +34,39 @@ TEST(RandomScene, IsAPureFunctionOfItsSeed) {
   EXPECT_NE(a.id, b.id);
   EXPECT_NE(DescribeFootage(a.condition).dump(), DescribeFootage(b.condition).dump());
   EXPECT_NE(DrawSeed(1, 0), DrawSeed(2, 0));
+}
+
+// The same frames encoded three times at a phone's bit rate give the same pictures: a draw's clip
+// must not depend on the encoder's threads (x264's frame threads under a bit rate made every
+// encode of a clip differ by a few levels, and a replayed draw then tracked differently).
+TEST(RandomScene, ItsClipIsTheSamePicturesOnEveryEncode) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("uphill-encode-test-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  cv::RNG rng(7);
+  cv::Mat table(360, 640, CV_8UC3);
+  rng.fill(table, cv::RNG::UNIFORM, 60, 200);  // grain everywhere: the bit rate binds
+  std::vector<std::vector<cv::Mat>> runs;
+  for (int run = 0; run < 3; ++run) {
+    const std::string path = (dir / ("clip" + std::to_string(run) + ".mp4")).string();
+    VideoEncoderSettings settings;
+    settings.fps = 60;
+    VideoEncoder encoder(path, table.size(), settings);
+    for (int f = 0; f < 60; ++f) {
+      cv::Mat frame = table.clone();
+      cv::circle(frame, cv::Point(100 + 6 * f, 180), 30, cv::Scalar(40, 160, 220), cv::FILLED, cv::LINE_AA);
+      encoder.Write(frame);
+    }
+    encoder.Finish();
+    cv::VideoCapture capture(path, cv::CAP_FFMPEG);
+    ASSERT_TRUE(capture.isOpened()) << path;
+    runs.emplace_back();
+    for (cv::Mat frame; capture.read(frame);) runs.back().push_back(frame.clone());
+    ASSERT_EQ(runs.back().size(), 60u) << path;
+  }
+  std::filesystem::remove_all(dir);
+  for (int run = 1; run < 3; ++run)
+    for (int f = 0; f < 60; ++f) EXPECT_EQ(cv::norm(runs[run][f], runs[0][f], cv::NORM_INF), 0) << "encode " << run << ", frame " << f;
 }
 
 TEST(RandomScene, EveryDrawnQuantityLiesInItsRange) {

@@ -56,7 +56,10 @@ VideoEncoder::VideoEncoder(const std::string& path, cv::Size size, const VideoEn
   const std::string gop = std::to_string(std::max(1L, std::lround(s.gop_seconds * s.fps)));
   switch (s.codec) {
     case VideoCodec::kH264:
-      argv.insert(argv.end(), {"-c:v", "libx264", "-preset", "medium", "-profile:v", "high", "-b:v", b,
+      // One thread: x264's frame threads under a bit rate and VBV make each run's pictures differ
+      // by a few levels (measured: three encodes of one clip decoded to three different clips),
+      // and a draw of the random benchmark must be the same clip on every machine and run.
+      argv.insert(argv.end(), {"-c:v", "libx264", "-threads", "1", "-preset", "medium", "-profile:v", "high", "-b:v", b,
                                "-maxrate", max, "-bufsize", buf, "-g", gop, "-pix_fmt", "yuv420p"});
       break;
     case VideoCodec::kH265:
