@@ -26,8 +26,9 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
   if (guesses.empty() || !predicted)
     for (const SearchStart& c : Candidates(frame, gain, x_lo, x_hi)) guesses.push_back(c);
   // Near a prediction the first candidate accepted within a radius of it is the body. Found
-  // anew, every candidate is fitted, and of the plausible fits (accepted, their ends standing out
-  // along the rods) the best is taken if it stands out of its surroundings by
+  // anew, every candidate is fitted, and of the plausible fits (accepted, or accepted loosely
+  // where the edge fit finds the body's outline; their ends standing out along the rods) the
+  // best is taken if it stands out of its surroundings by
   // kAcquireMinStandOut noise levels at least: a patch of the table's texture or a tape mark on
   // a rod may fit an outline too, but not by the contrast of a body.
   struct Plausible {
