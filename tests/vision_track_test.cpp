@@ -403,10 +403,12 @@ TEST_F(DefaultView, VideoWithoutBallIsPartialWithoutPositions) {
 }
 
 // A rolling ball, frames written by hand so that the picture can be changed from frame `from` on
-// by `change` (the linear-light picture, in place, before the camera's encoding). Truth: the renderer's centres (ClipRenderer) and the
+// by `change` (the linear-light picture, in place, before the camera's encoding), and its noise
+// (σ, 8-bit levels) with it. Truth: the renderer's centres (ClipRenderer) and the
 // frame where the change was made.
 std::vector<Eigen::Vector2d> WriteChangedClip(const ClipRenderer& renderer, const ClipSetup& setup, const std::string& video,
-                                              int frames, int from, const std::function<void(cv::Mat&)>& change) {
+                                              int frames, int from, const std::function<void(cv::Mat&)>& change,
+                                              double noise_before = 1.0, double noise_from = 1.0) {
   const Motion motion(setup.scene, setup.x0);
   cv::VideoWriter w(video, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30, cv::Size(1280, 720));
   cv::RNG rng(3);
@@ -416,10 +418,21 @@ std::vector<Eigen::Vector2d> WriteChangedClip(const ClipRenderer& renderer, cons
     const double x = m.x, z = m.z;
     cv::Mat linear = renderer.RenderLinear({Eigen::Vector2d(x, z)});
     if (i >= from) change(linear);
-    w.write(ToFrame8(linear, 1.0, 1.0, rng));
+    w.write(ToFrame8(linear, 1.0, i < from ? noise_before : noise_from, rng));
     uv.push_back(ProjectApparatusPoint(setup.calibration.camera, setup.calibration.pose, Eigen::Vector3d(x, 0, z)));
   }
   return uv;
+}
+
+// The largest distance of a frame's centre from its true pixel; every frame must be found.
+double LargestError(const TrackResult& track, const std::vector<Eigen::Vector2d>& uv) {
+  double worst = 0;
+  for (std::size_t i = 0; i < uv.size(); ++i) {
+    const BallObservation& b = track.rows[i].ball;
+    EXPECT_TRUE(b.found) << "frame " << i;
+    if (b.found) worst = std::max(worst, std::hypot(b.u - uv[i].x(), b.v - uv[i].y()));
+  }
+  return worst;
 }
 
 TEST_F(DefaultView, CameraThatMovedIsPartialWithoutPositionsAfterIt) {
@@ -462,12 +475,7 @@ TEST_F(DefaultView, ExposureThatChangedIsPartialAndKeepsPositions) {
   EXPECT_NE(track.partial_reason.find("exposure changed at frame 10"), std::string::npos) << track.partial_reason;
   ASSERT_EQ(track.exposure_changes.size(), 1u);
   EXPECT_EQ(track.exposure_changes[0], 10);
-  double worst = 0;
-  for (int i = 0; i < 20; ++i) {
-    const BallObservation& b = track.rows[i].ball;
-    ASSERT_TRUE(b.found) << "frame " << i;
-    worst = std::max(worst, std::hypot(b.u - uv[i].x(), b.v - uv[i].y()));
-  }
+  const double worst = LargestError(track, uv);
   std::printf("  largest error %.4f px\n", worst);
   EXPECT_LT(worst, 0.07);  // measured: 0.047 px
 }
@@ -479,27 +487,13 @@ TEST_F(DefaultView, NoiseAfterCopiedFramesIsNotASceneChange) {
   // 3.6 %, as much as the camera moved by 9 px above gives): the scene itself never changes.
   // Truth: nothing moved but the ball, and the renderer's centres.
   const std::string video = (TempDir() / "copied.avi").string();
-  const Motion motion(setup_->scene, setup_->x0);
-  cv::VideoWriter w(video, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30, cv::Size(1280, 720));
-  cv::RNG rng(5);
-  std::vector<Eigen::Vector2d> uv;
-  for (int i = 0; i < 24; ++i) {
-    const MotionSample m = motion.At(i / 30.0);
-    w.write(ToFrame8(renderer_->RenderLinear({Eigen::Vector2d(m.x, m.z)}), 1.0, i < 10 ? 0.0 : 8.0, rng));
-    uv.push_back(ProjectApparatusPoint(setup_->calibration.camera, setup_->calibration.pose, Eigen::Vector3d(m.x, 0, m.z)));
-  }
-  w.release();
+  const std::vector<Eigen::Vector2d> uv = WriteChangedClip(*renderer_, *setup_, video, 24, 10, [](cv::Mat&) {}, 0.0, 8.0);
   const TrackResult track = TrackVideo(video, setup_->scene, setup_->calibration);
   ASSERT_EQ(track.rows.size(), 24u);
   EXPECT_FALSE(track.partial) << track.partial_reason;
-  double worst = 0;
-  for (int i = 0; i < 24; ++i) {
-    const BallObservation& b = track.rows[i].ball;
-    ASSERT_TRUE(b.found) << "frame " << i;
-    worst = std::max(worst, std::hypot(b.u - uv[i].x(), b.v - uv[i].y()));
-  }
+  const double worst = LargestError(track, uv);
   std::printf("  largest error %.4f px\n", worst);
-  EXPECT_LT(worst, 0.1);  // measured: 0.058 px
+  EXPECT_LT(worst, 0.1);  // measured: 0.070 px
 }
 
 TEST(VisionTrack, SpheroidCleanClip) {
