@@ -143,6 +143,32 @@ TEST_F(DefaultView, CleanLosslessClipWithinATenthOfAPixel) {
   }
 }
 
+// A scene calibration that puts the rails' path a few pixels off the ball (its camera moved
+// across the picture): a position is reported only where it lies on the path, and that check
+// follows the clip's own offset, so the ball is still reported. Where the offset is within 2.5 px
+// (kOnPathFirstPx) from the first frame, beyond it from the eleventh (kOnPathAdoptFrames).
+// Truth: the renderer's centres (the calibration moves the path, not the picture).
+TEST_F(DefaultView, APathCalibratedAFewPixelsOffStillReportsTheBall) {
+  ClipSettings s;
+  s.frames = 30;
+  s.release_time = -0.9;
+  const Motion motion(setup_->scene, setup_->x0);
+  const std::string video = (TempDir() / "path_off.avi").string();
+  const std::vector<ClipTruth> truth = RenderClip(*renderer_, motion, s, video);
+  for (const double shift_px : {2.0, 4.0}) {
+    SceneCalibration shifted = setup_->calibration;
+    // The camera moved along its own y by d moves the picture of a point at depth Z by fy·d/Z px.
+    const Eigen::Vector3d at = shifted.pose.rotation * Eigen::Vector3d(setup_->x0, 0, 0) + shifted.pose.translation;
+    shifted.pose.translation.y() += shift_px * at.z() / shifted.camera.fy;
+    const TrackResult track = TrackVideo(video, setup_->scene, shifted);
+    ASSERT_EQ(track.rows.size(), truth.size());
+    const Errors e = Compare(truth, track);
+    const int first = shift_px < 2.5 ? 0 : 10;
+    for (int f = first; f < s.frames; ++f) EXPECT_TRUE(track.rows[f].ball.found) << shift_px << " px off, frame " << f;
+    EXPECT_LT(e.rms_uv, 0.1) << shift_px << " px off";
+  }
+}
+
 TEST_F(DefaultView, BlurNoiseFlickerAndH264WithinThreeTenthsOfAPixel) {
   ClipSettings s;
   s.frames = 30;

@@ -107,10 +107,12 @@ std::optional<BallTracker::Readout> BallTracker::ReadoutEstimate() const {
 }
 
 std::optional<long> BallTracker::SceneChangedAt() const { return impl_->scene_changed_at; }
+long BallTracker::FramesLeftOffPath() const { return impl_->left_off_path; }
 
 std::vector<std::pair<long, BallObservation>> BallTracker::TakeRevisions() {
   std::vector<std::pair<long, BallObservation>> out;
   out.swap(impl_->revisions);
+  impl_->AssessRevisions(&out);
   return out;
 }
 
@@ -126,12 +128,11 @@ const std::vector<long>& BallTracker::ExposureChanges() const { return impl_->ex
 BallObservation BallTracker::Track(const cv::Mat& input) {
   Impl& m = *impl_;
   const BallObservation o = m.Track(input);
-  if (!m.opening_closed && !m.scene_changed_at) {
-    cv::Mat bgr;
-    if (input.channels() == 1) cv::cvtColor(input, bgr, cv::COLOR_GRAY2BGR);
-    m.KeepOpening(m.frame_index, m.frame_index / m.options.fps, input.channels() == 1 ? bgr : input, o);
-  }
-  return o;
+  cv::Mat bgr;
+  if (input.channels() == 1) cv::cvtColor(input, bgr, cv::COLOR_GRAY2BGR);
+  const cv::Mat& frame = input.channels() == 1 ? bgr : input;
+  if (!m.opening_closed && !m.scene_changed_at) m.KeepOpening(m.frame_index, m.frame_index / m.options.fps, frame, o);
+  return m.Assess(frame, o);
 }
 
 BallObservation BallTracker::Impl::Track(const cv::Mat& input) {

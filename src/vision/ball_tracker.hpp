@@ -104,7 +104,9 @@
 // body rested since the first frame the background under it is unknown until it leaves: those
 // rays use a background constant along the ray, solved in the fit; while it stays where it was
 // found, an edge fit that finds its outline all round where the model put it elsewhere (a
-// striped or dotted print holds the model off the limb) measures it instead.
+// striped or dotted print holds the model off the limb) measures it instead. A centre measured
+// off the rails' path (across it, beyond the calibration's error: internal/tracker_assess.cpp) is
+// not reported unless the edge fit finds the outline on the path there (FramesLeftOffPath).
 #pragma once
 
 #include <Eigen/Core>
@@ -200,6 +202,10 @@ class BallTracker {
   // moved, or the scene was disturbed) at this frame: the calibration no longer holds. The tracker
   // reports no positions from that frame on.
   std::optional<long> SceneChangedAt() const;
+  // Frames whose measured centre lay off the rails' path, across it, by more than the
+  // calibration's error, and whose outline the edge fit did not find on it: reported as not found
+  // (a print's edge or a shadow taken for the outline; docs/track.md, "When it fails").
+  long FramesLeftOffPath() const;
   // Frames where the exposure gain jumped (a step > 25 % between frames that stays).
   const std::vector<long>& ExposureChanges() const;
 

@@ -260,6 +260,7 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
       }
   }
   result.transfer = tracker_options.transfer;
+  result.frames_left_off_path = tracker.FramesLeftOffPath();
   const long read = static_cast<long>(result.rows.size());
   // A scene change (the camera moved): no position from that frame on, the calibration no longer
   // holds there.
@@ -364,7 +365,8 @@ void WriteTrack(const std::string& csv_path, const TrackResult& result, const Tr
                           : result.readout > 0               ? "given"
                                                              : "global"},
       {"frames_by_edge_fit", found - outline_model},
-      {"frames_by_outline_model", outline_model}};
+      {"frames_by_outline_model", outline_model},
+      {"frames_left_off_the_path", result.frames_left_off_path}};
   if (result.partial) side["partial_reason"] = result.partial_reason;
   OutputPaths::CreateFolders(std::filesystem::path(csv_path).parent_path().string());
   WriteFileAtomically(csv_path, csv.str());

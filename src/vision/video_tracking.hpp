@@ -69,6 +69,7 @@ struct TrackResult {
   int image_height = 0;             // px, the rows the readout spans
   VideoTransfer transfer = VideoTransfer::kSrgb;
   std::vector<long> exposure_changes;  // frames where the exposure jumped
+  long frames_left_off_path = 0;       // BallTracker::FramesLeftOffPath
 };
 
 struct TrackVideoOptions {

@@ -104,9 +104,10 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
     if (stand_out < kAcquireMinStandOut && !(found_outline && p.fit.contrast / frame_noise >= kAcquireMinStandOut)) continue;
     body_at[p.place] = true;
     // A clean outline all round comes before any other, then an outline found where it was
-    // looked for, then the stand-out. Where the outline was found it measures the frame if the
-    // model put the body elsewhere (below).
-    const double score = stand_out + (clean ? 1e6 : 0) + (found_outline ? 1e3 : 0);
+    // looked for, then one found in part, then the stand-out. Where the outline was found it
+    // measures the frame if the model put the body elsewhere (below).
+    const bool partly_found = outline && OutlinePartlyFound(*outline);
+    const double score = stand_out + (clean ? 1e6 : 0) + (found_outline ? 1e3 : 0) + (partly_found ? 1e2 : 0);
     if (!best || score > best_score) best = Found{p.fit, p.request, found_outline ? outline : std::nullopt}, best_score = score;
   }
   for (size_t k = 0; k < windows.size(); ++k)

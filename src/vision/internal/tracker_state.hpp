@@ -11,6 +11,7 @@
 //                             the motion are known, the readout settled at the end, a body withdrawn
 //   tracker_opening.cpp       the clip's opening: its frames measured again at the end, backwards
 //                             from the first ones the background confirms
+//   tracker_assess.cpp        the last look at a position before it is reported: on the path?
 // Thresholds: tracker_thresholds.hpp.
 #pragma once
 
@@ -66,6 +67,9 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   double lens_reach = 0;                            // LensModelReach of the camera
   double noise = 0.01;                              // residual RMS of a sample, linear units
   std::deque<double> noises;                        // of the last accepted frames
+  std::deque<double> across_path;                   // AcrossPathPx of the last frames reported
+  long left_off_path = 0;                           // frames not reported for lying off the path
+  std::deque<double> left_heights;                  // AcrossPathPx of the frames left out in a row
   double row_delay = 0;                             // s per row
   std::vector<double> exposures;                    // per-frame measurements |D|/|V|
   std::vector<double> row_delays;                   // per-frame measurements of the row delay, s
@@ -220,6 +224,24 @@ struct BallTracker::Impl : internal::TrackerThresholds {
     return x > scene.x_low() - pixel && x < scene.x_max() + pixel;
   }
 
+  // A centre's height above the calibrated path at its x, in pixels at the body's distance.
+  double AcrossPathPx(double x, double z) const;
+  // Whether a centre lies across the path where the body can be. A body on the rails has its
+  // centre on the path, so a position off it by more than the calibration's error is a fit that
+  // took a print's edge, a shadow or a rod for the outline (kOnPathPx). A calibration that puts
+  // the path farther off is followed: a centre near the median height of the last frames
+  // reported lies on it too (kOnPathUsualPx), and before kOnPathMinFrames were, one within
+  // kOnPathFirstPx of the path.
+  bool OnPathAcross(double x, double z) const;
+  // A frame's position as reported (the tracker's own state keeps what it measured): o where it
+  // lies on the path; else the edge fit's, where that finds the body's outline on the path; else
+  // not found (counted in left_off_path), unless the frames left out in a row say that the
+  // calibration puts the path that far off (kOnPathAdoptFrames).
+  BallObservation Assess(const cv::Mat& frame, const BallObservation& o);
+  // The revisions that may be reported: a revised position off the path leaves the frame's row
+  // as it was.
+  void AssessRevisions(std::vector<std::pair<long, BallObservation>>* revised) const;
+
   // Two passes: around the guess with the given half width, then narrow around the first fit
   // (with `narrow_iterations`; q.iterations caps the first passes).
   FitOutcome Measure(const internal::FrameView& view, FitRequest q, Search search = Search::kTracking,
@@ -298,6 +320,14 @@ struct BallTracker::Impl : internal::TrackerThresholds {
     const bool most_rays = e.inliers >= kOutlineMostRays * kEdgePoints && e.inliers >= kOutlineMostSearched * e.attempted;
     return e.ok && e.inliers >= 0.35 * kEdgePoints && (most_found || most_rays) && e.contrast >= kFastMinContrast &&
            e.rms_px <= kCleanOutlineRmsPx;
+  }
+
+  // An edge fit that found edges of a body's contrast on part of the outline, nearly all of them
+  // on it (kOutlinePartialPoints at least): a grey body on a grey cloth shows its edge on half of
+  // its outline only, where a patch of the cloth's texture has no edge that strong.
+  bool OutlinePartlyFound(const internal::EdgeFitOutcome& e) const {
+    return e.ok && e.inliers >= kOutlinePartialPoints && e.inliers >= kOutlineFoundShare * e.edge_points &&
+           e.contrast >= kFastMinContrast && e.rms_px <= kCleanOutlineRmsPx;
   }
 
   // An edge fit that found the body's outline all round: most of its rays within a pixel of it,

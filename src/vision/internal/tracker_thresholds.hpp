@@ -105,6 +105,28 @@ struct TrackerThresholds {
   // first frames of 103 random scenes one place off a body reached both, a two-tone spheroid's
   // 3 px off its centre.
   static constexpr double kOutlineMostRays = 0.5, kOutlineMostSearched = 0.7;
+  // OutlinePartlyFound: edge points on the outline, at least a quarter of the rays. A grey sphere
+  // on a grey checked cloth had 29 of its 30 edges on it (of 59 rays searched, contrast 33 grey
+  // levels) while 16 places of the cloth along the path stood out of their surroundings as much
+  // (contrast 8-14); on the first frames of 153 random scenes taking such an outline before the
+  // stand-out changed no choice.
+  static constexpr int kOutlinePartialPoints = kEdgePoints / 4;
+  // OnPathAcross: a centre within kOnPathPx of the calibrated path, px, lies on it. On 153 random
+  // scenes (calibrated from their chessboard views and apparatus points) the model's frames within
+  // 0.3 px of the truth lay within 0.54 px of the path, and 76 of the 109 frames more than 1 px
+  // off the truth lay beyond 1 px of it. Where a calibration puts the path farther off, a centre
+  // within kOnPathUsualPx of the median height of the last kOnPathFrames frames reported lies on
+  // it too (on those scenes the height of the frames within 0.3 px of the truth spread over up to
+  // 0.8 px along the rails), and before kOnPathMinFrames were reported, one within
+  // kOnPathFirstPx of the path.
+  static constexpr double kOnPathPx = 1.0, kOnPathUsualPx = 0.8, kOnPathFirstPx = 2.5;
+  static constexpr std::size_t kOnPathFrames = 15, kOnPathMinFrames = 3;
+  // Frames left out in a row, their heights within kOnPathUsualPx of each other, that make their
+  // height the path's (a calibration farther off than kOnPathFirstPx): on those 153 scenes no
+  // ten frames left out in a row did (a print's edge holds the outline for up to six frames, and
+  // its height wanders), and a badly calibrated clip loses only its first third of a second at
+  // 30 frames/s.
+  static constexpr std::size_t kOnPathAdoptFrames = 10;
   // A body within this of where it was found anew, px, is still at rest there: an edge fit's
   // centre on a printed body scatters by a few tenths of a pixel, a rolling body leaves the
   // place within a few frames.

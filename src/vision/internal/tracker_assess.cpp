@@ -1,0 +1,65 @@
+// The tracker's assess stage (tracker_state.hpp): the last look at a frame's position before it
+// is reported. The tracker's own state (its history, its prediction) keeps what it measured;
+// only the report leaves out what the path contradicts.
+#include <algorithm>
+#include <cmath>
+
+#include "tracker_state.hpp"
+
+namespace uphill {
+
+double BallTracker::Impl::AcrossPathPx(double x, double z) const {
+  return (z - scene.At(std::clamp(x, x_lo, x_hi)).z) / MetresPerPx(x, z);
+}
+
+bool BallTracker::Impl::OnPathAcross(double x, double z) const {
+  const double height = AcrossPathPx(x, z);
+  if (std::abs(height) <= kOnPathPx) return true;
+  if (across_path.size() < kOnPathMinFrames) return std::abs(height) <= kOnPathFirstPx;
+  std::vector<double> sorted(across_path.begin(), across_path.end());
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  return std::abs(height - sorted[sorted.size() / 2]) <= kOnPathUsualPx;
+}
+
+BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObservation& o) {
+  if (!o.found) return o;
+  auto reported = [&](const BallObservation& r) {
+    across_path.push_back(AcrossPathPx(r.x, r.z));
+    if (across_path.size() > kOnPathFrames) across_path.pop_front();
+    return r;
+  };
+  const double height = AcrossPathPx(o.x, o.z);
+  if (OnPathAcross(o.x, o.z)) {
+    left_heights.clear();
+    return reported(o);
+  }
+  // The contrast at the outline alone, searched as wide as the search for a body found anew (a
+  // print's edge holds the model's outline a few pixels off the body), with its own polarity.
+  internal::EdgeFit outline = *edges;
+  outline.Reset();
+  const internal::EdgeFitOutcome e = outline.Measure(frame, o.x, o.z, 2 * options.search_half_width_px);
+  if (OutlineFound(e) && OnPath(e.x, e.z) && OnPathAcross(e.x, e.z)) {
+    BallObservation by_edges = ObserveEdges(e);
+    by_edges.time_offset = o.time_offset;
+    left_heights.clear();
+    return reported(by_edges);
+  }
+  // A calibration that puts the path farther off than kOnPathFirstPx: the frames left out in a
+  // row lie at one height off it. From kOnPathAdoptFrames of them on, that height is the path's.
+  left_heights.push_back(height);
+  const auto [low, high] = std::minmax_element(left_heights.begin(), left_heights.end());
+  if (left_heights.size() >= kOnPathAdoptFrames && *high - *low <= kOnPathUsualPx) {
+    across_path.assign(left_heights.begin(), left_heights.end());
+    left_heights.clear();
+    return reported(o);
+  }
+  if (left_heights.size() >= kOnPathAdoptFrames) left_heights.pop_front();
+  ++left_off_path;
+  return {};
+}
+
+void BallTracker::Impl::AssessRevisions(std::vector<std::pair<long, BallObservation>>* revised) const {
+  std::erase_if(*revised, [this](const auto& r) { return r.second.found && !OnPathAcross(r.second.x, r.second.z); });
+}
+
+}  // namespace uphill
