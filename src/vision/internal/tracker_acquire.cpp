@@ -29,8 +29,9 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
   // anew, every candidate is fitted, and of the plausible fits (accepted, or accepted loosely
   // where the edge fit finds the body's outline; their ends standing out along the rods) the
   // best is taken if it stands out of its surroundings by
-  // kAcquireMinStandOut noise levels at least: a patch of the table's texture or a tape mark on
-  // a rod may fit an outline too, but not by the contrast of a body.
+  // kAcquireMinStandOut noise levels at least (kAcquireMinStandOutSharp where its outline was
+  // found sharp): a patch of the table's texture or a tape mark on a rod may fit an outline too,
+  // but not by the contrast of a body.
   struct Plausible {
     FitOutcome fit;
     FitRequest request;
@@ -101,7 +102,10 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
     // body's own residuals hold its print), in the frame's.
     const double stand_out = p.fit.contrast / std::max(noise, p.fit.noise);
     if (!p.accepted && !found_outline) continue;
-    if (stand_out < kAcquireMinStandOut && !(found_outline && p.fit.contrast / frame_noise >= kAcquireMinStandOut)) continue;
+    const bool sharp = found_outline && outline->inliers >= kSharpOutlineShare * outline->edge_points &&
+                       outline->rms_px <= kFastMaxRmsPx;
+    const double least = sharp ? kAcquireMinStandOutSharp : kAcquireMinStandOut;
+    if (stand_out < least && !(found_outline && p.fit.contrast / frame_noise >= least)) continue;
     body_at[p.place] = true;
     // A clean outline all round comes before any other, then an outline found where it was
     // looked for, then one found in part, then the stand-out. Where the outline was found it
