@@ -80,9 +80,9 @@ TEST(PovrayAnalysis, FittedReleaseAndGLieWithinThreeUncertaintiesOfTheRenderersT
     }
     // Still a measurement: the default systematic floor (calibrated on the 720p clips of the
     // robustness matrix) is conservative on these low-resolution clips, where the tracker is better
-    // in pixels. Measured: pulls +0.13, +0.03, -0.04 and +0.24, +0.17, +0.04 (x0, t0, g), with
-    // u(x0) = 0.14-0.15 mm, u(t0) = 2.3-2.6 ms, u(g) = 0.07-0.09 m/s²; on the 720p clips the
-    // pulls reach 0.7 (docs/analyse-track.md, "Accuracy").
+    // in pixels. Measured: pulls -0.25, +0.23, +0.18 and -0.10, +0.17, +0.09 (x0, t0, g), with
+    // u(x0) = 0.12-0.13 mm, u(t0) = 1.8-2.2 ms, u(g) = 0.053-0.071 m/s²; on random ray-traced
+    // scenes the pulls' RMS is 0.7-0.9 (docs/analyse-track.md, "Accuracy").
     EXPECT_LT(fit["parameters"]["x0"]["u"].get<double>(), 0.3e-3);
     EXPECT_LT(fit["parameters"]["t0"]["u"].get<double>(), 5e-3);
     EXPECT_LT(fit["parameters"]["g"]["u"].get<double>(), 0.015 * 9.80665);

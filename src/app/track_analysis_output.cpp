@@ -82,7 +82,7 @@ std::string TrackAnalysisTable(const TrackAnalysis& a) {
     out << "  statistical: from the residuals (lag-1 autocorrelation " << Printf("%.2f", f.residual_lag1)
         << "); systematic: the tracker's " << Printf("%.3g", a.options.tracker_floor_px) << " px + "
         << Printf("%.3g", a.options.tracker_blur) << " x (px moved per frame) at "
-        << Printf("%.3g", f.metres_per_pixel * 1e3) << " mm/px, worst correlation length\n";
+        << Printf("%.3g", f.metres_per_pixel * 1e3) << " mm/px, averaged over its correlation length along the path\n";
     out << "  chi2 = " << Printf("%.4g", f.chi2) << ", dof = " << f.dof << ", chi2/dof = " << Printf("%.4g", f.reduced_chi2)
         << ", RMS residual = " << Printf("%.3g", f.rms_residual * 1e3) << " mm\n";
     for (const auto& e : f.model_events)
@@ -129,7 +129,6 @@ nlohmann::json TrackAnalysisJson(const TrackAnalysis& a) {
                                  {"se_statistical", Optional(p.se_statistical)},
                                  {"se_systematic", Optional(p.se_systematic)},
                                  {"u", Optional(p.u)},
-                                 {"systematic_length", p.se_systematic ? Finite(p.systematic_length) : nullptr},
                                  {"unit", p.unit}};
   if (f.covariance) {
     nlohmann::json c = nlohmann::json::array(), r = nlohmann::json::array();

@@ -35,7 +35,7 @@ FitErrors EstimateFitErrors(const FitErrorInputs& in) {
     out.timing_covariance = moved * moved.transpose();
   }
 
-  // Systematic part: the worst correlation length, parameter by parameter.
+  // Systematic part: the average over the correlation lengths (the header says why).
   const double span = in.x.maxCoeff() - in.x.minCoeff();
   std::vector<double> lengths = {0.0};
   for (int k = 8; k >= 0 && span > 0; --k) lengths.push_back(span * std::ldexp(1.0, -k));
@@ -47,21 +47,11 @@ FitErrors EstimateFitErrors(const FitErrorInputs& in) {
         const double rho = i == j ? 1.0 : length == 0 ? 0.0 : std::isinf(length) ? 1.0 : std::exp(-d / length);
         sigma(i, j) = in.systematic(i) * in.systematic(j) * rho;
       }
-    out.systematic_covariances.push_back(b * sigma * b.transpose() + out.timing_covariance);
-    const Eigen::Vector3d variance = out.systematic_covariances.back().diagonal();
-    for (int p = 0; p < 3; ++p)
-      if (variance(p) > out.systematic_variance(p)) {
-        out.systematic_variance(p) = variance(p);
-        out.systematic_length(p) = length;
-      }
+    out.systematic_covariance += b * sigma * b.transpose();
   }
+  out.systematic_covariance /= static_cast<double>(lengths.size());
+  out.systematic_covariance += out.timing_covariance;
   return out;
-}
-
-double FitErrors::WorstVariance(const Eigen::Vector3d& g) const {
-  double worst = 0;
-  for (const Eigen::Matrix3d& c : systematic_covariances) worst = std::max(worst, g.dot(c * g));
-  return g.dot(residual_covariance * g) + worst;
 }
 
 }  // namespace uphill::internal

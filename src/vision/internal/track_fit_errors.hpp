@@ -31,16 +31,16 @@ struct FitErrors {
   // ρ the lag-1 autocorrelation of the residuals clamped to [0, 0.98].
   Eigen::Matrix3d residual_covariance = Eigen::Matrix3d::Zero();
   double lag1 = 0;
-  // Systematic, per parameter: the largest variance over the correlation lengths ℓ (m) of
-  // Σ_ij = σ_i σ_j exp(−|x_i − x_j|/ℓ), ℓ from independent frames (0) to one bias (+inf).
-  Eigen::Vector3d systematic_variance = Eigen::Vector3d::Zero();
-  Eigen::Vector3d systematic_length = Eigen::Vector3d::Zero();  // the ℓ of that maximum, m
-  std::vector<Eigen::Matrix3d> systematic_covariances;         // one per ℓ tried, timing included
+  // Systematic: Σ_ij = σ_i σ_j exp(−|x_i − x_j|/ℓ) with the correlation length ℓ (m) unknown, so
+  // the average of BΣ(ℓ)Bᵀ over ℓ ∈ {0 (independent frames), span/256 … span (×2 steps), +inf (one
+  // bias)}, each equally likely: the covariance of an error whose ℓ is drawn from that prior.
+  // The timing part below is included.
+  Eigen::Matrix3d systematic_covariance = Eigen::Matrix3d::Zero();
   // The part of the shared time error (FitErrorInputs::time_systematic), in every ℓ's covariance.
   Eigen::Matrix3d timing_covariance = Eigen::Matrix3d::Zero();
 
-  // The largest variance of a linear combination gᵀδ over the ℓ tried, statistical part included.
-  double WorstVariance(const Eigen::Vector3d& g) const;
+  // Statistical and systematic parts together.
+  Eigen::Matrix3d Covariance() const { return residual_covariance + systematic_covariance; }
 };
 
 // Requires n ≥ 4 rows and AᵀWA invertible (the caller checked the fit's rank).

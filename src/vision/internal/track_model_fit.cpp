@@ -172,8 +172,7 @@ std::optional<FitErrors> AddErrorParts(const Series& s, const std::vector<int>& 
   for (int j = 0; j < 3; ++j) {
     FittedParameter& p = fit->parameters[j];
     p.se_statistical = std::sqrt(errors.residual_covariance(j, j));
-    p.se_systematic = std::sqrt(errors.systematic_variance(j));
-    p.systematic_length = errors.systematic_length(j);
+    p.se_systematic = std::sqrt(errors.systematic_covariance(j, j));
     p.u = std::hypot(*p.se_statistical, *p.se_systematic);
   }
   return errors;
@@ -393,11 +392,11 @@ void FitModel(const Series& s, int begin, int end, int direction, const Scene& s
     if (propagate && std::isfinite(events[k].t)) {
       const Eigen::Vector3d gt = dt.row(k).transpose(), gx = dx.row(k).transpose();
       // The larger of the stated σ's (inflated by χ²/ν) and the statistical + systematic parts'.
-      const auto worst = [&](const Eigen::Vector3d& g) {
-        return std::sqrt(std::max(g.dot(c_events * g), errors ? errors->WorstVariance(g) : 0.0));
+      const auto larger = [&](const Eigen::Vector3d& g) {
+        return std::sqrt(std::max(g.dot(c_events * g), errors ? g.dot(errors->Covariance() * g) : 0.0));
       };
-      e.t.u = worst(gt);
-      e.x.u = worst(gx);
+      e.t.u = larger(gt);
+      e.x.u = larger(gx);
       if (*e.x.u == 0.0) e.x.u.reset();  // x_max, x_low: fixed by the scene
     }
     e.method = "fitted model";
