@@ -102,9 +102,7 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
     // body's own residuals hold its print), in the frame's.
     const double stand_out = p.fit.contrast / std::max(noise, p.fit.noise);
     if (!p.accepted && !found_outline) continue;
-    const bool sharp = found_outline && outline->inliers >= kSharpOutlineShare * outline->edge_points &&
-                       outline->rms_px <= kFastMaxRmsPx;
-    const double least = sharp ? kAcquireMinStandOutSharp : kAcquireMinStandOut;
+    const double least = found_outline && SharpOutline(*outline) ? kAcquireMinStandOutSharp : kAcquireMinStandOut;
     if (stand_out < least && !(found_outline && p.fit.contrast / frame_noise >= least)) continue;
     body_at[p.place] = true;
     // A clean outline all round comes before any other, then an outline found where it was

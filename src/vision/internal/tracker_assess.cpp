@@ -3,6 +3,7 @@
 // only the report leaves out what the path contradicts.
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "tracker_state.hpp"
 
@@ -49,7 +50,7 @@ BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObserv
   left_heights.push_back(height);
   const auto [low, high] = std::minmax_element(left_heights.begin(), left_heights.end());
   if (left_heights.size() >= kOnPathAdoptFrames && *high - *low <= kOnPathUsualPx) {
-    across_path.assign(left_heights.begin(), left_heights.end());
+    across_path.assign(left_heights.begin(), std::prev(left_heights.end()));  // reported(o) adds this frame's
     left_heights.clear();
     return reported(o);
   }

@@ -330,6 +330,12 @@ struct BallTracker::Impl : internal::TrackerThresholds {
            e.contrast >= kFastMinContrast && e.rms_px <= kCleanOutlineRmsPx;
   }
 
+  // An outline found (OutlineFound) with nearly every edge on it and their scatter within the fast
+  // path's: sharp enough that a body found anew needs to stand out less (kAcquireMinStandOutSharp).
+  bool SharpOutline(const internal::EdgeFitOutcome& e) const {
+    return OutlineFound(e) && e.inliers >= kSharpOutlineShare * e.edge_points && e.rms_px <= kFastMaxRmsPx;
+  }
+
   // An edge fit that found the body's outline all round: most of its rays within a pixel of it,
   // their scatter below half a pixel, in contrast well above the noise. Looser than Trusted (the
   // fast path's check, which must also hold where the model would do better): it only decides
