@@ -88,9 +88,8 @@
 //    frames at rest share one bias, which no number of frames averages away). ℓ is not known,
 //    so the covariance is averaged over ℓ ∈ {0 (independent), span/256 … span (×2 steps),
 //    ∞ (one bias)}, each equally likely: the expected covariance of a bias whose ℓ is drawn from
-//    that prior. (The largest variance over ℓ, which this replaced, was a worst case: on 207
-//    parameters fitted on random ray-traced scenes, docs/track.md, it gave RMS pulls of 0.61–0.81,
-//    the average 0.72–0.91.)
+//    that prior. (The largest variance over ℓ is a worst case: on 68 fits of random
+//    ray-traced scenes it gave RMS pulls of 0.61–0.81, the average 0.72–0.91.)
 //    A rolling shutter's readout measured or assumed (Track::row_delay_u, from the sidecar) adds to
 //    it: every frame's time is uncertain by v_i·row_delay_u, one error shared by all frames, so
 //    position i by ẋ_i·v_i·row_delay_u (ẋ_i = −∂x/∂t0), a rank-one covariance added to it.
@@ -103,13 +102,11 @@
 // its error is 0.03–0.07 px at rest (0.12 px on the spheroid) and grows to 0.15–0.2 px at
 // 12.5 px/frame with a 180° shutter (1/500 s: no growth). Footage with a longer shutter, or a
 // tracker measured worse on it, needs larger values (measure them with uphill bench track).
-// Accuracy (tests/vision_povray_analysis_test.cpp, tests/vision_analysis_test.cpp,
-// docs/analyse-track.md "Accuracy"): on 9 independent POV-Ray clips, |fitted − truth| ≤ 2.7 u for
-// x0, t0, g (pulls 0.2–0.7 on the 720p lab clips, up to 2.2 on the isoluminant ball, 1.4–2.7 on
-// the spheroid, whose frames the tracker partly loses, < 0.25 on 320 × 180 clips where the tracker beats
-// the floor: there u is 5–20× the real error); on synthetic tracks with an injected bias of the
-// stated size the pulls' RMS is 0.4–0.7. Without the systematic part the same fits miss by up to
-// 12 se_scaled.
+// Accuracy (docs/analyse-track.md "Accuracy", tests/vision_povray_analysis_test.cpp,
+// tests/vision_analysis_test.cpp): on 68 fits of random ray-traced scenes (uphill bench track
+// --random), RMS pulls 0.91, 0.72, 0.74 for x0, t0, g, one |pull| beyond 3 of 204, where the
+// statistical part alone misses by more than 3 in 60; on synthetic tracks with an injected bias
+// of the stated size the pulls' RMS is 0.57–0.83.
 //
 // Accuracy (tests/vision_analysis_test.cpp): on tracks simulated by Motion (a 1-inch ball,
 // θ = 3°, α = 40°) with 0.3 mm Gaussian noise at 120 frames/s and lost frames, the fitted x0,
