@@ -33,10 +33,11 @@ struct FitErrors {
   double lag1 = 0;
   // Systematic: Σ_ij = σ_i σ_j exp(−|x_i − x_j|/ℓ) with the correlation length ℓ (m) unknown, so
   // the average of BΣ(ℓ)Bᵀ over ℓ ∈ {0 (independent frames), span/256 … span (×2 steps), +inf (one
-  // bias)}, each equally likely: the covariance of an error whose ℓ is drawn from that prior.
-  // The timing part below is included.
+  // bias)}, each equally likely: the covariance of an error whose ℓ is drawn from that prior;
+  // plus the timing part below.
   Eigen::Matrix3d systematic_covariance = Eigen::Matrix3d::Zero();
-  // The part of the shared time error (FitErrorInputs::time_systematic), in every ℓ's covariance.
+  // The part of the shared time error (FitErrorInputs::time_systematic), also in
+  // systematic_covariance.
   Eigen::Matrix3d timing_covariance = Eigen::Matrix3d::Zero();
 
   // Statistical and systematic parts together.

@@ -205,10 +205,11 @@ std::vector<BallTracker::Impl::SearchStart> BallTracker::Impl::Candidates(const 
   // starts from; a radius where the body is smaller than that: a fit started within a radius
   // reaches it) and the search's half-width from the other kind's (a fit started there sees the
   // same outline; one started a quarter radius off a printed body's centre may not reach it).
-  // A radius apart, a body wider than the reach can lie between two places, each too far from it. A body's colour score is a plateau, about as
-  // high wherever the outline stays on the body's colour with its outside off it, and a print's
-  // dot or a highlight can lift any place of it: where the plateau's centre lies a quarter radius
-  // or more from its highest place, it is a second start.
+  // A radius apart, a body wider than the reach can lie between two places, each too far from it.
+  // A body's colour score is a plateau, about as high wherever the outline stays on the body's
+  // colour with its outside off it, and a print's dot or a highlight can lift any place of it:
+  // where the plateau's centre lies a quarter radius or more from its highest place, it is a
+  // second start.
   const std::vector<std::pair<double, double>> colour_along = scored;  // in x order
   std::vector<SearchStart> out;
   const double reach = 2 * options.search_half_width_px;  // as Acquire requests its fits
