@@ -9,7 +9,6 @@
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -521,37 +520,6 @@ TEST_F(DefaultView, NoiseAfterCopiedFramesIsNotASceneChange) {
   const double worst = LargestError(track, uv);
   std::printf("  largest error %.4f px\n", worst);
   EXPECT_LT(worst, 0.1);  // measured: 0.070 px
-}
-
-// A ball wider in the picture (35 px radius) than the acquiring fit's reach (2 search half-widths,
-// 12 px) must have a search place within that reach: kept a radius apart, the places beside this
-// dotted ball lay 21 and 39 px from its centre, no fit reached it, and it was found only once it
-// moved. The frame (tests/data/dotted_ball_at_rest, its README) is POV-Ray's render of random draw
-// 56af0ac4 of `uphill bench track --random` (seed 10984066824552265521), H.264 by FFmpeg, cropped
-// to 320 × 180 with the camera's centre moved to match; held still for five frames, so the table
-// behind the ball is never seen. Truth: the centre placed in the POV-Ray scene, projected with the
-// camera that rendered it.
-TEST(VisionTrack, ABallWiderThanTheFitsReachIsFoundAtRestFromItsFirstFrame) {
-  const std::string data = std::string(UPHILL_TEST_DATA_DIR) + "/dotted_ball_at_rest/";
-  const cv::Mat frame = cv::imread(data + "frame.png");
-  ASSERT_FALSE(frame.empty());
-  const std::string video = (TempDir() / "dotted_ball_at_rest.avi").string();
-  {
-    cv::VideoWriter out(video, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 60, frame.size());
-    for (int i = 0; i < 5; ++i) out.write(frame);
-  }
-  const double tan_theta = 0.08672497812725147, tan_half_alpha = 0.0896205122684811;
-  const Scene scene(Body::Sphere(0.02350035527463374),
-                    Rails::FromApparatus(1.0, tan_theta, 2 * tan_half_alpha, LConvention::kHorizontal),
-                    0.004649410892595464);
-  const TrackResult track = TrackVideo(video, scene, ReadSceneFile(data + "scene_truth.json"));
-  ASSERT_EQ(track.rows.size(), 5u);
-  for (const TrackRow& r : track.rows) {
-    ASSERT_TRUE(r.ball.found) << "frame " << r.frame;
-    // measured: 0.03 px, 0.018 mm
-    EXPECT_LT(std::hypot(r.ball.u - (632.417054 - 472), r.ball.v - (353.244117 - 263)), 0.15) << "frame " << r.frame;
-    EXPECT_NEAR(r.ball.x, 251.525205e-3, 0.05e-3) << "frame " << r.frame;
-  }
 }
 
 TEST(VisionTrack, SpheroidCleanClip) {

@@ -200,19 +200,19 @@ std::vector<BallTracker::Impl::SearchStart> BallTracker::Impl::Candidates(const 
     std::nth_element(edge_steps.begin(), edge_steps.begin() + used / 2, edge_steps.begin() + used);
     stepped.emplace_back(std::abs(edge_steps[used / 2]), xc);
   }
-  // The best by colour and the best by the outline's step, each a fit's reach from the others of
-  // its kind (the acquiring fit's rays look 2 search half-widths either side of the outline it
-  // starts from; a radius where the body is smaller than that: a fit started within a radius
-  // reaches it) and the search's half-width from the other kind's (a fit started there sees the
-  // same outline; one started a quarter radius off a printed body's centre may not reach it).
-  // A radius apart, a body wider than the reach can lie between two places, each too far from it.
+  // The best by colour and the best by the outline's step, each a radius from the others of its
+  // kind (a fit started there reaches the body within a radius) and the search's half-width from
+  // the other kind's (a fit started there sees the same outline; one started a quarter radius
+  // off a printed body's centre may not reach it). Not quite for a body more than 12 px in
+  // radius (the acquiring fit looks 2 search half-widths either side of its outline): it can lie
+  // between two places, each too far off, and is found once it moves. Places that close cost the
+  // first frame's search more fits than the speed goal leaves (docs/track.md, "Accuracy").
   // A body's colour score is a plateau, about as high wherever the outline stays on the body's
   // colour with its outside off it, and a print's dot or a highlight can lift any place of it:
   // where the plateau's centre lies a quarter radius or more from its highest place, it is a
   // second start.
   const std::vector<std::pair<double, double>> colour_along = scored;  // in x order
   std::vector<SearchStart> out;
-  const double reach = 2 * options.search_half_width_px;  // as Acquire requests its fits
   auto take = [&](std::vector<std::pair<double, double>>& by, size_t most, bool plateau) {
     std::sort(by.begin(), by.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
     const size_t before = out.size();
@@ -222,7 +222,7 @@ std::vector<BallTracker::Impl::SearchStart> BallTracker::Impl::Candidates(const 
       const double r = RadiusPx(xc, scene.At(xc).z);
       bool near = false;
       for (size_t i = 0; i < out.size(); ++i)
-        near = near || (geometry.Project(out[i].at.x(), out[i].at.y()) - p).norm() < (i >= before ? std::min(r, reach) : options.search_half_width_px);
+        near = near || (geometry.Project(out[i].at.x(), out[i].at.y()) - p).norm() < (i >= before ? r : options.search_half_width_px);
       if (near) continue;
       SearchStart place{Vector2d(xc, scene.At(xc).z), std::nullopt};
       const double centre = plateau ? PlateauCentre(colour_along, xc) : xc;
