@@ -215,7 +215,7 @@ TEST(SmearedOutline, RowsBetweenTwoWindowsAreInterpolatedToSecondOrder) {
     const SmearNodes between(w.a, w.b, t);
     const auto shifted = w.At(t);
     const SmearNodes exact(w.body, shifted.data(), Vector2d::Zero(), w.pieces);
-    for (const Vector3d& d : DirectionsAcross(w.body, shifted.data(), 45, 1.0)) {
+    for (const Vector3d& d : DirectionsAcross(w.body, shifted.data(), 45, 3.0)) {
       // Against the definition, less what the pieces themselves err by (the exact window's).
       const double truth = ReferenceCoverage(w.body, shifted.data(), d);
       worst = std::max(worst, std::abs(between.Coverage(d, nullptr) - truth) - std::abs(exact.Coverage(d, nullptr) - truth));
