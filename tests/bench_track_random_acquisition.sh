@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Draws of `uphill bench track --random 40` where the search along the path, finding the body in
 # the first frame, took something else for it or missed it, or where a print held the fit off
-# the body; replayed with --draw (rendered by POV-Ray at test time, about 470 s of CPU, cached in
+# the body; replayed with --draw (rendered by POV-Ray at test time, about 480 s of CPU, cached in
 # the build tree after). Truth: the renderer's projected
 # centre and uphill::Motion (src/motion), as the benchmark states.
 #   seed 9998171038873176079, ce3de63a: two-tone spheroid (dark green and cream) on tiles, at
@@ -51,8 +51,10 @@
 #             of its edges on the outline: kVideoTrackerVersion 26 refused the body and tracked
 #             the rails 100 px away, 92.9 px RMS, 14 frames silent wrong. Now a fit found anew
 #             is plausible at the clip's noise level too, and an outline with most of the rays
-#             searched on it (0.71; half of all rays) is found. Known and left: frames 0 and 11
-#             lie 1.06 and 1.03 px off (0.50 px RMS).
+#             searched on it (0.71; half of all rays) is found. Frame 0, 1.1 px off and below
+#             the path (by the looser bound of the first frames), is withdrawn at the clip's end,
+#             judged by the height of the frames after it. Known and left: frame 11 lies 1.03 px
+#             off (0.47 px RMS).
 #   seed 2383948610122348438, facce25b: green ball on thick painted rods (6.5 mm) over tiles,
 #             640x360 240 fps, rolling down, the camera close to the rails. The near rail's band
 #             was drawn at the rod's widest along the whole rail, reached outside the picture
@@ -76,6 +78,13 @@
 #             (10 needed) with 45 of its 46 edges on its outline: the search refused it, took a
 #             place of the cloth 90 px off from frame 8 (8 frames silent wrong, 32 lost). Now an
 #             outline found sharp needs 7 levels (kAcquireMinStandOutSharp).
+#   seed 4322825014656021629, cf88bf86: two-tone sphere at rest on cloth, 960x540 240 fps. The
+#             search's fit in the first frame lay 2.1 px below the body, within the looser bound
+#             across the path that holds before the path's height is known from the frames
+#             reported; every later frame found the body within 0.12 px, and refitted there the
+#             first frame still lay 1.5 px off: one frame silent wrong, 0.34 px RMS (the
+#             baseline's 0.21). Now the first frames are judged again at the clip's end by the
+#             height of the frames after them, and that one is withdrawn.
 #   bash tests/bench_track_random_acquisition.sh UPHILL_VISION_PROGRAM CACHE_DIR
 set -euo pipefail
 program="$1"
@@ -99,18 +108,20 @@ replay 2383948610122348438 facce25b
 replay 10961322922834187387 533defb6
 replay 5739382750275171141 9d8827da
 replay 5739382750275171141 538a68d2
+replay 4322825014656021629 cf88bf86
 /usr/bin/python3 - "$out" <<'PY'
 import json, sys
 # (most px RMS, least frames found, most silent wrong). Measured: ce3de63a 0.19 px, 40 of 40
 # found, 0 silent wrong; 53032858 0.087 px, 40 of 40, 0; bed4dec5 0.12 px, 40 of 40, 0;
 # 0783b577 0.51 px, 40 of 40, 0; a48dc08e 0.21 px, 40 of 40, 0; f49a1ef3 0.12 px, 30 of 30, 0;
-# ea3d7415 0.45 px, 36 of 40, 0; b7f73885 0.50 px, 30 of 30, 1; facce25b 0.055 px, 40 of 40, 0;
-# 533defb6 0.41 px, 37 of 40, 1; 9d8827da 0.089 px, 40 of 40, 0; 538a68d2 0.098 px, 40 of 40, 0.
+# ea3d7415 0.45 px, 36 of 40, 0; b7f73885 0.47 px, 29 of 30, 0; facce25b 0.055 px, 40 of 40, 0;
+# 533defb6 0.41 px, 37 of 40, 1; 9d8827da 0.089 px, 40 of 40, 0; 538a68d2 0.098 px, 40 of 40, 0;
+# cf88bf86 0.062 px, 39 of 40, 0.
 bounds = {"ce3de63a": (0.3, 40, 0), "53032858": (0.1, 40, 0), "bed4dec5": (0.15, 40, 0),
           "0783b577": (0.7, 40, 0), "a48dc08e": (0.25, 40, 0), "f49a1ef3": (0.25, 30, 0),
-          "ea3d7415": (0.6, 35, 0), "b7f73885": (0.7, 30, 2),
+          "ea3d7415": (0.6, 35, 0), "b7f73885": (0.6, 29, 1),
           "facce25b": (0.1, 40, 0), "533defb6": (0.6, 36, 1), "9d8827da": (0.15, 40, 0),
-          "538a68d2": (0.15, 40, 0)}
+          "538a68d2": (0.15, 40, 0), "cf88bf86": (0.1, 39, 0)}
 for name, (most_px, least_found, most_wrong) in bounds.items():
     (draw,) = json.load(open(f"{sys.argv[1]}/{name}.json"))["draws"]
     assert draw["id"] == name, draw["id"]

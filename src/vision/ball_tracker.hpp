@@ -20,7 +20,9 @@
 // already refused whose pixels have not changed are skipped, and of the bodies found the one that
 // stands out of its surroundings by the most noise levels is taken (one whose outline the edge fit
 // finds all round before any other, then one where the edges it finds lie on the outline; such a
-// body's contrast is weighed against the frame's noise, which its print does not raise), none by
+// body's contrast is weighed against the frame's noise, which its print does not raise; where
+// the edge fit found the outline away from the model's fit, a print having pulled the model off
+// the body, the contrast of the model fitted again from the outline counts), none by
 // fewer than kAcquireMinStandOut (internal/tracker_thresholds.hpp). Where the edge fit found the
 // outline and the model put the body elsewhere, the edge fit measures that frame. TrackerOptions::init_uv, a raw pixel near the centre,
 // replaces that search for the first frame. Then frame by frame near the prediction from the last
@@ -106,7 +108,9 @@
 // found, an edge fit that finds its outline all round where the model put it elsewhere (a
 // striped or dotted print holds the model off the limb) measures it instead. A centre measured
 // off the rails' path (across it, beyond the calibration's error: internal/tracker_assess.cpp) is
-// not reported unless the edge fit finds the outline on the path there (FramesLeftOffPath).
+// not reported unless the edge fit finds the outline on the path there (FramesLeftOffPath); the
+// first frames, judged by a looser bound before the frames reported show the path's height, are
+// judged again by that height when the clip ends (Finish), and withdrawn where they lie off it.
 #pragma once
 
 #include <Eigen/Core>

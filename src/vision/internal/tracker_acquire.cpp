@@ -99,11 +99,16 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
     }
     const bool found_outline = outline && OutlineFound(*outline), clean = outline && CleanOutline(*outline);
     // Its stand-out in its own fit's noise levels, or, where its outline was found (a printed
-    // body's own residuals hold its print), in the frame's.
-    const double stand_out = p.fit.contrast / std::max(noise, p.fit.noise);
+    // body's own residuals hold its print), in the frame's. Where the edge fit found the outline
+    // elsewhere (a dotted body's print pulled the model 10 px along the path), the contrast is
+    // also read from the model fitted again there, and the better of the two fits counts: the
+    // contrast belongs to the body's outline, wherever the print pulled the first fit. Which of
+    // the two positions measures the frame is decided below, as for any found outline.
     if (!p.accepted && !found_outline) continue;
+    const FitOutcome at_outline = found_outline ? ContrastAtOutline(frame, gain, *outline, p.fit) : p.fit;
+    const double stand_out = at_outline.contrast / std::max(noise, at_outline.noise);
     const double least = found_outline && SharpOutline(*outline) ? kAcquireMinStandOutSharp : kAcquireMinStandOut;
-    if (stand_out < least && !(found_outline && p.fit.contrast / frame_noise >= least)) continue;
+    if (stand_out < least && !(found_outline && at_outline.contrast / frame_noise >= least)) continue;
     body_at[p.place] = true;
     // A clean outline all round comes before any other, then an outline found where it was
     // looked for, then one found in part, then the stand-out. Where the outline was found it
@@ -125,6 +130,18 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
                                              .norm() > kFastMaxDisagreementPx;
   if (!disagree) best->outline.reset();
   return best;
+}
+
+FitOutcome BallTracker::Impl::ContrastAtOutline(const cv::Mat& frame, double gain, const internal::EdgeFitOutcome& outline,
+                                                const FitOutcome& fit) {
+  const Vector2d at(outline.x, outline.z);
+  if ((geometry.Project(at.x(), at.y()) - geometry.Project(fit.p[internal::kCentreX], fit.p[internal::kCentreZ])).norm() <=
+      kFastMaxDisagreementPx)
+    return fit;
+  FitOutcome refit = Measure({frame, {0, 0}, gain}, Request(at, Vector2d::Zero(), false, 2 * options.search_half_width_px),
+                             Search::kAcquiring);
+  const bool better = refit.ok && refit.contrast / std::max(noise, refit.noise) > fit.contrast / std::max(noise, fit.noise);
+  return better ? refit : fit;
 }
 
 std::vector<BallTracker::Impl::SearchStart> BallTracker::Impl::Candidates(const cv::Mat& frame, double gain, double x0, double x1) const {

@@ -13,8 +13,9 @@ double BallTracker::Impl::AcrossPathPx(double x, double z) const {
   return (z - scene.At(std::clamp(x, x_lo, x_hi)).z) / MetresPerPx(x, z);
 }
 
-bool BallTracker::Impl::OnPathAcross(double x, double z) const {
-  const double height = AcrossPathPx(x, z);
+bool BallTracker::Impl::OnPathAcross(double x, double z) const { return HeightOnPath(AcrossPathPx(x, z)); }
+
+bool BallTracker::Impl::HeightOnPath(double height) const {
   if (std::abs(height) <= kOnPathPx) return true;
   if (across_path.size() < kOnPathMinFrames) return std::abs(height) <= kOnPathFirstPx;
   std::vector<double> sorted(across_path.begin(), across_path.end());
@@ -25,7 +26,9 @@ bool BallTracker::Impl::OnPathAcross(double x, double z) const {
 BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObservation& o) {
   if (!o.found) return o;
   auto reported = [&](const BallObservation& r) {
-    across_path.push_back(AcrossPathPx(r.x, r.z));
+    const double height = AcrossPathPx(r.x, r.z);
+    if (across_path.size() < kOnPathMinFrames && std::abs(height) > kOnPathPx) first_heights.emplace_back(frame_index, height);
+    across_path.push_back(height);
     if (across_path.size() > kOnPathFrames) across_path.pop_front();
     return r;
   };
@@ -57,6 +60,19 @@ BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObserv
   if (left_heights.size() >= kOnPathAdoptFrames) left_heights.pop_front();
   ++left_off_path;
   return {};
+}
+
+void BallTracker::Impl::RejudgeFirstFrames() {
+  if (across_path.size() < kOnPathMinFrames) return;
+  for (const auto& [k, height] : first_heights) {
+    const auto last = std::find_if(revisions.rbegin(), revisions.rend(), [k](const auto& r) { return r.first == k; });
+    if (last != revisions.rend() && (!last->second.found || OnPathAcross(last->second.x, last->second.z))) continue;
+    if (last == revisions.rend() && HeightOnPath(height)) continue;
+    revisions.emplace_back(k, BallObservation{});
+    samples.erase(k);
+    ++left_off_path;
+  }
+  first_heights.clear();
 }
 
 void BallTracker::Impl::AssessRevisions(std::vector<std::pair<long, BallObservation>>* revised) const {

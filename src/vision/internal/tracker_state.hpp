@@ -70,6 +70,7 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   std::deque<double> across_path;                   // AcrossPathPx of the last frames reported
   long left_off_path = 0;                           // frames not reported for lying off the path
   std::deque<double> left_heights;                  // AcrossPathPx of the frames left out in a row
+  std::vector<std::pair<long, double>> first_heights;  // frames reported before the path's height was known
   double row_delay = 0;                             // s per row
   std::vector<double> exposures;                    // per-frame measurements |D|/|V|
   std::vector<double> row_delays;                   // per-frame measurements of the row delay, s
@@ -233,6 +234,8 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // reported lies on it too (kOnPathUsualPx), and before kOnPathMinFrames were, one within
   // kOnPathFirstPx of the path.
   bool OnPathAcross(double x, double z) const;
+  // The same for a centre `height` px across the path (AcrossPathPx).
+  bool HeightOnPath(double height) const;
   // A frame's position as reported (the tracker's own state keeps what it measured): o where it
   // lies on the path; else the edge fit's, where that finds the body's outline on the path; else
   // not found (counted in left_off_path), unless the frames left out in a row say that the
@@ -241,6 +244,10 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // The revisions that may be reported: a revised position off the path leaves the frame's row
   // as it was.
   void AssessRevisions(std::vector<std::pair<long, BallObservation>>* revised) const;
+  // At the end of the clip, the frames reported while kOnPathFirstPx was the bound (the first
+  // kOnPathMinFrames, more than kOnPathPx off the path) judged again by the usual height of the
+  // frames after them: one off it, and not since revised onto it, is withdrawn.
+  void RejudgeFirstFrames();
 
   // Two passes: around the guess with the given half width, then narrow around the first fit
   // (with `narrow_iterations`; q.iterations caps the first passes).
@@ -300,6 +307,12 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   void Place(const Vector2d& centre, BallObservation* o) const;
 
   BallObservation Observe(const FitOutcome& f, const FitRequest& q);
+
+  // The fit whose contrast says how much a body found anew stands out: `fit`, or where the edge
+  // fit found its outline `outline` elsewhere and the model fitted again from the outline's
+  // centre stands out by more there, that fit.
+  FitOutcome ContrastAtOutline(const cv::Mat& frame, double gain, const internal::EdgeFitOutcome& outline,
+                               const FitOutcome& fit);
 
   // The fast path's fit is trusted when it saw the outline nearly all round, in grey-level
   // contrast well above the noise, and its edge points lie on the fitted outline.
