@@ -285,6 +285,25 @@ TEST(TrackAnalysis, BallThatNeverMoves) {
   EXPECT_NE(a.fit.unavailable.find("never moves"), std::string::npos);
 }
 
+// A ball at rest of which only a few frames were found: fewer than rest_frames give no rest
+// position (a search that took a place of the table for the body in a few frames would give one
+// with a tiny scatter); from rest_frames on, the mean. Truth: the rule, and the recorded x0.
+TEST(TrackAnalysis, TooFewFramesFoundGiveNoRestPosition) {
+  const Scene scene = Ball();
+  Recording r = Released(20e-3, 1e9);
+  r.fps = 30, r.duration = 1.0, r.seed = 4;
+  for (int k = 0; k < 30; ++k)
+    if (k % 4 != 0) r.lost.insert(k);  // 8 frames found: 0, 4, …, 28
+  const TrackAnalysis few = AnalyseTrack(Record(scene, r), scene, {.u_x = kNoise});
+  SCOPED_TRACE(TrackAnalysisTable(few));
+  EXPECT_FALSE(few.rest);
+  EXPECT_FALSE(few.fit.available);
+  EXPECT_NE(few.fit.unavailable.find("only 8 frames found"), std::string::npos);
+  const TrackAnalysis enough = AnalyseTrack(Record(scene, r), scene, {.u_x = kNoise, .rest_frames = 8});
+  ASSERT_TRUE(enough.rest);
+  ExpectWithin(enough.rest->x.value, r.x0, enough.rest->x.u, 4, "position at rest");
+}
+
 // A sharp tracker (0.02 mm of noise) and the default stated u_x (0.5 mm: a 2.5 mm band): a ball
 // released late in the clip moves by less than the band. Its mean is no rest position; the
 // analysis finds the move against the tracker's own error at rest (the floor, 0.08 px at

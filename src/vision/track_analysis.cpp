@@ -145,6 +145,15 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
                         " s on, within the stated band: it is not at rest (no measured Y)");
       return a;
     }
+    if (n < o.rest_frames) {
+      // As few frames as this are no rest: a search that took a place of the table or the rods'
+      // meeting point for the body in a few frames, and never found it, would give a position
+      // with a tiny scatter (one ray-traced scene: 5 of 30 frames, 160 mm off).
+      a.fit.unavailable = "only " + std::to_string(n) + " frames found: a position at rest needs " +
+                          std::to_string(o.rest_frames);
+      a.notes.push_back(a.fit.unavailable + "; no measured Y");
+      return a;
+    }
     const auto [x, sd] = stationary(0, n);
     a.scatter_at_rest = sd;
     a.rest = TrackEvent{"comes to rest", {s.t[0], std::nullopt}, x,

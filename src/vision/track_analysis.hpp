@@ -23,7 +23,8 @@
 //    fitted as x_r after a changepoint t_r and x_r + c·(t_r − t)² before (least squares, t_r
 //    profiled over the frame times): x_r ± its standard error from the scatter, t_r. This is a
 //    measured Y for the fit report. A ball that never leaves its band is at rest from the first
-//    frame: rest (the mean ± scatter/√n), no release, no fit, unless it creeps: within the band,
+//    frame: rest (the mean ± scatter/√n, from `rest_frames` frames found at least: fewer are no
+//    measured Y), no release, no fit, unless it creeps: within the band,
 //    it leaves k times the wander a ball at rest shows in this track (the tracker's systematic
 //    error at rest below, or the frames' jitter, the robust SD of successive differences over
 //    √2, if larger) with the same confirmation. The k·σ band, σ the stated u_x (0.5 mm by
@@ -144,7 +145,7 @@ struct TrackAnalysisOptions {
   double band_sigmas = 5.0;                          // k of the k·σ bands
   int confirm_frames = 3;                            // consecutive frames that confirm a change
   int reference_frames = 25;                         // frames of the release band's median
-  int rest_frames = 10;                              // a final rest lasts at least this many frames
+  int rest_frames = 10;                              // a rest lasts at least this many frames found
   double huber_sigmas = 3.0;                         // Huber loss threshold, in σ
   // The tracker's systematic error of one position, 1σ in raw pixels (see "Uncertainty of the
   // fit"): tracker_floor_px + tracker_blur × (pixels the centre moves in one frame interval).
