@@ -277,7 +277,7 @@ TEST_F(DefaultView, InitialGuessAndLostBallKeepTheirRows) {
   EXPECT_EQ(lines, static_cast<int>(truth.size()));
   EXPECT_NE(last.find(",,,,,,0,,"), std::string::npos) << last;
   // Each found row's uncertainty: the documented model (video_tracking.hpp, TrackRow), computed
-  // here from the rows' own pixels: 0.08 px + 0.015 × the pixels moved per frame between the found
+  // here from the rows' own pixels: 0.08 px + 0.007 × the pixels moved per frame between the found
   // neighbours, with 0.10 px in quadrature, and in mm at the body's scale.
   std::vector<const TrackRow*> found_rows;
   for (const TrackRow& r : track.rows)
@@ -286,7 +286,7 @@ TEST_F(DefaultView, InitialGuessAndLostBallKeepTheirRows) {
     const TrackRow& a = *found_rows[i == 0 ? 0 : i - 1];
     const TrackRow& b = *found_rows[std::min(i + 1, found_rows.size() - 1)];
     const double per_frame = std::hypot(b.ball.u - a.ball.u, b.ball.v - a.ball.v) / (b.t - a.t) / s.fps;
-    EXPECT_NEAR(found_rows[i]->u_px, std::hypot(0.08 + 0.015 * per_frame, 0.10), 1e-3) << "frame " << found_rows[i]->frame;
+    EXPECT_NEAR(found_rows[i]->u_px, std::hypot(0.08 + 0.007 * per_frame, 0.10), 1e-3) << "frame " << found_rows[i]->frame;
     EXPECT_NEAR(found_rows[i]->u_x, found_rows[i]->u_px * setup_->scene.body().across / found_rows[i]->ball.radius_px, 1e-9);
   }
   std::ifstream side_in(csv + ".json");

@@ -98,16 +98,17 @@
 //    small double count, on the safe side). The release event quotes max(u, se·sqrt(max(1, χ²/ν))).
 // Assumptions: the bias is smooth along the path at the scales tried and of the size the two
 // options state; the model is right (fed the true positions, the fit recovers x0, t0, g to 1e-8).
-// The defaults (0.08 px, 0.015) are calibrated on the tracker over the 720p clips of the
-// robustness matrix (uphill bench track: clean, baseline, cloth, spheroid-band): along the path
-// its error is 0.03–0.07 px at rest (0.12 px on the spheroid) and grows to 0.15–0.2 px at
-// 12.5 px/frame with a 180° shutter (1/500 s: no growth). Footage with a longer shutter, or a
-// tracker measured worse on it, needs larger values (measure them with uphill bench track).
+// The defaults (0.08 px, 0.007) are the tracker's error along the path on random ray-traced
+// scenes (uphill bench track --random: 255 scenes of 10 seeds, 4,200 moving frames found within a
+// pixel of the truth): 0.09 px RMS with under a pixel of smear, growing by about 0.014 px per
+// pixel the ball moves during the exposure (0.2 px at 6–10 px of smear), which is 0.007 per pixel
+// moved per frame interval at a 180° shutter. Footage with a longer shutter, or a tracker measured
+// worse on it, needs larger values (measure them with uphill bench track).
 // Accuracy (docs/analyse-track.md "Accuracy", tests/vision_povray_analysis_test.cpp,
-// tests/vision_analysis_test.cpp): on 68 fits of random ray-traced scenes (uphill bench track
-// --random), RMS pulls 0.91, 0.72, 0.74 for x0, t0, g, one |pull| beyond 3 of 204, where the
-// statistical part alone misses by more than 3 in 60; on synthetic tracks with an injected bias
-// of the stated size the pulls' RMS is 0.57–0.83.
+// tests/vision_analysis_test.cpp): on 83 fits of random ray-traced scenes (uphill bench track
+// --random), RMS pulls 0.87, 0.79, 0.73 for x0, t0, g, no |pull| beyond 3 of 249, where the
+// statistical part alone misses by more than 3 in 71; on synthetic tracks with an
+// injected bias of the stated size the pulls' RMS is 0.69–0.74.
 //
 // Accuracy (tests/vision_analysis_test.cpp): on tracks simulated by Motion (a 1-inch ball,
 // θ = 3°, α = 40°) with 0.3 mm Gaussian noise at 120 frames/s and lost frames, the fitted x0,
@@ -150,7 +151,7 @@ struct TrackAnalysisOptions {
   // The tracker's systematic error of one position, 1σ in raw pixels (see "Uncertainty of the
   // fit"): tracker_floor_px + tracker_blur × (pixels the centre moves in one frame interval).
   double tracker_floor_px = 0.08;
-  double tracker_blur = 0.015;
+  double tracker_blur = 0.007;
 };
 
 struct FittedParameter {

@@ -24,7 +24,7 @@ namespace uphill::cli {
 namespace {
 
 // TrackAnalysisOptions' defaults (asserted in Run, where the header is seen).
-constexpr double kTrackerFloorPx = 0.08, kTrackerBlur = 0.015;
+constexpr double kTrackerFloorPx = 0.08, kTrackerBlur = 0.007;
 
 struct AnalyseTrackFlags {
   SceneFlags scene;
