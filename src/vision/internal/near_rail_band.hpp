@@ -9,7 +9,10 @@
 // them into the outline fits. The widest is taken over the whole rail as far as the lens model
 // holds (the widest reach, before the picture's edge is known to bound it), unless a band that
 // wide hides the body's outline at every place along the path (a thick rod near the camera,
-// outside the picture): then over the part of the rail whose band reaches into the picture.
+// outside the picture): then over the part of the rail whose band reaches into the picture. Where
+// the band still hides the outline at two places in three or more (a thick rod between a low
+// camera and a small ball), it is drawn at the rod's own width at each point: the tracker would
+// be blind over most of the path, and a rod's highlight is the smaller risk.
 #pragma once
 
 #include <Eigen/Core>
