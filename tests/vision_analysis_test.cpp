@@ -471,9 +471,11 @@ TEST(TrackAnalysis, UncertaintyCoversACorrelatedSpeedDependentTrackerBias) {
       naive_misses += std::abs(p.value - truth[j]) > 3 * *p.se_scaled;
     }
   }
-  // Measured: pulls' RMS 0.74, 0.72, 0.69 (x0, t0, g), the largest 1.80 (the injected bias is one
-  // sinusoid of wavelength span/8 … 2 span, gentler than the prior over ℓ the systematic part
-  // averages); the standard errors from the scatter alone miss by more than 3 in 21 of the 48.
+  // Measured: pulls' RMS 0.85, 1.08, 0.98 (x0, t0, g), the largest 2.74. The injected bias is one
+  // sinusoid of wavelength span/8 … 2 span, all of it at the intermediate lengths that hold only
+  // 20 % of the prior the systematic part averages over (track_fit_errors.hpp): the hardest case
+  // for g and t0, which the stated u still covers. The standard errors from the scatter alone
+  // miss by more than 3 in 21 of the 48.
   for (int j = 0; j < 3; ++j) {
     EXPECT_GT(std::sqrt(sum2[j] / seeds), 0.15) << j;
     EXPECT_LT(std::sqrt(sum2[j] / seeds), 1.2) << j;

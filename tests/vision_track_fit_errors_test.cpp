@@ -43,7 +43,7 @@ TEST(TrackFitErrors, ASharedTimeShiftMovesOnlyT0) {
 }
 
 // The systematic part is the covariance of a tracker bias whose correlation length ℓ is drawn
-// from the stated prior (each of 0, span/256 … span, +inf equally likely). Truth: a Monte Carlo of
+// from the stated prior (0, span/256 … span, +inf, weighted as below). Truth: a Monte Carlo of
 // that process, written here: draw ℓ, draw the bias from its Gaussian process, move the parameters
 // by the weighted least-squares response (unit weights: B = (AᵀA)⁻¹Aᵀ), and take the sample
 // covariance. 20000 draws: the sample variances are within a few per cent of the stated ones.
@@ -80,7 +80,11 @@ TEST(TrackFitErrors, SystematicPartIsTheCovarianceOfABiasOfUnknownCorrelationLen
   }
   std::mt19937_64 random(7);
   std::normal_distribution<double> normal;
-  std::uniform_int_distribution<int> pick(0, static_cast<int>(factors.size()) - 1);
+  // The prior as track_fit_errors.hpp states it: ℓ = 0 with 0.35, +inf with 0.45, the nine lengths
+  // between with 0.20 / 9 each.
+  std::vector<double> prior(factors.size(), 0.20 / 9);
+  prior.front() = 0.35, prior.back() = 0.45;
+  std::discrete_distribution<int> pick(prior.begin(), prior.end());
   const int draws = 20000;
   Eigen::Matrix3d sample = Eigen::Matrix3d::Zero();
   Eigen::VectorXd z(n);

@@ -88,9 +88,11 @@
 //    positions x_i, x_j are correlated as exp(−|x_i − x_j|/ℓ): equal at the same place (the
 //    frames at rest share one bias, which no number of frames averages away). ℓ is not known,
 //    so the covariance is averaged over ℓ ∈ {0 (independent), span/256 … span (×2 steps),
-//    ∞ (one bias)}, each equally likely: the expected covariance of a bias whose ℓ is drawn from
-//    that prior. (The largest variance over ℓ is a worst case: on 68 fits of random
-//    ray-traced scenes it gave RMS pulls of 0.61–0.81, the average 0.72–0.91.)
+//    ∞ (one bias)} with the weights the tracker's errors on random ray-traced scenes show (0.35
+//    independent, 0.45 one bias, 0.20 spread over the lengths between; track_fit_errors.hpp):
+//    the expected covariance of a bias whose ℓ is drawn from that prior. (The largest variance
+//    over ℓ is a worst case, and an even prior over the eleven lengths left g's pulls at an RMS
+//    of 0.6–0.7.)
 //    A rolling shutter's readout measured or assumed (Track::row_delay_u, from the sidecar) adds to
 //    it: every frame's time is uncertain by v_i·row_delay_u, one error shared by all frames, so
 //    position i by ẋ_i·v_i·row_delay_u (ẋ_i = −∂x/∂t0), a rank-one covariance added to it.
@@ -105,10 +107,11 @@
 // moved per frame interval at a 180° shutter. Footage with a longer shutter, or a tracker measured
 // worse on it, needs larger values (measure them with uphill bench track).
 // Accuracy (docs/analyse-track.md "Accuracy", tests/vision_povray_analysis_test.cpp,
-// tests/vision_analysis_test.cpp): on 83 fits of random ray-traced scenes (uphill bench track
-// --random), RMS pulls 0.87, 0.79, 0.73 for x0, t0, g, no |pull| beyond 3 of 249, where the
-// statistical part alone misses by more than 3 in 71; on synthetic tracks with an
-// injected bias of the stated size the pulls' RMS is 0.69–0.74.
+// tests/vision_analysis_test.cpp): on 83 fits of the random ray-traced scenes the defaults were
+// set on (uphill bench track --random), RMS pulls 0.96, 0.98, 0.97 for x0, t0, g, one |pull|
+// beyond 3 of 249, where the statistical part alone misses by more than 3 in 71; on 21 fits of
+// fresh scenes 0.86, 0.95, 0.80, none beyond 3; on synthetic tracks with a bias of the stated
+// size at the intermediate lengths alone (the hardest case for g) the pulls' RMS is 0.85–1.08.
 //
 // Accuracy (tests/vision_analysis_test.cpp): on tracks simulated by Motion (a 1-inch ball,
 // θ = 3°, α = 40°) with 0.3 mm Gaussian noise at 120 frames/s and lost frames, the fitted x0,

@@ -40,16 +40,21 @@ FitErrors EstimateFitErrors(const FitErrorInputs& in) {
   std::vector<double> lengths = {0.0};
   for (int k = 8; k >= 0 && span > 0; --k) lengths.push_back(span * std::ldexp(1.0, -k));
   lengths.push_back(std::numeric_limits<double>::infinity());
+  const double trend_share =
+      (1.0 - kSharedBiasShare - kIndependentShare) / static_cast<double>(std::max<std::size_t>(lengths.size() - 2, 1));
+  double shares = 0;
   for (double length : lengths) {
+    const double share = length == 0 ? kIndependentShare : std::isinf(length) ? kSharedBiasShare : trend_share;
     for (Eigen::Index i = 0; i < n; ++i)
       for (Eigen::Index j = 0; j < n; ++j) {
         const double d = std::abs(in.x(i) - in.x(j));
         const double rho = i == j ? 1.0 : length == 0 ? 0.0 : std::isinf(length) ? 1.0 : std::exp(-d / length);
         sigma(i, j) = in.systematic(i) * in.systematic(j) * rho;
       }
-    out.systematic_covariance += b * sigma * b.transpose();
+    out.systematic_covariance += share * (b * sigma * b.transpose());
+    shares += share;
   }
-  out.systematic_covariance /= static_cast<double>(lengths.size());
+  out.systematic_covariance /= shares;  // 1 but where all frames lie at one x
   out.systematic_covariance += out.timing_covariance;
   return out;
 }
