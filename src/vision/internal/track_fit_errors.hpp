@@ -33,7 +33,7 @@ struct FitErrorInputs {
 // quadratic parts over the clip) and 36 % frame to frame (lag-1 autocorrelation 0.5). So ℓ = +inf
 // has kSharedBiasShare, ℓ = 0 kIndependentShare, and the rest is spread evenly over span/256 …
 // span. An even prior over all eleven (9 % each end) made the intermediate lengths, which move g
-// most, 82 % of it: on those scenes the pulls' RMS of g was 0.73, on 21 fits of fresh ones 0.60.
+// most, 82 % of it: on those scenes the pulls' RMS of g was 0.73, on 21 fits of fresh ones 0.54.
 inline constexpr double kSharedBiasShare = 0.45, kIndependentShare = 0.35;
 
 struct FitErrors {
