@@ -102,8 +102,12 @@ cv::Mat DrawNearRailBand(const Scene& scene, const OutlineGeometry& geometry, do
   const cv::Size size(geometry.cal.camera.width, geometry.cal.camera.height);
   cv::Mat band = Draw(trace, trace.widest_px, size);
   const auto hidden = [&](const cv::Mat& b) { return HiddenShare(b, geometry, scene, x_lo, x_hi, within_lens); };
-  if (trace.widest_in_picture_px < trace.widest_px && hidden(band) == 1.0) band = Draw(trace, trace.widest_in_picture_px, size);
-  if (hidden(band) >= kMostlyHidden) band = DrawAtTheRodsOwnWidth(trace, size);
+  double share = hidden(band);
+  if (trace.widest_in_picture_px < trace.widest_px && share == 1.0) {
+    band = Draw(trace, trace.widest_in_picture_px, size);
+    share = hidden(band);
+  }
+  if (share >= kMostlyHidden) band = DrawAtTheRodsOwnWidth(trace, size);
   return band;
 }
 
