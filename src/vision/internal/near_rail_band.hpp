@@ -8,8 +8,9 @@
 // reach beyond its geometric width, and on random ray-traced scenes a band at the local width let
 // them into the outline fits. The widest is taken over the whole rail as far as the lens model
 // holds (the widest reach, before the picture's edge is known to bound it), unless a band that
-// wide hides the body's outline at every place along the path (a thick rod near the camera,
-// outside the picture): then over the part of the rail whose band reaches into the picture. Where
+// wide hides the body's outline at a quarter or more of the places along the path where a band
+// at the rod's widest in the picture would not (a thick rod near the camera, outside the
+// picture): then over the part of the rail whose band reaches into the picture. Where
 // the band still hides the outline at two places in three or more (a thick rod between a low
 // camera and a small ball), it is drawn at the rod's own width at each point: the tracker would
 // be blind over most of the path, and a rod's highlight is the smaller risk.
