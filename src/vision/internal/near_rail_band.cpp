@@ -32,8 +32,9 @@ constexpr double kMostlyHidden = 2.0 / 3.0;
 // path where the rod itself is far narrower. On the random scenes looked at while building the
 // tracker: uncovered 0.69 and 0.88 (bands 145 px wide, the body found in no frame; now all),
 // 0.35 (a dotted spheroid at rest behind 14 mm rods: a patch of the table was found 265 px off in
-// 9 frames; now 40 of 40 at 0.095 px), 0.38 (a glossy spheroid beside steel rods: 0.11 -> 0.19 px,
-// the rods' highlights reach its outline) and 0.46; 0.08 at most on the other 252.
+// 9 frames; now 40 of 40 at 0.095 px), 0.38 (a glossy spheroid in front of steel rods: 0.11 -> 0.19
+// px, 0.17 px low in every frame: the narrower band lets rays across the rods into its fit) and
+// 0.46; 0.08 at most on the other 252.
 constexpr double kUncovered = 0.25;
 
 struct RailTrace {
