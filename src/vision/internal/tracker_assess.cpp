@@ -27,7 +27,8 @@ BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObserv
   if (!o.found) return o;
   auto reported = [&](const BallObservation& r) {
     const double height = AcrossPathPx(r.x, r.z);
-    if (across_path.size() < kOnPathMinFrames && std::abs(height) > kOnPathPx) first_heights.emplace_back(frame_index, height);
+    if (adopted_left > 0) --adopted_left, first_heights.emplace_back(frame_index, height);
+    else if (across_path.size() < kOnPathMinFrames && std::abs(height) > kOnPathPx) first_heights.emplace_back(frame_index, height);
     across_path.push_back(height);
     if (across_path.size() > kOnPathFrames) across_path.pop_front();
     return r;
@@ -55,6 +56,7 @@ BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObserv
   if (left_heights.size() >= kOnPathAdoptFrames && *high - *low <= kOnPathUsualPx) {
     across_path.assign(left_heights.begin(), std::prev(left_heights.end()));  // reported(o) adds this frame's
     left_heights.clear();
+    adopted_left = kOnPathFrames;
     return reported(o);
   }
   if (left_heights.size() >= kOnPathAdoptFrames) left_heights.pop_front();

@@ -70,7 +70,10 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   std::deque<double> across_path;                   // AcrossPathPx of the last frames reported
   long left_off_path = 0;                           // frames not reported for lying off the path
   std::deque<double> left_heights;                  // AcrossPathPx of the frames left out in a row
-  std::vector<std::pair<long, double>> first_heights;  // frames reported before the path's height was known
+  // Frames reported before the path's height was known: the first ones, and those reported from
+  // an adopted height on (kOnPathAdoptFrames) until kOnPathFrames were.
+  std::vector<std::pair<long, double>> first_heights;
+  std::size_t adopted_left = 0;  // frames still to be reported as provisional since a height was adopted
   double row_delay = 0;                             // s per row
   std::vector<double> exposures;                    // per-frame measurements |D|/|V|
   std::vector<double> row_delays;                   // per-frame measurements of the row delay, s
@@ -244,9 +247,12 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // The revisions that may be reported: a revised position off the path leaves the frame's row
   // as it was.
   void AssessRevisions(std::vector<std::pair<long, BallObservation>>* revised) const;
-  // At the end of the clip, the frames reported while kOnPathFirstPx was the bound (the first
-  // kOnPathMinFrames, more than kOnPathPx off the path) judged again by the usual height of the
-  // frames after them: one off it, and not since revised onto it, is withdrawn.
+  // At the end of the clip, the frames reported before the path's height was known (the first
+  // kOnPathMinFrames, more than kOnPathPx off the path, while kOnPathFirstPx was the bound; and
+  // the kOnPathFrames from an adopted height on) judged again by the usual height of the frames
+  // after them: one off it, and not since revised onto it, is withdrawn. A fit held off a body at
+  // rest (a chrome ball's reflections) stays at one height for ten frames as a calibration that
+  // far off would; the frames after it, back on the path, tell the two apart.
   void RejudgeFirstFrames();
 
   // Two passes: around the guess with the given half width, then narrow around the first fit
