@@ -89,8 +89,8 @@
 #             tiles, 960x540 120 fps, rolling down, the camera low. The near rail's band, at the
 #             rod's widest, hid the body's outline at 73 % of the places along the path: found in
 #             0 of 40 frames (the baseline too). A band that hides two places in three or
-#             more is drawn at the rod's own width (near_rail_band.hpp); since a band at the
-#             rod's widest in the picture uncovers most of the path, that one is drawn (27 %).
+#             more is drawn at the rod's own width; a band at the rod's widest in the picture,
+#             which hides 27 % of the places, comes first (near_rail_band.hpp).
 #   seed 3776755755160792373, 38509762: dotted spheroid (a 10 mm) at rest behind thick painted
 #             rods (7 mm radius), 640x360 240 fps. The band at the rail's widest (48 px, near the
 #             camera, outside the picture) hid the body's place; the search took a patch of the
@@ -98,11 +98,12 @@
 #             Now where the band at the widest in the picture uncovers a quarter of the path or
 #             more, it is drawn (near_rail_band.hpp).
 #   seed 3776755755160792373, 7e8ad8e9: chrome ball (R 24 mm, 12 px in the picture) at rest on
-#             steel rods, 1920x1080 240 fps. Its fit held 3.5 px off the path for ten frames, which
-#             made that height the path's as a calibration that far off would (kOnPathAdoptFrames):
-#             6 frames reported 3 px off, and analyse-track read the fit's later move onto the
-#             body as a release (x0 5 σ off). Now the frames reported from an adopted height are
-#             judged again at the clip's end by the height of the frames after them.
+#             steel rods, 1920x1080 240 fps. Its fit held 3.3-3.6 px off the path for ten frames,
+#             which made that height the path's as a calibration that far off would
+#             (kOnPathAdoptFrames): 6 frames reported about 3 px off, and analyse-track read the
+#             fit's later move onto the body as a release (x0 5 σ off). Now where the last frames
+#             lie on the calibrated path, the frames reported from an adopted height are judged
+#             again at the clip's end by their height.
 #   bash tests/bench_track_random_acquisition.sh UPHILL_VISION_PROGRAM CACHE_DIR
 set -euo pipefail
 program="$1"

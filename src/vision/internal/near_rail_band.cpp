@@ -20,21 +20,20 @@ constexpr int kRailSamples = 400;
 constexpr int kOutlineRays = 32, kPlacesAlongPath = 48;
 // A band that hides the body's outline at this share of the places or more leaves the tracker
 // blind over most of the path (a thick rod between a low camera and a small ball): it is drawn at
-// the rod's own width instead. On the random scenes looked at while building the tracker, one in
-// 255 hid 73 % of its places at the rail's widest (found in no frame; at the rod's own width 40 of
-// 40 at 0.082 px). A band at the widest in the picture (kUncovered) hides 27 % there (40 of 40 at
-// 0.087 px), and no scene looked at reaches this share since: it stays for a thick rod near the
-// camera and inside the picture.
+// the rod's own width instead. No scene looked at while building the tracker reaches it once
+// kUncovered has chosen the band (one hid 73 % of its places at the rail's widest, 27 % at the
+// widest in the picture); it stays for a thick rod near the camera and inside the picture.
 constexpr double kMostlyHidden = 2.0 / 3.0;
-// A band at the rod's widest in the picture is drawn instead of the rail's widest where it uncovers
-// the body's outline at this share of the places or more: the rail's widest part is then near the
+// A band at the rod's widest in the picture is drawn instead of the rail's widest where it shows
+// the body's outline at this share of the places more: the rail's widest part is then near the
 // camera and outside the picture, and a band at its width hides the body over a stretch of the
 // path where the rod itself is far narrower. On the random scenes looked at while building the
-// tracker: uncovered 0.69 and 0.88 (bands 145 px wide, the body found in no frame; now all),
-// 0.35 (a dotted spheroid at rest behind 14 mm rods: a patch of the table was found 265 px off in
-// 9 frames; now 40 of 40 at 0.095 px), 0.38 (a glossy spheroid in front of steel rods: 0.11 -> 0.19
-// px, 0.17 px low in every frame: the narrower band lets rays across the rods into its fit) and
-// 0.46; 0.08 at most on the other 252.
+// tracker it showed 0.69 and 0.88 more (bands 145 px wide that hid every place: the body found in
+// every frame at the narrower band, in none at the wider), 0.46 (a dotted ball behind 9 mm rods, a
+// low camera: 40 of 40 frames at 0.087 px), 0.35 (a dotted spheroid at rest behind 14 mm rods: at
+// the rail's widest the search took a patch of the table 265 px off; at the narrower band 40 of 40
+// at 0.095 px) and 0.38 (a glossy spheroid in front of steel rods: 0.19 px against 0.11 px, 0.17
+// px low in every frame: rays across the rods enter its fit); 0.08 at most on the other 251.
 constexpr double kUncovered = 0.25;
 
 struct RailTrace {
@@ -83,10 +82,16 @@ cv::Mat DrawAtTheRodsOwnWidth(const RailTrace& trace, const cv::Size& size) {
   return band;
 }
 
-// The share of the places along the path (those the lens model maps) where fewer than a third of
-// the body's outline rays (their samples just outside the outline, in the picture) clear the band.
-double HiddenShare(const cv::Mat& band, const OutlineGeometry& g, const Scene& scene, double x_lo, double x_hi,
-                   const std::function<bool(const Vector3d&)>& within_lens) {
+// The places along the path (those the lens model maps), and those of them where fewer than a
+// third of the body's outline rays (their samples just outside the outline, in the picture) clear
+// the band.
+struct HiddenPlaces {
+  int hidden = 0, places = 0;
+  double share() const { return places ? static_cast<double>(hidden) / places : 1.0; }
+};
+
+HiddenPlaces Hidden(const cv::Mat& band, const OutlineGeometry& g, const Scene& scene, double x_lo, double x_hi,
+                    const std::function<bool(const Vector3d&)>& within_lens) {
   int places = 0, hidden = 0;
   for (int i = 0; i < kPlacesAlongPath; ++i) {
     const double x = x_lo + (x_hi - x_lo) * (i + 0.5) / kPlacesAlongPath, z = scene.At(x).z;
@@ -103,7 +108,7 @@ double HiddenShare(const cv::Mat& band, const OutlineGeometry& g, const Scene& s
     ++places;
     hidden += clear < kOutlineRays / 3;
   }
-  return places ? static_cast<double>(hidden) / places : 1.0;
+  return {hidden, places};
 }
 
 }  // namespace
@@ -114,14 +119,14 @@ cv::Mat DrawNearRailBand(const Scene& scene, const OutlineGeometry& geometry, do
   const RailTrace trace = TraceNearRail(scene, geometry.cal, rod, side, within_lens);
   const cv::Size size(geometry.cal.camera.width, geometry.cal.camera.height);
   cv::Mat band = Draw(trace, trace.widest_px, size);
-  const auto hidden = [&](const cv::Mat& b) { return HiddenShare(b, geometry, scene, x_lo, x_hi, within_lens); };
-  double share = hidden(band);
+  const auto hidden = [&](const cv::Mat& b) { return Hidden(b, geometry, scene, x_lo, x_hi, within_lens); };
+  HiddenPlaces at_widest = hidden(band);
   if (trace.widest_in_picture_px < trace.widest_px) {
     cv::Mat in_picture = Draw(trace, trace.widest_in_picture_px, size);
-    const double share_in_picture = hidden(in_picture);
-    if (share - share_in_picture >= kUncovered) band = std::move(in_picture), share = share_in_picture;
+    const HiddenPlaces in = hidden(in_picture);  // the same places: the band's width alone differs
+    if (at_widest.hidden - in.hidden >= kUncovered * at_widest.places) band = std::move(in_picture), at_widest = in;
   }
-  if (share >= kMostlyHidden) band = DrawAtTheRodsOwnWidth(trace, size);
+  if (at_widest.share() >= kMostlyHidden) band = DrawAtTheRodsOwnWidth(trace, size);
   return band;
 }
 

@@ -27,8 +27,9 @@ BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObserv
   if (!o.found) return o;
   auto reported = [&](const BallObservation& r) {
     const double height = AcrossPathPx(r.x, r.z);
-    if (adopted_left > 0) --adopted_left, first_heights.emplace_back(frame_index, height);
-    else if (across_path.size() < kOnPathMinFrames && std::abs(height) > kOnPathPx) first_heights.emplace_back(frame_index, height);
+    if (adopted_left > 0) --adopted_left, provisional.push_back({frame_index, height, true});
+    else if (across_path.size() < kOnPathMinFrames && std::abs(height) > kOnPathPx)
+      provisional.push_back({frame_index, height, false});
     across_path.push_back(height);
     if (across_path.size() > kOnPathFrames) across_path.pop_front();
     return r;
@@ -66,19 +67,30 @@ BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObserv
 
 void BallTracker::Impl::RejudgeFirstFrames() {
   if (across_path.size() < kOnPathMinFrames) return;
-  for (const auto& [k, height] : first_heights) {
+  std::vector<double> sorted(across_path.begin(), across_path.end());
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const bool adoption_disproved = std::abs(sorted[sorted.size() / 2]) <= kOnPathPx;
+  for (const Provisional& p : provisional) {
+    if (p.adopted && !adoption_disproved) continue;
+    const long k = p.frame;
     const auto last = std::find_if(revisions.rbegin(), revisions.rend(), [k](const auto& r) { return r.first == k; });
     if (last != revisions.rend() && (!last->second.found || OnPathAcross(last->second.x, last->second.z))) continue;
-    if (last == revisions.rend() && HeightOnPath(height)) continue;
+    if (last == revisions.rend() && HeightOnPath(p.height)) continue;
     revisions.emplace_back(k, BallObservation{});
     samples.erase(k);
     ++left_off_path;
   }
-  first_heights.clear();
+  provisional.clear();
 }
 
-void BallTracker::Impl::AssessRevisions(std::vector<std::pair<long, BallObservation>>* revised) const {
+void BallTracker::Impl::AssessRevisions(std::vector<std::pair<long, BallObservation>>* revised) {
   std::erase_if(*revised, [this](const auto& r) { return r.second.found && !OnPathAcross(r.second.x, r.second.z); });
+  for (const auto& [k, o] : *revised) {
+    const auto p = std::find_if(provisional.begin(), provisional.end(), [k](const Provisional& q) { return q.frame == k; });
+    if (p == provisional.end()) continue;
+    if (o.found) p->height = AcrossPathPx(o.x, o.z);
+    else provisional.erase(p);
+  }
 }
 
 }  // namespace uphill

@@ -70,9 +70,15 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   std::deque<double> across_path;                   // AcrossPathPx of the last frames reported
   long left_off_path = 0;                           // frames not reported for lying off the path
   std::deque<double> left_heights;                  // AcrossPathPx of the frames left out in a row
-  // Frames reported before the path's height was known: the first ones, and those reported from
-  // an adopted height on (kOnPathAdoptFrames) until kOnPathFrames were.
-  std::vector<std::pair<long, double>> first_heights;
+  // A frame reported before the path's height was known: one of the first, or one of the
+  // kOnPathFrames reported from an adopted height on (kOnPathAdoptFrames). Its height is kept as
+  // revised since.
+  struct Provisional {
+    long frame;
+    double height;  // AcrossPathPx
+    bool adopted;
+  };
+  std::vector<Provisional> provisional;
   std::size_t adopted_left = 0;  // frames still to be reported as provisional since a height was adopted
   double row_delay = 0;                             // s per row
   std::vector<double> exposures;                    // per-frame measurements |D|/|V|
@@ -245,14 +251,15 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // calibration puts the path that far off (kOnPathAdoptFrames).
   BallObservation Assess(const cv::Mat& frame, const BallObservation& o);
   // The revisions that may be reported: a revised position off the path leaves the frame's row
-  // as it was.
-  void AssessRevisions(std::vector<std::pair<long, BallObservation>>* revised) const;
-  // At the end of the clip, the frames reported before the path's height was known (the first
-  // kOnPathMinFrames, more than kOnPathPx off the path, while kOnPathFirstPx was the bound; and
-  // the kOnPathFrames from an adopted height on) judged again by the usual height of the frames
-  // after them: one off it, and not since revised onto it, is withdrawn. A fit held off a body at
-  // rest (a chrome ball's reflections) stays at one height for ten frames as a calibration that
-  // far off would; the frames after it, back on the path, tell the two apart.
+  // as it was. The provisional frames among them take their revised height (or leave the list,
+  // withdrawn).
+  void AssessRevisions(std::vector<std::pair<long, BallObservation>>* revised);
+  // At the end of the clip, the provisional frames judged again by the usual height of the last
+  // frames reported: one off it is withdrawn. The first kOnPathMinFrames (more than kOnPathPx off
+  // the path, while kOnPathFirstPx was the bound) always; the kOnPathFrames reported from an
+  // adopted height on only where the last frames lie on the calibrated path (within kOnPathPx):
+  // the adoption was then a fit held off a body at rest at one height for ten frames (a chrome
+  // ball's reflections), not a calibration that far off, whose offset may change along the path.
   void RejudgeFirstFrames();
 
   // Two passes: around the guess with the given half width, then narrow around the first fit
