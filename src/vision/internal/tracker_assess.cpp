@@ -15,12 +15,16 @@ double BallTracker::Impl::AcrossPathPx(double x, double z) const {
 
 bool BallTracker::Impl::OnPathAcross(double x, double z) const { return HeightOnPath(AcrossPathPx(x, z)); }
 
+double BallTracker::Impl::UsualHeight() const {
+  std::vector<double> sorted(across_path.begin(), across_path.end());
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  return sorted[sorted.size() / 2];
+}
+
 bool BallTracker::Impl::HeightOnPath(double height) const {
   if (std::abs(height) <= kOnPathPx) return true;
   if (across_path.size() < kOnPathMinFrames) return std::abs(height) <= kOnPathFirstPx;
-  std::vector<double> sorted(across_path.begin(), across_path.end());
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  return std::abs(height - sorted[sorted.size() / 2]) <= kOnPathUsualPx;
+  return std::abs(height - UsualHeight()) <= kOnPathUsualPx;
 }
 
 BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObservation& o) {
@@ -67,9 +71,7 @@ BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObserv
 
 void BallTracker::Impl::RejudgeFirstFrames() {
   if (across_path.size() < kOnPathMinFrames) return;
-  std::vector<double> sorted(across_path.begin(), across_path.end());
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const bool adoption_disproved = std::abs(sorted[sorted.size() / 2]) <= kOnPathPx;
+  const bool adoption_disproved = std::abs(UsualHeight()) <= kOnPathPx;
   for (const Provisional& p : provisional) {
     if (p.adopted && !adoption_disproved) continue;
     const long k = p.frame;

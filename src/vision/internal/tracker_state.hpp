@@ -245,6 +245,8 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   bool OnPathAcross(double x, double z) const;
   // The same for a centre `height` px across the path (AcrossPathPx).
   bool HeightOnPath(double height) const;
+  // The median height of the last frames reported (across_path, not empty), px.
+  double UsualHeight() const;
   // A frame's position as reported (the tracker's own state keeps what it measured): o where it
   // lies on the path; else the edge fit's, where that finds the body's outline on the path; else
   // not found (counted in left_off_path), unless the frames left out in a row say that the
