@@ -122,7 +122,7 @@ void BallTracker::Finish() {
   m.FitAgain(true);
   if (m.unconfirmed && m.frame_index > m.unconfirmed->frame) m.Withdraw();
   m.RecoverOpening();
-  m.RejudgeFirstFrames();
+  m.RejudgeProvisionalFrames();
 }
 const std::vector<long>& BallTracker::ExposureChanges() const { return impl_->exposure_changes; }
 

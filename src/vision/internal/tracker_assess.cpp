@@ -69,7 +69,7 @@ BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObserv
   return {};
 }
 
-void BallTracker::Impl::RejudgeFirstFrames() {
+void BallTracker::Impl::RejudgeProvisionalFrames() {
   if (across_path.size() < kOnPathMinFrames) return;
   const bool adoption_disproved = std::abs(UsualHeight()) <= kOnPathPx;
   for (const Provisional& p : provisional) {

@@ -262,7 +262,7 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // adopted height on only where the last frames lie on the calibrated path (within kOnPathPx):
   // the adoption was then a fit held off a body at rest at one height for ten frames (a chrome
   // ball's reflections), not a calibration that far off, whose offset may change along the path.
-  void RejudgeFirstFrames();
+  void RejudgeProvisionalFrames();
 
   // Two passes: around the guess with the given half width, then narrow around the first fit
   // (with `narrow_iterations`; q.iterations caps the first passes).

@@ -132,9 +132,9 @@ struct TrackerThresholds {
   // height the path's (a calibration farther off than kOnPathFirstPx): on those 153 scenes no
   // ten frames left out in a row did (a print's edge holds the outline for up to six frames, and
   // its height wanders), and a badly calibrated clip loses only its first third of a second at
-  // 30 frames/s. A fit held off a chrome ball at rest did, for 15 frames, on a later draw: the
-  // frames reported from an adopted height are judged again at the clip's end
-  // (RejudgeFirstFrames).
+  // 30 frames/s. A fit held off a chrome ball at rest did (15 frames, on another random scene):
+  // the frames reported from an adopted height are judged again at the clip's end
+  // (RejudgeProvisionalFrames).
   static constexpr std::size_t kOnPathAdoptFrames = 10;
   // A body within this of where it was found anew, px, is still at rest there: an edge fit's
   // centre on a printed body scatters by a few tenths of a pixel, a rolling body leaves the
