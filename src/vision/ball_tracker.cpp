@@ -171,8 +171,9 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
   // A frame the model measured. `acquired`: the body was found anew (not near the prediction).
   // `outline`: an edge fit that found a body's outline where the model, without the background,
   // put it elsewhere (the acquisition below); it measures the frame.
-  auto finish = [&](const FitOutcome& fit, const FitRequest& q, bool acquired,
+  auto finish = [&](const FitOutcome& measured, const FitRequest& q, bool acquired,
                     const std::optional<internal::EdgeFitOutcome>& outline = std::nullopt) {
+    const FitOutcome fit = outline ? measured : m.HeldOnPath({frame, {0, 0}, gain}, measured, q);
     const bool needs_model_before = m.needs_model;
     BallObservation o = m.Observe(fit, q);
     m.light_inverse_distance = fit.light_inverse_distance;

@@ -106,7 +106,9 @@
 // body rested since the first frame the background under it is unknown until it leaves: those
 // rays use a background constant along the ray, solved in the fit; while it stays where it was
 // found, an edge fit that finds its outline all round where the model put it elsewhere (a
-// striped or dotted print holds the model off the limb) measures it instead. A centre measured
+// striped or dotted print holds the model off the limb) measures it instead. A model fit a little
+// off the rails' path that the pixels do not hold there (its rim without contrast on one side)
+// is fitted again held on the path (internal/tracker_measure.cpp, HeldOnPath). A centre measured
 // off the rails' path (across it, beyond the calibration's error: internal/tracker_assess.cpp) is
 // not reported unless the edge fit finds the outline on the path there (FramesLeftOffPath); the
 // first frames, judged by a looser bound before the frames reported show the path's height, are

@@ -77,6 +77,17 @@ struct PriorCost {
   }
 };
 
+// FitRequest::path: the centre's height above the path's tangent line, over σ (a vertical
+// distance: across the path to within the slope's cosine).
+struct PathCost {
+  PathHold hold;
+  template <typename T>
+  bool operator()(const T* p, T* r) const {
+    r[0] = (p[kCentreZ] - hold.z0 - hold.slope * (p[kCentreX] - hold.x0)) / hold.sigma;
+    return true;
+  }
+};
+
 // The rolling shutter's row delay (s per row) that the inlier rays prefer, every parameter free,
 // and its standard error: one Gauss–Newton step in (p, δ) from the solution p at the request's
 // delay, over the inlier rays' χ² and the priors. Its δ part is the least-squares delay of this
@@ -253,6 +264,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   double params[kSmearParameters] = {x, z, q.smear.x(), q.smear.y(), 0.0};
   ceres::Problem problem;
   std::vector<RayCost*> costs;
+  std::vector<ceres::ResidualBlockId> ray_blocks;
   int without_background = 0;
   const double inv_noise = 1.0 / std::max(q.noise, 1e-4);
   const cv::Mat& occluder = *g.occluder;
@@ -321,7 +333,7 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
     auto* cost = new RayCost(body, std::move(samples), inv_noise, shaded, params);
     if (q.estimate_row_delay) cost->KeepGradients();
     costs.push_back(cost);
-    problem.AddResidualBlock(cost, new ceres::CauchyLoss(loss_scale), params);
+    ray_blocks.push_back(problem.AddResidualBlock(cost, new ceres::CauchyLoss(loss_scale), params));
   }
   out.rays_fitted = static_cast<int>(costs.size());
   out.rays_without_background = without_background;
@@ -330,6 +342,9 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, kSmearParameters>(
                                new PriorCost{q.smear, 1.0 / sigma_d}),
                            nullptr, params);
+  if (q.path)
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PathCost, 1, kSmearParameters>(new PathCost{*q.path}),
+                             nullptr, params);
   if (!q.fit_edge_shift) problem.SetManifold(params, new ceres::SubsetManifold(kSmearParameters, {kEdgeShift}));
   QuietSolverLogs();
   ceres::Solver::Options solver;
@@ -379,6 +394,9 @@ FitOutcome FitOutline(const OutlineGeometry& g, const FrameView& view, const Bac
   out.noise = q.noise * std::sqrt(median);
   std::copy(std::begin(params), std::end(params), out.p.begin());
   out.last_step_px = steps.last_px();
+  ceres::Problem::EvaluateOptions rays_only;
+  rays_only.residual_blocks = ray_blocks;
+  problem.Evaluate(rays_only, &out.ray_cost, nullptr, nullptr, nullptr);
   if (q.estimate_row_delay) {
     const auto [delay, sigma] = PreferredRowDelay(costs, squares, limit, params, q);
     out.row_delay = delay, out.row_delay_sigma = sigma;

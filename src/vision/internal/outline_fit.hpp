@@ -48,6 +48,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <optional>
 #include <opencv2/core.hpp>
 
 #include "vision/camera.hpp"
@@ -69,6 +70,13 @@ struct OutlineGeometry {
   std::vector<Eigen::Vector3d> OutlinePoints(double x, double z, int n) const;
   Eigen::Vector2d Project(double x, double z) const;
   double PxPerRad(double x, double z) const;
+};
+
+// The centre held near the line z = z0 + slope·(x − x0) (the path's tangent at x0) by a prior of
+// σ sigma across it, m: the fit the tracker compares with a free one where a fit lies off the
+// calibrated path (tracker_measure.cpp, HeldOnPath).
+struct PathHold {
+  double x0 = 0, z0 = 0, slope = 0, sigma = 0;
 };
 
 struct FitRequest {
@@ -95,6 +103,8 @@ struct FitRequest {
   // pass started within half a pixel or so, at a fit of the same frame or a checked prediction,
   // in 1 (ball_tracker.cpp).
   int iterations = 3;
+  // Set: the centre held near the path's tangent line (PathHold).
+  std::optional<PathHold> path;
 };
 
 // The picture a fit reads: a whole frame (origin 0, 0) or a window of one kept for a later refit,
@@ -121,6 +131,7 @@ struct FitOutcome {
   // The centre's move in the image at the solve's last successful iteration, px: how far from
   // settled a solve stopped by its cap of iterations was (0: no step taken).
   double last_step_px = 0;
+  double ray_cost = 0;  // the rays' robust cost at the solution (Ceres' ½Σρ, residuals in units of the noise)
 };
 
 FitOutcome FitOutline(const OutlineGeometry& geometry, const FrameView& view, const BackgroundModel& background,

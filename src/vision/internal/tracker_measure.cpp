@@ -103,6 +103,29 @@ FitOutcome BallTracker::Impl::MeasureNear(const internal::FrameView& view, FitRe
   return Measure(view, wide);
 }
 
+FitOutcome BallTracker::Impl::HeldOnPath(const internal::FrameView& view, const FitOutcome& fit, FitRequest q) const {
+  const double x = fit.p[internal::kCentreX], z = fit.p[internal::kCentreZ];
+  const double height = std::abs(AcrossPathPx(x, z));
+  if (!fit.ok || height <= kHeldFromPx || height > kOnPathFirstPx) return fit;
+  // Both fits start at this one, in the narrow pass's windows, so that their costs compare.
+  q.centre = Vector2d(x, z);
+  q.smear = Vector2d(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]);
+  q.half_width_px = kNarrowHalfWidthPx;
+  q.iterations = kHeldIterations;
+  q.fit_edge_shift = false;
+  q.estimate_row_delay = false;
+  const FitOutcome free = internal::FitOutline(geometry, view, *background, q);
+  const double on = std::clamp(x, x_lo, x_hi);
+  const PathPoint path = scene.At(on);
+  q.path = internal::PathHold{on, path.z, path.dzdx, kHeldSigmaPx * MetresPerPx(x, z)};
+  FitOutcome held = internal::FitOutline(geometry, view, *background, q);
+  if (!free.ok || !held.ok) return fit;
+  const double gain = (held.ray_cost - free.ray_cost) / std::max(1.0, free.misfit * free.misfit);
+  if (gain >= kHeldSignificance) return fit;
+  held.row_delay = fit.row_delay, held.row_delay_sigma = fit.row_delay_sigma;
+  return held;
+}
+
 double BallTracker::Impl::Quality(const FitOutcome& f) const {
   const double fraction = std::min(1.0, static_cast<double>(f.inliers) / std::max(1, f.rays_tried));
   const double excess = std::max(0.0, f.misfit - 1.5);

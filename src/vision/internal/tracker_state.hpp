@@ -275,6 +275,10 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // that both fit the same parameters: freed here alone, it moves the centre across the motion
   // on fast frames.
   FitOutcome MeasureNear(const internal::FrameView& view, FitRequest q);
+  // `fit` (of request q), or where it lies off the calibrated path by kHeldFromPx to
+  // kOnPathFirstPx, the fit held on the path unless the pixels ask for the offset
+  // (tracker_thresholds.hpp): a rim without contrast on one side lets the outline slide across.
+  FitOutcome HeldOnPath(const internal::FrameView& view, const FitOutcome& fit, FitRequest q) const;
 
   // Whether the lens model maps the camera-frame point where it is (LensModelReach).
   bool WithinLens(const Vector3d& pc) const { return pc.z() > 0 && pc.head<2>().norm() < lens_reach * pc.z(); }
