@@ -107,8 +107,9 @@
 // rays use a background constant along the ray, solved in the fit; while it stays where it was
 // found, an edge fit that finds its outline all round where the model put it elsewhere (a
 // striped or dotted print holds the model off the limb) measures it instead. A model fit a little
-// off the rails' path that the pixels do not hold there (its rim without contrast on one side)
-// is fitted again held on the path (internal/tracker_measure.cpp, HeldOnPath). A centre measured
+// off the rails' path is fitted again, freely and held on the path, and the held one replaces
+// it where the pixels do not ask for the offset (its rim without contrast on one side:
+// internal/tracker_measure.cpp, HeldOnPath). A centre measured
 // off the rails' path (across it, beyond the calibration's error: internal/tracker_assess.cpp) is
 // not reported unless the edge fit finds the outline on the path there (FramesLeftOffPath); the
 // first frames, judged by a looser bound before the frames reported show the path's height, are
