@@ -125,7 +125,12 @@ double Quantile(std::vector<double> values, double p) {
 
 ordered_json AnalysisJson(const AnalysisScore& a) {
   ordered_json pulls = ordered_json::array();
-  for (const AnalysisPull& p : a.pulls) pulls.push_back({{"name", p.name}, {"error", p.error}, {"u", p.u}});
+  for (const AnalysisPull& p : a.pulls)
+    pulls.push_back({{"name", p.name},
+                     {"error", p.error},
+                     {"u", p.u},
+                     {"u_statistical", p.u_statistical},
+                     {"u_systematic", p.u_systematic}});
   return {{"kind", a.kind}, {"pulls", pulls}};
 }
 

@@ -51,7 +51,8 @@ AnalysisScore ScoreAnalysis(const std::string& track_csv, const FootageCondition
   const double truth[] = {c.x0, c.release_time, c.motion.mu > 0 ? c.motion.mu : c.motion.g};
   for (size_t i = 0; i < a.fit.parameters.size() && i < 3; ++i) {
     const FittedParameter& p = a.fit.parameters[i];
-    s.pulls.push_back({p.name, p.value - truth[i], p.u.value_or(0)});
+    s.pulls.push_back(
+        {p.name, p.value - truth[i], p.u.value_or(0), p.se_statistical.value_or(0), p.se_systematic.value_or(0)});
   }
   return s;
 }

@@ -20,6 +20,10 @@ struct AnalysisPull {
   std::string name;  // "Y" (a rest position), "x0", "t0", "g", "mu"
   double error = 0;  // fitted − true, SI (m, s, m/s², 1)
   double u = 0;      // the stated standard uncertainty, SI; 0 when none was stated
+  // A fitted parameter's two parts of u (FittedParameter::se_statistical, se_systematic), so that
+  // the pulls under another size of the tracker's systematic error can be computed from the
+  // --json output without tracking again; 0 for a position at rest.
+  double u_statistical = 0, u_systematic = 0;
   double Pull() const { return u > 0 ? error / u : INFINITY; }
 };
 
