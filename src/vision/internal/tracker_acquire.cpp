@@ -222,12 +222,14 @@ std::vector<BallTracker::Impl::SearchStart> BallTracker::Impl::Candidates(const 
   // the other kind's (a fit started there sees the same outline; one started a quarter radius
   // off a printed body's centre may not reach it). Not quite for a body more than 12 px in
   // radius (the acquiring fit looks 2 search half-widths either side of its outline): it can lie
-  // between two places, each too far off, and is found once it moves. Places that close cost the
-  // first frame's search more fits than the speed goal leaves (docs/track.md, "Accuracy").
-  // A body's colour score is a plateau, about as high wherever the outline stays on the body's
-  // colour with its outside off it, and a print's dot or a highlight can lift any place of it:
-  // where the plateau's centre lies a quarter radius or more from its highest place, it is a
-  // second start.
+  // between two places, each too far off. Places that close cost the first frame's search more
+  // fits than the speed goal leaves (docs/track.md, "Accuracy"), so a second start is tried only
+  // where the first found no body: a body's colour score is a plateau, about as high wherever
+  // the outline stays on the body's colour with its outside off it, and a print's dot or a
+  // highlight can lift any place of it. Where the plateau's centre lies a quarter radius or more
+  // from its highest place, it is the second start; else the higher of its two neighbours on the
+  // plateau (a dotted spheroid at rest, 35 px in radius, whose highest place lay a third of a
+  // radius off its centre, was found in none of its frames without it).
   const std::vector<std::pair<double, double>> colour_along = scored;  // in x order
   std::vector<SearchStart> out;
   auto take = [&](std::vector<std::pair<double, double>>& by, size_t most, bool plateau) {
@@ -243,7 +245,10 @@ std::vector<BallTracker::Impl::SearchStart> BallTracker::Impl::Candidates(const 
       if (near) continue;
       SearchStart place{Vector2d(xc, scene.At(xc).z), std::nullopt};
       const double centre = plateau ? PlateauCentre(colour_along, xc) : xc;
-      if ((geometry.Project(centre, scene.At(centre).z) - p).norm() >= 0.25 * r) place.again = Vector2d(centre, scene.At(centre).z);
+      if ((geometry.Project(centre, scene.At(centre).z) - p).norm() >= 0.25 * r)
+        place.again = Vector2d(centre, scene.At(centre).z);
+      else if (const std::optional<double> side = plateau ? PlateauNeighbour(colour_along, xc) : std::nullopt)
+        place.again = Vector2d(*side, scene.At(*side).z);
       out.push_back(place);
     }
   };
@@ -263,6 +268,17 @@ double BallTracker::Impl::PlateauCentre(const std::vector<std::pair<double, doub
   double weight = 0, sum = 0;
   for (auto s = first; s != std::next(last); ++s) weight += s->first, sum += s->first * s->second;
   return sum / weight;
+}
+
+// Of the two places next to the one at `peak` along the path, the one that scores higher, if it
+// belongs to the peak's plateau (kPlateauShare of its score).
+std::optional<double> BallTracker::Impl::PlateauNeighbour(const std::vector<std::pair<double, double>>& along, double peak) {
+  const auto at = std::find_if(along.begin(), along.end(), [&](const auto& s) { return s.second == peak; });
+  std::optional<std::pair<double, double>> best;
+  if (at != along.begin()) best = *std::prev(at);
+  if (std::next(at) != along.end() && (!best || std::next(at)->first > best->first)) best = *std::next(at);
+  if (!best || best->first < kPlateauShare * at->first) return std::nullopt;
+  return best->second;
 }
 
 }  // namespace uphill

@@ -316,6 +316,11 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   std::vector<SearchStart> Candidates(const cv::Mat& frame, double gain, double x0, double x1) const;
   // The centre of the plateau of colour scores ((score, x) in x order) around the place x = peak.
   static double PlateauCentre(const std::vector<std::pair<double, double>>& along, double peak);
+  // Where the plateau's centre lies within a quarter radius of its highest place, a print's dot or
+  // a highlight may still have lifted the place beside the body's centre above the one on it, and
+  // a fit started a quarter radius off on a large body can miss it: the neighbour on the plateau
+  // is the second start.
+  static std::optional<double> PlateauNeighbour(const std::vector<std::pair<double, double>>& along, double peak);
 
   // Quality in [0, 1]: the share of the visible outline's rays that agree with the fit, lowered
   // when those fit worse than the pixel noise allows and when the body stands out of the
