@@ -454,6 +454,7 @@ TEST(TrackAnalysis, UncertaintyCoversACorrelatedSpeedDependentTrackerBias) {
     const Track track = RecordBiased(scene, r, &bias);
     TrackAnalysisOptions o;
     o.u_x = 0.01e-3;
+    o.fit_systematic_scale = 1;  // the injected bias is the whole stated error
     const TrackAnalysis a = AnalyseTrack(track, scene, o);
     ASSERT_TRUE(a.fit.available) << a.fit.unavailable;
     EXPECT_NEAR(a.fit.metres_per_pixel, bias.metres_per_pixel, 1e-3 * bias.metres_per_pixel);
@@ -495,6 +496,7 @@ TEST(TrackAnalysis, UncertaintyOfMuCoversACorrelatedTrackerBias) {
     BiasedRecording bias;
     TrackAnalysisOptions o;
     o.u_x = 0.01e-3;
+    o.fit_systematic_scale = 1;  // the injected bias is the whole stated error
     o.fit = TrackFitParameter::kMu;
     const TrackAnalysis a = AnalyseTrack(RecordBiased(scene, r, &bias), scene, o);
     ASSERT_TRUE(a.fit.available) << a.fit.unavailable;
@@ -528,6 +530,7 @@ TEST(TrackAnalysis, AFarCameraStillGetsTheTrackersSystematicPart) {
     ASSERT_LT(widest, 5.0) << "the case needs a window that moves the centre less than 5 px";
     TrackAnalysisOptions o;
     o.u_x = 0.01e-3;
+    o.fit_systematic_scale = 1;  // the injected bias is the whole stated error
     const TrackAnalysis a = AnalyseTrack(track, scene, o);
     ASSERT_TRUE(a.fit.available) << a.fit.unavailable;
     EXPECT_NEAR(a.fit.metres_per_pixel, bias.metres_per_pixel, 0.1 * bias.metres_per_pixel);
@@ -737,10 +740,14 @@ TEST(AnalyseTrackCommand, PrintsTheFitAndWritesJsonAndFigures) {
         << name;
   }
   EXPECT_EQ(j["tracker_floor_px"], 0.08);
+  EXPECT_EQ(j["fit_systematic_scale"], 0.8);
   EXPECT_TRUE(j["fit"]["frames"][0]["u_systematic"].is_number());
   const auto negative = testing::RunUphill("analyse-track " + csv + scene_flags + " --tracker-floor-px -0.1");
   EXPECT_EQ(negative.status, 2);
   EXPECT_NE(negative.err.find("--tracker-floor-px"), std::string::npos) << negative.err;
+  const auto negative_scale = testing::RunUphill("analyse-track " + csv + scene_flags + " --fit-systematic-scale -1");
+  EXPECT_EQ(negative_scale.status, 2);
+  EXPECT_NE(negative_scale.err.find("--fit-systematic-scale"), std::string::npos) << negative_scale.err;
   for (const char* name : {"track_x_vs_t.svg", "track_x_vs_t.png", "track_x_vs_t.gp", "track_residuals.svg"})
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / name)) << name;
   // Bad input: exit 2 and one line naming the file, row and column, or the flag.

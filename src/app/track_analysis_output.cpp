@@ -80,8 +80,9 @@ std::string TrackAnalysisTable(const TrackAnalysis& a) {
       out << line;
     }
     out << "  statistical: from the residuals (lag-1 autocorrelation " << Printf("%.2f", f.residual_lag1)
-        << "); systematic: the tracker's " << Printf("%.3g", a.options.tracker_floor_px) << " px + "
-        << Printf("%.3g", a.options.tracker_blur) << " x (px moved per frame) at "
+        << "); systematic: " << Printf("%.3g", a.options.fit_systematic_scale) << " x (the tracker's "
+        << Printf("%.3g", a.options.tracker_floor_px) << " px + " << Printf("%.3g", a.options.tracker_blur)
+        << " x (px moved per frame)) at "
         << Printf("%.3g", f.metres_per_pixel * 1e3) << " mm/px, averaged over its correlation length along the path\n";
     out << "  chi2 = " << Printf("%.4g", f.chi2) << ", dof = " << f.dof << ", chi2/dof = " << Printf("%.4g", f.reduced_chi2)
         << ", RMS residual = " << Printf("%.3g", f.rms_residual * 1e3) << " mm\n";
@@ -105,6 +106,7 @@ nlohmann::json TrackAnalysisJson(const TrackAnalysis& a) {
   j["band_sigmas"] = a.options.band_sigmas;
   j["tracker_floor_px"] = a.options.tracker_floor_px;
   j["tracker_blur"] = a.options.tracker_blur;
+  j["fit_systematic_scale"] = a.options.fit_systematic_scale;
   j["g"] = a.options.g;
   j["scatter_at_rest"] = Optional(a.scatter_at_rest);
   j["direction"] = a.direction;

@@ -25,6 +25,9 @@ void RequireOptions(const TrackAnalysisOptions& o) {
   if (o.rest_frames < 2) throw InputError("rest_frames", "must be >= 2");
   if (!(o.tracker_floor_px >= 0.0 && std::isfinite(o.tracker_floor_px)))
     throw InputError("tracker_floor_px", "must be >= 0 (the tracker's systematic error at rest, px)");
+  if (!(o.fit_systematic_scale >= 0.0 && std::isfinite(o.fit_systematic_scale)))
+    throw InputError("fit_systematic_scale",
+                     "must be >= 0 (the share of the tracker's systematic error a fit carries)");
   if (!(o.tracker_blur >= 0.0 && std::isfinite(o.tracker_blur)))
     throw InputError("tracker_blur", "must be >= 0 (the tracker's systematic error per pixel of motion per frame)");
 }

@@ -24,19 +24,20 @@ namespace uphill::cli {
 namespace {
 
 // TrackAnalysisOptions' defaults (asserted in Run, where the header is seen).
-constexpr double kTrackerFloorPx = 0.08, kTrackerBlur = 0.007;
+constexpr double kTrackerFloorPx = 0.08, kTrackerBlur = 0.007, kFitSystematicScale = 0.8;
 
 struct AnalyseTrackFlags {
   SceneFlags scene;
   std::string track, g = "9.80665m/s2", fit = "g", u_x = "0.5mm", output;
-  double tracker_floor_px = kTrackerFloorPx, tracker_blur = kTrackerBlur;
+  double tracker_floor_px = kTrackerFloorPx, tracker_blur = kTrackerBlur, fit_systematic_scale = kFitSystematicScale;
   bool json = false;
 };
 
 #if UPHILL_VISION_PROGRAM
 void Run(const AnalyseTrackFlags& f) {
   static_assert(TrackAnalysisOptions{}.tracker_floor_px == kTrackerFloorPx &&
-                TrackAnalysisOptions{}.tracker_blur == kTrackerBlur);
+                TrackAnalysisOptions{}.tracker_blur == kTrackerBlur &&
+                TrackAnalysisOptions{}.fit_systematic_scale == kFitSystematicScale);
   const Scene scene = ParseConfiguration(FlagSource(f.scene)).MakeScene();
   TrackAnalysisOptions o;
   o.g = ParseQuantity(f.g, Dimension::kAcceleration, "--g");
@@ -47,8 +48,11 @@ void Run(const AnalyseTrackFlags& f) {
     throw InputError("--tracker-floor-px", "must be >= 0 (pixels)");
   if (!(f.tracker_blur >= 0.0 && std::isfinite(f.tracker_blur)))
     throw InputError("--tracker-blur", "must be >= 0 (pixels of error per pixel moved per frame)");
+  if (!(f.fit_systematic_scale >= 0.0 && std::isfinite(f.fit_systematic_scale)))
+    throw InputError("--fit-systematic-scale", "must be >= 0 (a share of the tracker's systematic error)");
   o.tracker_floor_px = f.tracker_floor_px;
   o.tracker_blur = f.tracker_blur;
+  o.fit_systematic_scale = f.fit_systematic_scale;
   o.fit = ParseTrackFitParameter(f.fit, "--fit");
   if (!f.output.empty()) {  // checked before any work
     OutputPaths outputs;
@@ -93,6 +97,10 @@ void AddAnalyseTrackCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--tracker-blur", flags->tracker_blur,
                   "the tracker's systematic error added per pixel the ball moves in one frame interval")
+      ->capture_default_str();
+  cmd->add_option("--fit-systematic-scale", flags->fit_systematic_scale,
+                  "the share of the tracker's systematic error a moving fit's x0, t0, g or mu carry "
+                  "(1: all of it; positions at rest always carry all)")
       ->capture_default_str();
   cmd->add_option("-o,--output", flags->output, "folder for track_analysis.json and the figures (created if needed)");
   cmd->add_flag("--json", flags->json, "print track_analysis.json instead of the table");

@@ -158,7 +158,8 @@ std::optional<FitErrors> AddErrorParts(const Series& s, const std::vector<int>& 
   const std::vector<double> speed = PixelsPerFrame(t, u, v);
   fit->metres_per_pixel = MetresPerPixel(s, use);
   for (int i = 0; i < n; ++i) {
-    in.systematic(i) = fit->metres_per_pixel * (o.tracker_floor_px + o.tracker_blur * speed[i]);
+    in.systematic(i) =
+        o.fit_systematic_scale * fit->metres_per_pixel * (o.tracker_floor_px + o.tracker_blur * speed[i]);
     fit->systematic.push_back(in.systematic(i));
   }
   if (fit->metres_per_pixel == 0.0)
