@@ -2,6 +2,7 @@
 // accuracy against the exact ground truth, lost frames, partial and bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -167,6 +168,59 @@ TEST_F(DefaultView, APathCalibratedAFewPixelsOffStillReportsTheBall) {
     for (int f = first; f < s.frames; ++f) EXPECT_TRUE(track.rows[f].ball.found) << shift_px << " px off, frame " << f;
     EXPECT_LT(e.rms_uv, 0.1) << shift_px << " px off";
   }
+}
+
+// TrackerOptions::min_report_quality: a frame of a doubted fit is withdrawn where it lies off the
+// motion of the frames around it, and kept where it lies on it. Truth: a clean clip whose frame
+// 15 is altered after rendering, the ball's region moved 2 px along its own motion (so that it
+// stays on the rails' path and only the motion tells it); with every fit doubted (1), that frame
+// alone is withdrawn, and with none (0) it is reported about 2 px off.
+TEST_F(DefaultView, ADoubtedFitOffTheMotionAroundItIsWithdrawn) {
+  ClipSettings s;
+  s.frames = 30;
+  s.release_time = -0.9;  // rolling toward O, up to 10 px per frame
+  const Motion motion(setup_->scene, setup_->x0);
+  const std::string clean = (TempDir() / "doubted_clean.avi").string();
+  const std::vector<ClipTruth> truth = RenderClip(*renderer_, motion, s, clean);
+  constexpr int kMoved = 15;
+  const Eigen::Vector2d along =
+      Eigen::Vector2d(truth[kMoved + 1].u - truth[kMoved - 1].u, truth[kMoved + 1].v - truth[kMoved - 1].v).normalized();
+  const Eigen::Vector2d shift = 2.0 * along;
+  const std::string moved = (TempDir() / "doubted_moved.avi").string();
+  {
+    cv::VideoCapture in(clean);
+    cv::VideoWriter out(moved, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 30,
+                        cv::Size(setup_->calibration.camera.width, setup_->calibration.camera.height));
+    ASSERT_TRUE(in.isOpened() && out.isOpened());
+    cv::Mat frame;
+    for (int f = 0; in.read(frame); ++f) {
+      if (f == kMoved) {
+        cv::Mat shifted;
+        const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, shift.x(), 0, 1, shift.y());
+        cv::warpAffine(frame, shifted, m, frame.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+        const int r = 60;  // px, beyond the ball's radius (about 40 px) and its shift
+        const cv::Rect box = cv::Rect(static_cast<int>(truth[f].u) - r, static_cast<int>(truth[f].v) - r, 2 * r, 2 * r) &
+                             cv::Rect(0, 0, frame.cols, frame.rows);
+        shifted(box).copyTo(frame(box));
+      }
+      out.write(frame);
+    }
+  }
+  TrackVideoOptions none, every;
+  none.tracker.min_report_quality = 0;
+  every.tracker.min_report_quality = 1;
+  const TrackResult kept = TrackVideo(moved, setup_->scene, setup_->calibration, none);
+  const TrackResult judged = TrackVideo(moved, setup_->scene, setup_->calibration, every);
+  ASSERT_EQ(kept.rows.size(), truth.size());
+  ASSERT_EQ(judged.rows.size(), truth.size());
+  ASSERT_TRUE(kept.rows[kMoved].ball.found);
+  const BallObservation& k = kept.rows[kMoved].ball;
+  EXPECT_NEAR(k.u - truth[kMoved].u, shift.x(), 0.3);
+  EXPECT_NEAR(k.v - truth[kMoved].v, shift.y(), 0.3);
+  EXPECT_EQ(kept.frames_of_poor_fit, 0);
+  for (size_t f = 0; f < truth.size(); ++f)
+    EXPECT_EQ(judged.rows[f].ball.found, f != kMoved) << "frame " << f << ", quality " << kept.rows[f].ball.quality;
+  EXPECT_EQ(judged.frames_of_poor_fit, 1);
 }
 
 TEST_F(DefaultView, BlurNoiseFlickerAndH264WithinThreeTenthsOfAPixel) {
@@ -596,6 +650,9 @@ TEST(VisionTrack, BadInputIsNamed) {
   both.readout = 0.02;
   both.measure_readout = true;
   ExpectInputError([&] { BallTracker(setup.scene, setup.calibration, both); }, {"--readout", "auto"});
+  TrackerOptions beyond_one;
+  beyond_one.min_report_quality = 1.5;
+  ExpectInputError([&] { BallTracker(setup.scene, setup.calibration, beyond_one); }, {"--min-quality", "[0, 1]"});
 }
 
 }  // namespace

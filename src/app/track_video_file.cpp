@@ -27,6 +27,7 @@ TrackResult TrackVideoFile(const std::string& video, const std::string& camera_f
   track.tracker.readout = options.readout;
   track.tracker.measure_readout = options.measure_readout;
   track.tracker.transfer = options.transfer;
+  track.tracker.min_report_quality = options.min_report_quality;
   return TrackVideo(video, scene, calibration, track);
 }
 

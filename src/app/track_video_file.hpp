@@ -35,6 +35,7 @@ struct TrackVideoFileOptions {
   double readout = 0;                              // s, first to last row; 0: a global shutter
   bool measure_readout = false;                    // a rolling shutter of unknown readout ("auto")
   VideoTransfer transfer = VideoTransfer::kSrgb;   // the video's transfer curve
+  double min_report_quality = TrackerOptions{}.min_report_quality;  // TrackerOptions' rule
   std::string overlay_path;                        // "" : none; else the video with the fit drawn (.mp4)
   std::string video_label;                         // names the video in messages ("": its path)
   std::string scene_label;                         // names the scene file in messages ("": its path)

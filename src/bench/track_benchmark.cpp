@@ -185,6 +185,7 @@ void RunTrackBenchmark(const TrackBenchmarkOptions& f, std::ostream& out) {
     random.fresh = f.fresh;
     random.json = f.json;
     random.only = f.draw_ids;
+    if (f.min_quality) random.core = [q = *f.min_quality](const DecodedClip& clip) { return TrackWithCore(clip, q); };
     return RunTrackRandom(random, out);
   }
   std::unique_ptr<TrackMatrixRecord> matrix;

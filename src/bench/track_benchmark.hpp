@@ -31,6 +31,7 @@ struct TrackBenchmarkOptions {
   std::string random_cache = "/tmp/uphill-bench-random";
   std::string json;                     // --json FILE: the random scenes' results
   std::vector<std::string> draw_ids;    // --draw ID...: only these of the N draws
+  std::optional<double> min_quality;    // --min-quality: the tracker's TrackerOptions::min_report_quality
 };
 
 void RunTrackBenchmark(const TrackBenchmarkOptions& options, std::ostream& out);

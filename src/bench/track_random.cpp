@@ -182,10 +182,11 @@ std::vector<std::string> Cells(const std::string& tracker, const Score& s) {
 
 }  // namespace
 
-TrackerOutput TrackWithCore(const DecodedClip& clip) {
+TrackerOutput TrackWithCore(const DecodedClip& clip, double min_report_quality) {
   TrackerOutput out;
   TrackVideoOptions options;
   options.tracker = OptionsFor(clip);
+  options.tracker.min_report_quality = min_report_quality;
   TrackResult result;
   try {
     result = TrackVideo(clip.video, clip.scene, clip.calibration, options);

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "model/scene.hpp"
+#include "vision/ball_tracker.hpp"
 #include "vision/camera.hpp"
 
 namespace uphill::bench {
@@ -52,8 +53,9 @@ struct DecodedClip {
 // of the benchmark itself; the clip's refusal goes into TrackerOutput::refusal.
 using ClipTracker = std::function<TrackerOutput(const DecodedClip&)>;
 
-// "core": `uphill track`'s path (TrackVideo on the file, the sidecar written and read back).
-TrackerOutput TrackWithCore(const DecodedClip& clip);
+// "core": `uphill track`'s path (TrackVideo on the file, the sidecar written and read back), with
+// TrackerOptions::min_report_quality as given.
+TrackerOutput TrackWithCore(const DecodedClip& clip, double min_report_quality = TrackerOptions{}.min_report_quality);
 // "baseline": the edge-fit tracker of bench/baseline_edge_tracker.hpp fed the decoded frames.
 TrackerOutput TrackWithBaseline(const DecodedClip& clip);
 
@@ -64,7 +66,8 @@ struct TrackRandomOptions {
   bool fresh = false;                 // render again
   std::string json;                   // "" = no JSON file
   std::vector<std::string> only;      // non-empty: only the draws with these ids (to replay one)
-  ClipTracker core = TrackWithCore, baseline = TrackWithBaseline;
+  ClipTracker core = [](const DecodedClip& clip) { return TrackWithCore(clip); };
+  ClipTracker baseline = TrackWithBaseline;
 };
 
 // Renders (or reuses) the draws, tracks each with both trackers, prints a row per draw and the

@@ -32,6 +32,8 @@ BallTracker::BallTracker(const Scene& scene, const SceneCalibration& calibration
     throw InputError("--readout", "give the readout or have it measured (auto), not both");
   if (!(options.point_spread_px >= 0.2 && options.point_spread_px <= 5))
     throw InputError("point_spread_px", "must be in [0.2, 5] px");
+  if (!(options.min_report_quality >= 0 && options.min_report_quality <= 1))
+    throw InputError("--min-quality", "must be in [0, 1]");
   Impl& m = *impl_;
   internal::OutlineGeometry& g = m.geometry;
   g.cal = calibration;

@@ -147,6 +147,13 @@ struct TrackerOptions {
   bool measure_readout = false;            // a rolling shutter of unknown readout: measured (readout 0)
   VideoTransfer transfer = VideoTransfer::kSrgb;
   double point_spread_px = 0.7;            // σ of the optics' blur across an edge
+  // A reported position of a quality (BallObservation::quality) below this is doubted, and left
+  // out of the track where it lies off the motion of the frames around it
+  // (video_tracking.hpp, TrackResult::frames_of_poor_fit). On random ray-traced scenes 4 of the
+  // 20 frames below it were a pixel or more off (a print's edge, a blurred body half found), 1 of
+  // the 2,912 above it; others below it were right (docs/track.md, "When it fails"). 0 doubts
+  // none. The tracker itself only checks its range.
+  double min_report_quality = 0.45;
 };
 
 struct BallObservation {

@@ -19,6 +19,7 @@
 #include "io/output_paths.hpp"
 #include "model/environment_error.hpp"
 #include "model/input_error.hpp"
+#include "internal/doubtful_rows.hpp"
 #include "internal/track_series.hpp"
 #include "vision/library_logs.hpp"
 #include "vision/track_analysis.hpp"
@@ -261,6 +262,7 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
   }
   result.transfer = tracker_options.transfer;
   result.frames_left_off_path = tracker.FramesLeftOffPath();
+  result.frames_of_poor_fit = internal::LeaveOutDoubtfulRows(tracker_options.min_report_quality, &result.rows);
   const long read = static_cast<long>(result.rows.size());
   // A scene change (the camera moved): no position from that frame on, the calibration no longer
   // holds there.
@@ -366,7 +368,8 @@ void WriteTrack(const std::string& csv_path, const TrackResult& result, const Tr
                                                              : "global"},
       {"frames_by_edge_fit", found - outline_model},
       {"frames_by_outline_model", outline_model},
-      {"frames_left_off_the_path", result.frames_left_off_path}};
+      {"frames_left_off_the_path", result.frames_left_off_path},
+      {"frames_left_out_of_poor_fit", result.frames_of_poor_fit}};
   if (result.partial) side["partial_reason"] = result.partial_reason;
   OutputPaths::CreateFolders(std::filesystem::path(csv_path).parent_path().string());
   WriteFileAtomically(csv_path, csv.str());

@@ -70,6 +70,9 @@ struct TrackResult {
   VideoTransfer transfer = VideoTransfer::kSrgb;
   std::vector<long> exposure_changes;  // frames where the exposure jumped
   long frames_left_off_path = 0;       // BallTracker::FramesLeftOffPath
+  // Positions of a quality below TrackerOptions::min_report_quality that lay off the motion of the
+  // frames around them: left out (internal/doubtful_rows.hpp).
+  long frames_of_poor_fit = 0;
 };
 
 struct TrackVideoOptions {

@@ -136,6 +136,9 @@ void AddTrack(CLI::App& bench, const std::shared_ptr<std::vector<std::string>>& 
   cmd->add_option("--draw", o->draw_ids, "only the draws with these ids (to replay one; with --seed)")
       ->delimiter(',')
       ->needs(random);
+  cmd->add_option("--min-quality", o->min_quality,
+                  "the tracker's --min-quality (uphill track), to compare its rule on the same draws")
+      ->needs(random);
   RunsWith(cmd, o, argv, RunTrackBenchmark);
 }
 

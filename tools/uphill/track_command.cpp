@@ -3,6 +3,7 @@
 // its sidecar JSON (data/README.md, "Track CSV"); optionally an overlay video and the analysis of
 // the track (src/vision/track_analysis.hpp, written beside the CSV as `uphill analyse-track` does).
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "commands.hpp"
@@ -34,6 +35,7 @@ namespace {
 struct TrackFlags {
   SceneFlags scene;
   std::string video, camera, scene_file, out, init, overlay, exposure, readout, transfer = "srgb";
+  std::optional<double> min_quality;  // unset: TrackerOptions' default
   bool analyse = false, quiet = false;
 };
 
@@ -83,6 +85,7 @@ void Run(const TrackFlags& f) {
   if (f.readout == "auto") options.measure_readout = true;
   else if (!f.readout.empty()) options.readout = ParseQuantity(f.readout, Dimension::kTime, "--readout");
   options.transfer = ParseVideoTransfer(f.transfer, "--transfer");
+  if (f.min_quality) options.min_report_quality = *f.min_quality;
   const bool bar = !f.quiet && isatty(STDERR_FILENO);
   const auto start = std::chrono::steady_clock::now();
   FrameProgressCallback progress;
@@ -144,6 +147,9 @@ void AddTrackCommand(CLI::App& app) {
                   "rolling shutter: time from the first to the last row, with unit (e.g. 25ms), or auto (measured from "
                   "the ball's shear: a phone); default 0 (global shutter)");
   cmd->add_option("--transfer", flags->transfer, "the video's transfer curve: srgb (cameras, default) or linear");
+  cmd->add_option("--min-quality", flags->min_quality,
+                  "positions of a lower quality (0 to 1) are doubted: left out where they lie off the motion of "
+                  "the frames around them (default 0.45, docs/track.md); 0 doubts none");
   cmd->add_option("--overlay", flags->overlay, "write the video with the fitted outline drawn (.mp4)");
   cmd->add_flag("--analyse", flags->analyse, "then analyse the track (release, rest, fall-off, model fit)");
   cmd->add_flag("--quiet", flags->quiet, "no progress bar");
