@@ -2,7 +2,6 @@
 // accuracy against the exact ground truth, lost frames, partial and bad input.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
