@@ -97,7 +97,12 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
       edges->Reset();
       outline = edges->Measure(frame, p.fit.p[internal::kCentreX], p.fit.p[internal::kCentreZ], 2 * options.search_half_width_px);
     }
-    const bool found_outline = outline && OutlineFound(*outline), clean = outline && CleanOutline(*outline);
+    // A faint outline counts where its edges lie on it sharply (FaintOutlineFound): a dark body in
+    // dim light steps by fewer grey levels than the fast path asks for, and stands out of the
+    // noise less than a body in good light, but no patch of the table has its edges that sharply
+    // on one outline.
+    const bool faint = outline && !OutlineFound(*outline) && FaintOutlineFound(*outline);
+    const bool found_outline = outline && (OutlineFound(*outline) || faint), clean = outline && CleanOutline(*outline);
     // Its stand-out in its own fit's noise levels, or, where its outline was found (a printed
     // body's own residuals hold its print), in the frame's. Where the edge fit found the outline
     // elsewhere (a dotted body's print pulled the model 10 px along the path), the contrast is
@@ -107,7 +112,7 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
     if (!p.accepted && !found_outline) continue;
     const FitOutcome at_outline = found_outline ? ContrastAtOutline(frame, gain, *outline, p.fit) : p.fit;
     const double stand_out = at_outline.contrast / std::max(noise, at_outline.noise);
-    const double least = found_outline && SharpOutline(*outline) ? kAcquireMinStandOutSharp : kAcquireMinStandOut;
+    const double least = faint || (found_outline && SharpOutline(*outline)) ? kAcquireMinStandOutSharp : kAcquireMinStandOut;
     if (stand_out < least && !(found_outline && at_outline.contrast / frame_noise >= least)) continue;
     body_at[p.place] = true;
     // A clean outline all round comes before any other, then an outline found where it was

@@ -352,10 +352,12 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // least (kOutlineMostRays); their scatter below half a pixel, in contrast well above the noise.
   // Looser than CleanOutline: a print's stripes hide the limb's grey step on a third of the rays,
   // or put a stronger edge beside it on a quarter of them, but not the outline's place.
-  bool OutlineFound(const internal::EdgeFitOutcome& e) const {
+  // min_contrast: grey levels (kFastMinContrast; a sharp outline found anew may be fainter,
+  // kAcquireFaintContrast).
+  bool OutlineFound(const internal::EdgeFitOutcome& e, double min_contrast = kFastMinContrast) const {
     const bool most_found = e.inliers >= kOutlineFoundShare * e.edge_points;
     const bool most_rays = e.inliers >= kOutlineMostRays * kEdgePoints && e.inliers >= kOutlineMostSearched * e.attempted;
-    return e.ok && e.inliers >= 0.35 * kEdgePoints && (most_found || most_rays) && e.contrast >= kFastMinContrast &&
+    return e.ok && e.inliers >= 0.35 * kEdgePoints && (most_found || most_rays) && e.contrast >= min_contrast &&
            e.rms_px <= kCleanOutlineRmsPx;
   }
 
@@ -371,6 +373,12 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // path's: sharp enough that a body found anew needs to stand out less (kAcquireMinStandOutSharp).
   bool SharpOutline(const internal::EdgeFitOutcome& e) const {
     return OutlineFound(e) && e.inliers >= kSharpOutlineShare * e.edge_points && e.rms_px <= kFastMaxRmsPx;
+  }
+
+  // An outline found (OutlineFound) in a contrast from kAcquireFaintContrast grey levels, its
+  // edges scattered by kFastMaxRmsPx at most: a body in dim light, at acquisition.
+  bool FaintOutlineFound(const internal::EdgeFitOutcome& e) const {
+    return OutlineFound(e, kAcquireFaintContrast) && e.rms_px <= kFastMaxRmsPx;
   }
 
   // An edge fit that found the body's outline all round: most of its rays within a pixel of it,

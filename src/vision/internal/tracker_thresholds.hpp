@@ -73,6 +73,13 @@ struct TrackerThresholds {
   // an outline lay within 10 px of it and stood out by 6.6 or less (or by more than 10), and
   // taking them from 5 levels on changed no choice.
   static constexpr double kAcquireMinStandOutSharp = 7, kSharpOutlineShare = 0.95;
+  // Grey levels from which an outline whose edges lie on it within kFastMaxRmsPx is found at
+  // acquisition (FaintOutlineFound), and then stands out by kAcquireMinStandOutSharp. A dark
+  // two-tone ball in dim light stepped by 16.7 levels, its 36 edges on its outline at 0.1 px, and
+  // was found in none of its frames; on the first frames of 151 random scenes no place off a
+  // body had its edges that sharply on an outline (the closest: 0.87 of them on it at 0.38 px,
+  // or 0.65 at 0.29 px), whatever its contrast.
+  static constexpr double kAcquireFaintContrast = 10;
   // Noise levels by which the outline's two ends along the rods (path_end_steps.hpp) must each
   // stand out of what lies beyond them for a model fit to be the body (EndsStandOut). On 190
   // random scenes (2787 frames the model measured, none refused by this check), every frame
