@@ -256,6 +256,19 @@ BallObservation BallTracker::Impl::Track(const cv::Mat& input) {
     return o;
   };
 
+  // A still track the background cannot confirm, and a body it confirms elsewhere: the track was
+  // something else (a place on the rods, kept out of the background's learning since), and the
+  // body is that one. Looked at as often as the whole band is learnt (kLearnEvery), within half
+  // a radius of where the track was found: a fit on a rod wanders by a few pixels.
+  if (predicted && f % kLearnEvery == 0 &&
+      (m.geometry.Project(centre.x(), centre.y()) - m.geometry.Project(m.found_at.x(), m.found_at.y())).norm() <
+          0.5 * m.RadiusPx(centre.x(), centre.y()))
+    if (const std::optional<Impl::Found> elsewhere = m.ConfirmedElsewhere(frame, gain, centre)) {
+      m.history.clear();
+      m.rejected.Clear();
+      return finish(elsewhere->fit, elsewhere->request, true);
+    }
+
   // The fast path: the edge fit, where the scene does not need the model (see the header).
   if (predicted && !m.needs_model && m.row_delay == 0 && !m.MeasuresReadout(centre, velocity)) {
     const double px = 1 / m.MetresPerPx(centre.x(), centre.y());

@@ -114,6 +114,8 @@
 // not reported unless the edge fit finds the outline on the path there (FramesLeftOffPath); the
 // first frames, judged by a looser bound before the frames reported show the path's height, are
 // judged again by that height when the clip ends (Finish), and withdrawn where they lie off it.
+// A still track whose silhouette the background does not confirm (a place on the rods taken for
+// a body at rest) gives way to a body it confirms elsewhere on the path (ConfirmedElsewhere).
 #pragma once
 
 #include <Eigen/Core>

@@ -137,6 +137,27 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
   return best;
 }
 
+std::optional<BallTracker::Impl::Found> BallTracker::Impl::ConfirmedElsewhere(const cv::Mat& frame, double gain,
+                                                                              const Vector2d& tracked) {
+  const internal::FrameView view{frame, {0, 0}, gain};
+  if (SilhouetteOf(view, tracked, 0) == Silhouette::kConfirms) return std::nullopt;
+  const Vector2d here = geometry.Project(tracked.x(), tracked.y());
+  const double apart = 2 * RadiusPx(tracked.x(), tracked.y());
+  auto away = [&](const Vector2d& c) { return (geometry.Project(c.x(), c.y()) - here).norm() >= apart; };
+  int fitted = 0;
+  for (const SearchStart& place : Candidates(frame, gain, x_lo, x_hi)) {
+    if (!away(place.at)) continue;
+    if (++fitted > kAcquireFitsPerFrame) break;
+    const FitRequest q = Request(place.at, Vector2d::Zero(), false, 2 * options.search_half_width_px);
+    const FitOutcome fit = Measure(view, q, Search::kAcquiring);
+    const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
+    if (!away(c) || !Accept(fit, kAcquireAgreement) || !EndsStandOut(view, fit, q)) continue;
+    const double smear_px = SmearPx(c, Vector2d(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]));
+    if (SilhouetteOf(view, c, smear_px) == Silhouette::kConfirms) return Found{fit, q, std::nullopt, true};
+  }
+  return std::nullopt;
+}
+
 FitOutcome BallTracker::Impl::ContrastAtOutline(const cv::Mat& frame, double gain, const internal::EdgeFitOutcome& outline,
                                                 const FitOutcome& fit) {
   const Vector2d at(outline.x, outline.z);

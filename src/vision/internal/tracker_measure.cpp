@@ -162,10 +162,7 @@ BallObservation BallTracker::Impl::Observe(const FitOutcome& f, const FitRequest
   }
   Place(c, &o);
   o.time_offset = offset;
-  const Vector2d smear(f.p[internal::kSmearX], f.p[internal::kSmearZ]);
-  o.smear_px = (geometry.Project(c_ref.x() + 0.5 * smear.x(), c_ref.y() + 0.5 * smear.y()) -
-                geometry.Project(c_ref.x() - 0.5 * smear.x(), c_ref.y() - 0.5 * smear.y()))
-                   .norm();
+  o.smear_px = SmearPx(c_ref, Vector2d(f.p[internal::kSmearX], f.p[internal::kSmearZ]));
   o.rays = f.rays_fitted;
   o.inliers = f.inliers;
   o.misfit = f.misfit;

@@ -190,6 +190,12 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // from it.
   std::optional<internal::MotionFit> Motion(long f) const;
 
+  // The length in the picture of a smear (x, z), m, centred at `centre`, px.
+  double SmearPx(const Vector2d& centre, const Vector2d& smear) const {
+    return (geometry.Project(centre.x() + 0.5 * smear.x(), centre.y() + 0.5 * smear.y()) -
+            geometry.Project(centre.x() - 0.5 * smear.x(), centre.y() - 0.5 * smear.y()))
+        .norm();
+  }
   // The body's region (smeared silhouette, a radius around it, and its shadow below it), px.
   cv::Rect BodyRegion(const Vector2d& centre, const Vector2d& smear) const;
 
@@ -303,6 +309,13 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // outline the edge fit finds, then the one that stands out of its surroundings by the most
   // noise levels). Clears the history when the body is found anew or far from the prediction.
   std::optional<Found> Acquire(const cv::Mat& frame, double gain, long f, const std::optional<Prediction>& near);
+  // A body the background confirms (SilhouetteOf) away from the still one tracked at `tracked`,
+  // whose silhouette it does not: a place on the rods or the table taken for a body at rest keeps
+  // the background under it from ever being learnt, while the body rolls elsewhere. The search
+  // along the path skips the places within two radii of `tracked` and fits up to
+  // kAcquireFitsPerFrame of the others; the first accepted whose silhouette the background
+  // confirms is the body, found anew.
+  std::optional<Found> ConfirmedElsewhere(const cv::Mat& frame, double gain, const Vector2d& tracked);
 
   // A place to start a fit at, and a second start where a fit from the first does not find a
   // body (the centre of a colour candidate's plateau).
