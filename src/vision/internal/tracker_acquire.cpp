@@ -2,6 +2,7 @@
 // looked for anew, and the search that fits them.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "tracker_state.hpp"
 
@@ -41,6 +42,7 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
   std::vector<Plausible> plausible;
   std::vector<cv::Rect> windows;
   int fitted = 0;
+  double lowest_residual = std::numeric_limits<double>::infinity();  // of any fit in this frame
   const int budget = f == 0 && !predicted ? kAcquireFitsFirstFrame : kAcquireFitsPerFrame;
   for (const SearchStart& place : guesses) {
     // Without a prediction a candidate's fit depends on its window of the frame alone.
@@ -54,6 +56,7 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
       const FitRequest q = Request(*guess, v, predicted && history.size() >= 2, 2 * options.search_half_width_px,
                                    predicted ? near->acceleration : Vector2d::Zero());
       const FitOutcome fit = Measure({frame, {0, 0}, gain}, q, Search::kAcquiring);
+      if (fit.ok && fit.inliers > 0) lowest_residual = std::min(lowest_residual, fit.noise);
       // Found anew, a fit is plausible at the clip's noise level too, and with fewer rays agreeing:
       // a print's stripes raise a body's own residuals to several times the pixel noise, its dots
       // near the limb cost rays. Such a fit is the body only where its outline is found (below).
@@ -77,14 +80,13 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
     if (!predicted) windows.push_back(window);
     if (fitted >= budget) break;
   }
-  // The frame's noise level: the lowest residual any plausible fit reached (and at least the
-  // clip's). Every place of one frame has the same pixel noise; a body's print or reflections
-  // only add to its own fit's residuals.
-  double frame_noise = noise;
-  if (noises.empty() && !plausible.empty())
-    frame_noise = std::max(noise, std::min_element(plausible.begin(), plausible.end(), [](const Plausible& a, const Plausible& b) {
-                                    return a.fit.noise < b.fit.noise;
-                                  })->fit.noise);
+  // The frame's noise level: the lowest residual any fit of this frame reached, plausible or not
+  // (and at least the clip's). Every place of one frame has the same pixel noise; a body's print,
+  // reflections or shading only add to its own fit's residuals. Where the body is the only
+  // plausible place, its own residuals would otherwise be the frame's noise: a dark ball at rest
+  // between thick dark rods, its outline found all round at 161 grey levels, stood out by 9.1 of
+  // its own fit's residuals and was found in none of its frames.
+  const double frame_noise = noises.empty() && std::isfinite(lowest_residual) ? std::max(noise, lowest_residual) : noise;
   std::optional<Found> best;
   double best_score = 0;
   std::vector<bool> body_at(windows.size(), false);
