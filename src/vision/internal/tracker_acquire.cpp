@@ -61,7 +61,7 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
       // a print's stripes raise a body's own residuals to several times the pixel noise, its dots
       // near the limb cost rays. Such a fit is the body only where its outline is found (below).
       const bool accepted = Accept(fit, kAcquireAgreement);
-      if (!accepted && (predicted || !Accept(fit, kAcquireLooseAgreement, noise))) continue;
+      if (!accepted && (predicted || !Accept(fit, kAcquireLooseAgreement, noise, kAcquireLooseMinLevels))) continue;
       if (!EndsStandOut({frame, {0, 0}, gain}, fit, q)) continue;
       const Vector2d c(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
       if (predicted) {

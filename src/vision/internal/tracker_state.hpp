@@ -215,16 +215,19 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // A fit is a body when enough rays agree with it, the body stands out of the background by
   // several noise levels, and its inlier rays fit within a few noise levels. `agreement`: the
   // share of the fitted rays that must be inliers (less near the prediction, where a painted
-  // body's band or the rails may cost rays, than for a body found anew). Before any frame was
+  // body's band or the rails may cost rays, than for a body found anew); and 10 rays at least, a
+  // quarter of those fitted (the rays in view): the near rail hides up to two thirds of a body
+  // between thick rods (a chrome ball with 22 rays in view, 14 of them on its outline within
+  // 0.2 px of the truth, was refused in all its frames by a floor of a quarter of all rays). Before any frame was
   // accepted the clip's noise is not known (`noise` is a guess, and a 1080p phone clip's is three
   // times it): the levels are then the fit's own residual RMS, so that a body found where it is
   // is not refused for the guess. And the centre must lie on the path (OnPath).
   bool Accept(const FitOutcome& f, double agreement) const { return Accept(f, agreement, NoiseLevel(f)); }
-  // The same at a given noise level.
-  bool Accept(const FitOutcome& f, double agreement, double level) const {
+  // The same at a given noise level, the body standing out of the background by `levels` of it.
+  bool Accept(const FitOutcome& f, double agreement, double level, double levels = kAcceptMinLevels) const {
     const double misfit = f.misfit * noise / level;
-    return f.ok && f.inliers >= std::max(10.0, 0.25 * options.rays) && f.inliers >= agreement * f.rays_fitted &&
-           f.contrast >= options.min_contrast && f.contrast >= 6 * level && misfit < 3 &&
+    return f.ok && f.inliers >= std::max(10.0, 0.25 * f.rays_fitted) && f.inliers >= agreement * f.rays_fitted &&
+           f.contrast >= options.min_contrast && f.contrast >= levels * level && misfit < 3 &&
            OnPath(f.p[internal::kCentreX], f.p[internal::kCentreZ]);
   }
   // Whether the fitted outline's ends along the rods (path_end_steps.hpp) each stand out of what
@@ -457,8 +460,9 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   double SmearOf(long f, const BallObservation& o) const;
   // Keeps this frame for the opening while it lasts (after Track measured it as `o`).
   void KeepOpening(long f, double t, const cv::Mat& frame, const BallObservation& o);
-  // At Finish(): the opening measured again, backwards from its first confirmed run; each frame
-  // whose observation changes (found, moved, or withdrawn) becomes a revision.
+  // At Finish(): the opening measured again, backwards from its first confirmed run (without
+  // one, only its frames not found, backwards from its first run found and not contradicted);
+  // each frame whose observation changes (found, moved, or withdrawn) becomes a revision.
   void RecoverOpening();
 
   // Scene residual and gain bookkeeping (SceneChangedAt, ExposureChanges).

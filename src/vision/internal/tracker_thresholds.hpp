@@ -61,6 +61,13 @@ struct TrackerThresholds {
   // The same where the edge fit finds the body's outline there (OutlineFound): a dotted ball's
   // dots near the limb left 0.53 of its rays agreeing with a fit on its centre.
   static constexpr double kAcquireLooseAgreement = 0.45;
+  // Noise levels by which a fit's body must stand out of the background to be one (Accept).
+  static constexpr double kAcceptMinLevels = 6;
+  // The same on that loose route, which counts only where the edge fit then finds the outline
+  // (an independent check): a banded ball at rest on a checked cloth held the first fit 10 px off
+  // its centre, where it stood out by 5.8 levels, and its outline, found clean all round at 31 grey
+  // levels, was not looked for in 23 of its 40 frames.
+  static constexpr double kAcquireLooseMinLevels = 4;
   // Noise levels by which a body found anew (not near a prediction) stands out of its
   // surroundings at least (its limb's contrast against what lies behind it): on 80 random scenes
   // every fit that landed on the body stood out by 10.9 or more, and two in three of those that
