@@ -218,10 +218,11 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // body's band or the rails may cost rays, than for a body found anew); and 10 rays at least, a
   // quarter of those fitted (the rays in view): the near rail hides up to two thirds of a body
   // between thick rods (a chrome ball with 22 rays in view, 14 of them on its outline within
-  // 0.2 px of the truth, was refused in all its frames by a floor of a quarter of all rays). Before any frame was
-  // accepted the clip's noise is not known (`noise` is a guess, and a 1080p phone clip's is three
-  // times it): the levels are then the fit's own residual RMS, so that a body found where it is
-  // is not refused for the guess. And the centre must lie on the path (OnPath).
+  // 0.2 px of the truth, was refused in all its frames by a floor of a quarter of all rays).
+  // Before any frame was accepted the clip's noise is not known (`noise` is a guess, and a 1080p
+  // phone clip's is three times it): the levels are then the fit's own residual RMS, so that a
+  // body found where it is is not refused for the guess. And the centre must lie on the path
+  // (OnPath).
   bool Accept(const FitOutcome& f, double agreement) const { return Accept(f, agreement, NoiseLevel(f)); }
   // The same at a given noise level, the body standing out of the background by `levels` of it.
   bool Accept(const FitOutcome& f, double agreement, double level, double levels = kAcceptMinLevels) const {
