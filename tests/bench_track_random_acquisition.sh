@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Draws of `uphill bench track --random 40` where the search along the path, finding the body in
 # the first frame, took something else for it or missed it, or where a print held the fit off
-# the body; replayed with --draw (rendered by POV-Ray at test time, about 740 s of CPU, cached in
+# the body; replayed with --draw (rendered by POV-Ray at test time, about 820 s of CPU, cached in
 # the build tree after; PART 1 or 2 replays half of them, so that two tests share the
 # renders). Truth: the renderer's projected
 # centre and uphill::Motion (src/motion), as the benchmark states.
@@ -158,6 +158,13 @@
 #             than its diameter is never seen: 26 of 40 frames found. Now, where no such run
 #             exists, the first five found in a row that the background does not contradict,
 #             and the frames before them not found are measured backwards from there.
+#   seed 7999587104654648718, 762801aa: glossy grey ball (R 21.3 mm) on a checked cloth behind
+#             4.8 mm steel rods, 960x540, at rest 8 frames, then rolling up. Its limb mirrors the
+#             rods and the cloth; the tracking fits, with the limb's shading profile, drifted off
+#             the path while it rested (1.1 to 2.8 px), their height became the usual one, and 12
+#             frames 1-1.3 px off the truth were reported: 0.74 px, 32 of 40, 7 silent wrong (the
+#             baseline found none). Now a fit off the path is fitted again without the profile
+#             and taken where that lies on the path (OnPathWithoutLimb), also when refitted.
 #   bash tests/bench_track_random_acquisition.sh UPHILL_VISION_PROGRAM CACHE_DIR PART
 set -euo pipefail
 program="$1"
@@ -172,7 +179,7 @@ draws=(
   "1 2542344287153215731 a48dc08e" "1 2542344287153215731 f49a1ef3" "1 5739382750275171141 9d8827da"
   "1 5739382750275171141 538a68d2" "1 4322825014656021629 cf88bf86" "1 4322825014656021629 d2b8edec"
   "1 9998171038873176079 ce3de63a" "1 4366590314390829142 53032858" "1 3776755755160792373 38509762"
-  "1 3776755755160792373 7e8ad8e9"
+  "1 3776755755160792373 7e8ad8e9" "1 7999587104654648718 762801aa"
   "2 17093003944487397490 c4b6408c" "2 17093003944487397490 78ea526f" "2 11339591480978857371 bed4dec5"
   "2 17747053619211448336 0783b577" "2 10961322922834187387 533defb6" "2 8882055501653666445 fc3256a3"
   "2 3471206893078657273 9166e91b" "2 16165027434125150366 b3a4dfa6" "2 16165027434125150366 837f417a"
@@ -198,7 +205,8 @@ import json, pathlib, sys
 # of 30); 9166e91b 1.01 px, 11 of 40, 6 (was 84.7 px, 40, 40). ea3d7415 0.41 px, 35 of 40, 1, a frame
 # just over 1 px off (before the hold 0.45 px, 36, 0, with frames at 0.98-0.99 px). b3a4dfa6 0.17 px,
 # 40 of 40, 0 (was 0 of 40). 6b97f61e 0.090 px, 40 of 40, 0 (was 17 of 40). 642e4077 0.134 px,
-# 40 of 40, 0 (was 0 of 40). 837f417a 0.144 px, 40 of 40, 0 (was 26 of 40).
+# 40 of 40, 0 (was 0 of 40). 837f417a 0.144 px, 40 of 40, 0 (was 26 of 40). 762801aa 0.297 px,
+# 40 of 40, 0 (was 0.74 px, 32 of 40, 7).
 bounds = {"ce3de63a": (0.3, 40, 0), "53032858": (0.1, 40, 0), "bed4dec5": (0.15, 40, 0),
           "0783b577": (0.7, 40, 0), "a48dc08e": (0.25, 40, 0), "f49a1ef3": (0.25, 30, 0),
           "ea3d7415": (0.6, 35, 1), "b7f73885": (0.6, 29, 1),
@@ -207,7 +215,7 @@ bounds = {"ce3de63a": (0.3, 40, 0), "53032858": (0.1, 40, 0), "bed4dec5": (0.15,
           "38509762": (0.15, 40, 0), "7e8ad8e9": (0.7, 24, 2), "fc3256a3": (0.6, 37, 0),
           "c4b6408c": (0.15, 40, 0), "78ea526f": (0.3, 30, 0), "9166e91b": (1.3, 10, 6),
           "b3a4dfa6": (0.25, 40, 0), "6b97f61e": (0.15, 40, 0),
-          "642e4077": (0.2, 40, 0), "837f417a": (0.25, 40, 0)}
+          "642e4077": (0.2, 40, 0), "837f417a": (0.25, 40, 0), "762801aa": (0.4, 40, 0)}
 replayed = {p.stem for p in pathlib.Path(sys.argv[1]).glob("*.json")}
 assert replayed and replayed <= bounds.keys(), replayed
 for name in sorted(replayed):

@@ -103,17 +103,40 @@ FitOutcome BallTracker::Impl::MeasureNear(const internal::FrameView& view, FitRe
   return Measure(view, wide);
 }
 
-FitOutcome BallTracker::Impl::HeldOnPath(const internal::FrameView& view, const FitOutcome& fit, FitRequest q) const {
-  const double x = fit.p[internal::kCentreX], z = fit.p[internal::kCentreZ];
-  const double height = std::abs(AcrossPathPx(x, z));
-  if (!fit.ok || height <= kHeldFromPx || height > kOnPathFirstPx) return fit;
-  // Both fits start at this one, in the narrow pass's windows, so that their costs compare.
-  q.centre = Vector2d(x, z);
+// Both HeldOnPath's fits and OnPathWithoutLimb's start at the fit, in the narrow pass's windows,
+// so that their costs compare.
+static FitRequest StartedAt(const FitOutcome& fit, FitRequest q) {
+  q.centre = Vector2d(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]);
   q.smear = Vector2d(fit.p[internal::kSmearX], fit.p[internal::kSmearZ]);
-  q.half_width_px = kNarrowHalfWidthPx;
-  q.iterations = kHeldIterations;
+  q.half_width_px = BallTracker::Impl::kNarrowHalfWidthPx;
+  q.iterations = BallTracker::Impl::kHeldIterations;
   q.fit_edge_shift = false;
   q.estimate_row_delay = false;
+  return q;
+}
+
+bool BallTracker::Impl::HeldOffPath(const FitOutcome& fit) const {
+  const double height = std::abs(AcrossPathPx(fit.p[internal::kCentreX], fit.p[internal::kCentreZ]));
+  return fit.ok && height > kHeldFromPx && height <= kOnPathFirstPx;
+}
+
+std::optional<FitOutcome> BallTracker::Impl::OnPathWithoutLimb(const internal::FrameView& view, const FitOutcome& fit,
+                                                               const FitRequest& q) const {
+  if (!HeldOffPath(fit)) return std::nullopt;
+  FitRequest plain = StartedAt(fit, q);
+  plain.limb_profile = false;
+  FitOutcome without = internal::FitOutline(geometry, view, *background, plain);
+  if (!without.ok || std::abs(AcrossPathPx(without.p[internal::kCentreX], without.p[internal::kCentreZ])) > kHeldFromPx)
+    return std::nullopt;
+  without.row_delay = fit.row_delay, without.row_delay_sigma = fit.row_delay_sigma;
+  return without;
+}
+
+FitOutcome BallTracker::Impl::HeldOnPath(const internal::FrameView& view, const FitOutcome& fit, FitRequest q) const {
+  if (!HeldOffPath(fit)) return fit;
+  if (std::optional<FitOutcome> without = OnPathWithoutLimb(view, fit, q)) return *without;
+  const double x = fit.p[internal::kCentreX], z = fit.p[internal::kCentreZ];
+  q = StartedAt(fit, q);
   const FitOutcome free = internal::FitOutline(geometry, view, *background, q);
   const double on = std::clamp(x, x_lo, x_hi);
   const PathPoint path = scene.At(on);

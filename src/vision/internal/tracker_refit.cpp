@@ -94,7 +94,9 @@ void BallTracker::Impl::FitAgain(bool all) {
     FitRequest q = Request(start, velocity, motion, kNarrowHalfWidthPx + 1.5, acceleration);
     q.iterations = kStartedNearIterations;
     q.estimate_row_delay = false;  // measured when the frame was first fitted
-    const FitOutcome fit = Measure({it->window, it->origin, it->gain}, q, Search::kTracking, kStartedNearIterations);
+    const internal::FrameView view{it->window, it->origin, it->gain};
+    FitOutcome fit = Measure(view, q, Search::kTracking, kStartedNearIterations);
+    if (std::optional<FitOutcome> without = OnPathWithoutLimb(view, fit, q)) fit = *without;
     if (Accept(fit, 0.45)) {
       BallObservation o = Observe(fit, q);
       const double moved = std::hypot(o.u - it->observed.u, o.v - it->observed.v);

@@ -288,7 +288,16 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // `fit` (of request q), or where it lies off the calibrated path by kHeldFromPx to
   // kOnPathFirstPx, the fit held on the path unless the pixels ask for the offset
   // (tracker_thresholds.hpp): a rim without contrast on one side lets the outline slide across.
+  // OnPathWithoutLimb first.
   FitOutcome HeldOnPath(const internal::FrameView& view, const FitOutcome& fit, FitRequest q) const;
+  // A fit kHeldFromPx to kOnPathFirstPx off the calibrated path (HeldOffPath), fitted again
+  // without the limb's shading profile (outline_fit.hpp), where that fit lies within kHeldFromPx
+  // of the path; else nothing. The profile refines a matte body's limb; a glossy limb mirrors the
+  // rods and the table, and the profile then holds the outline off the path (a ball at rest
+  // drifted 2.8 px off it in its first frames; its fits without the profile within 0.2 px).
+  std::optional<FitOutcome> OnPathWithoutLimb(const internal::FrameView& view, const FitOutcome& fit,
+                                              const FitRequest& q) const;
+  bool HeldOffPath(const FitOutcome& fit) const;
 
   // Whether the lens model maps the camera-frame point where it is (LensModelReach).
   bool WithinLens(const Vector3d& pc) const { return pc.z() > 0 && pc.head<2>().norm() < lens_reach * pc.z(); }

@@ -150,16 +150,19 @@ struct TrackerThresholds {
   // the frames reported from an adopted height are judged again at the clip's end
   // (RejudgeProvisionalFrames).
   static constexpr std::size_t kOnPathAdoptFrames = 10;
-  // HeldOnPath: a model fit between kHeldFromPx and kOnPathFirstPx off the calibrated path is
-  // fitted again held on it (a prior of σ kHeldSigmaPx across it) and freely, both in the same
-  // windows, and the offset is kept only where it lowers the rays' cost (Ceres' ½χ², over the
-  // fit's reduced χ²) by kHeldSignificance or more: a χ² of 9, 3σ for one parameter. Where the
-  // rim shows no edge on one side (a pale print against a grey wall, the near rail hiding the
-  // bottom) the outline slides across the path at no cost; a striped spheroid at rest sat 1.4 px
-  // off it in every frame. From half kOnPathPx: correct fits lie within 0.54 px of a calibrated
-  // path (above), and a fit nearer holds no more than it shows. Not beyond kOnPathFirstPx: there a
-  // fit is reported only from an adopted height, and a fit strayed 3–8 px off a released striped
-  // ball, held on the path, was reported 1 px off its body instead of being left out.
+  // HeldOnPath: a model fit between kHeldFromPx and kOnPathFirstPx off the calibrated path is first
+  // fitted again without the limb's shading profile, and taken where that lies within kHeldFromPx
+  // of the path (OnPathWithoutLimb: a glossy limb mirrors the rods, and the profile fitted to it
+  // held a ball at rest 1-2.8 px off the path); else it is fitted again held on it (a prior of σ
+  // kHeldSigmaPx across it) and freely, both in the same windows, and the offset is kept only where
+  // it lowers the rays' cost (Ceres' ½χ², over the fit's reduced χ²) by kHeldSignificance or more:
+  // a χ² of 9, 3σ for one parameter. Where the rim shows no edge on one side (a pale print against
+  // a grey wall, the near rail hiding the bottom) the outline slides across the path at no cost; a
+  // striped spheroid at rest sat 1.4 px off it in every frame. From half kOnPathPx: correct fits
+  // lie within 0.54 px of a calibrated path (above), and a fit nearer holds no more than it shows.
+  // Not beyond kOnPathFirstPx: there a fit is reported only from an adopted height, and a fit
+  // strayed 3–8 px off a released striped ball, held on the path, was reported 1 px off its body
+  // instead of being left out.
   static constexpr double kHeldFromPx = 0.5, kHeldSigmaPx = 0.02, kHeldSignificance = 4.5;
   // Ceres iterations of both: from a fit that may not have settled (a narrow refit of a fit held
   // 2 px off moved it by 1.7 px).
