@@ -133,8 +133,8 @@ std::optional<FitOutcome> BallTracker::Impl::OnPathWithoutLimb(const internal::F
 }
 
 FitOutcome BallTracker::Impl::HeldOnPath(const internal::FrameView& view, const FitOutcome& fit, FitRequest q) const {
-  if (!HeldOffPath(fit)) return fit;
   if (std::optional<FitOutcome> without = OnPathWithoutLimb(view, fit, q)) return *without;
+  if (!HeldOffPath(fit)) return fit;
   const double x = fit.p[internal::kCentreX], z = fit.p[internal::kCentreZ];
   q = StartedAt(fit, q);
   const FitOutcome free = internal::FitOutline(geometry, view, *background, q);
