@@ -23,15 +23,15 @@ py::dict CameraToPython(const CameraIntrinsics& c) {
 }
 
 // Columns of a track: one element per frame; a frame without the ball has found = False and NaN
-// in u, v, radius_px, x, z, u_px, u_x (never interpolated), quality 0. u_px, u_x are NaN too where
-// the track states no uncertainty.
+// in u, v, radius_px, x, z, u_px, u_x, u_outline_px (never interpolated), quality 0. u_px, u_x are
+// NaN too where the track states no uncertainty, u_outline_px where it states no outline spread.
 struct TrackColumns {
   py::array_t<std::int64_t> frame;
   py::array_t<bool> found;
-  py::array_t<double> t, u, v, radius_px, x, z, quality, u_px, u_x;
+  py::array_t<double> t, u, v, radius_px, x, z, quality, u_px, u_x, u_outline_px;
   explicit TrackColumns(std::size_t n)
       : frame(Size(n)), found(Size(n)), t(Size(n)), u(Size(n)), v(Size(n)), radius_px(Size(n)), x(Size(n)),
-        z(Size(n)), quality(Size(n)), u_px(Size(n)), u_x(Size(n)) {}
+        z(Size(n)), quality(Size(n)), u_px(Size(n)), u_x(Size(n)), u_outline_px(Size(n)) {}
   static py::ssize_t Size(std::size_t n) { return static_cast<py::ssize_t>(n); }
   void Set(std::size_t i, const TrackFrame& f) {
     const double missing = std::nan("");
@@ -48,11 +48,13 @@ struct TrackColumns {
     quality.mutable_at(i) = f.found ? f.quality : 0.0;
     u_px.mutable_at(i) = stated ? f.u_px : missing;
     u_x.mutable_at(i) = stated ? f.u_x : missing;
+    u_outline_px.mutable_at(i) = f.found && f.u_outline_px > 0 ? f.u_outline_px : missing;
   }
   py::dict ToDict() const {
     py::dict d;
     d["frame"] = frame, d["t"] = t, d["found"] = found, d["u"] = u, d["v"] = v, d["radius_px"] = radius_px;
     d["x"] = x, d["z"] = z, d["quality"] = quality, d["u_px"] = u_px, d["u_x"] = u_x;
+    d["u_outline_px"] = u_outline_px;
     return d;
   }
 };
@@ -60,7 +62,8 @@ struct TrackColumns {
 constexpr const char* kTrackColumnsDoc =
     "frame (int), t (s), found (bool), u, v (raw pixels), radius_px, x, z (m, apparatus frame), quality "
     "(0..1), u_px (raw pixels, each image axis) and u_x (m, along the rails): the standard uncertainty of the "
-    "centre (NaN where the track states none); a frame without the ball keeps its element with found = False, "
+    "centre (NaN where the track states none), u_outline_px (raw pixels): the part of it that the frame's outline "
+    "shows, its centre's spread over the outline's sectors (NaN where not stated); a frame without the ball keeps its element with found = False, "
     "NaN positions and quality 0 (never interpolated)";
 
 }  // namespace
@@ -128,7 +131,7 @@ void BindVision(py::module_& m) {
           TrackFrame f;
           f.frame = r.frame, f.t = r.t, f.found = r.ball.found, f.quality = r.ball.quality;
           f.u = r.ball.u, f.v = r.ball.v, f.radius_px = r.ball.radius_px, f.x = r.ball.x, f.z = r.ball.z;
-          f.u_px = r.u_px, f.u_x = r.u_x;
+          f.u_px = r.u_px, f.u_x = r.u_x, f.u_outline_px = r.ball.outline_spread_px;
           c.Set(i, f);
         }
         py::dict d = c.ToDict();

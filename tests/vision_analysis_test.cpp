@@ -234,6 +234,21 @@ TEST(TrackAnalysis, ARestPositionKeepsTheTrackersBiasThatNoNumberOfFramesAverage
   ASSERT_TRUE(a.rest);
   EXPECT_NEAR(a.rest->x.value, 0.02, 1e-15);  // the mean of 200 equal values
   EXPECT_NEAR(*a.rest->x.u, 0.08 * 12.7e-3 / 40, 1e-12);
+
+  // Where the frames state how far their centres depend on the part of the outline their edges
+  // came from (u_outline_px), the larger of that (the median over the frames, 0 where a frame
+  // states none) and the floor is the shared error: 0.3 px in most frames here, so 0.3 px at the
+  // body's scale; 0.05 px, under the floor, leaves the floor, and so do spreads stated in fewer
+  // than half of the frames.
+  for (std::size_t k = 0; k < track.frames.size(); ++k) track.frames[k].u_outline_px = k % 5 == 0 ? 2.0 : 0.3;
+  for (std::size_t k = 0; k < track.frames.size(); k += 7) track.frames[k].u_outline_px = 0;  // not stated
+  const TrackAnalysis spread = AnalyseTrack(track, scene);
+  ASSERT_TRUE(spread.rest);
+  EXPECT_NEAR(*spread.rest->x.u, 0.3 * 12.7e-3 / 40, 1e-12);
+  for (TrackFrame& f : track.frames) f.u_outline_px = 0.05;
+  EXPECT_NEAR(*AnalyseTrack(track, scene).rest->x.u, 0.08 * 12.7e-3 / 40, 1e-12);
+  for (std::size_t k = 0; k < track.frames.size(); ++k) track.frames[k].u_outline_px = k % 3 == 0 ? 0.5 : 0.0;
+  EXPECT_NEAR(*AnalyseTrack(track, scene).rest->x.u, 0.08 * 12.7e-3 / 40, 1e-12);
 }
 
 TEST(TrackAnalysis, ComesToRestInTheFrictionBand) {
@@ -618,23 +633,32 @@ TEST(TrackTable, ReadsFramesLostFramesAndExtraColumns) {
   EXPECT_EQ(t.found_count(), 2u);
 }
 
-// The uncertainty columns `uphill track` writes after quality (u_px in px, u_x in mm), read by name
+// The uncertainty columns `uphill track` writes after quality (u_px in px, u_x in mm, u_outline_px
+// in px), read by name
 // wherever they stand after the leading columns; a track without them states none (0).
 TEST(TrackTable, ReadsEachPositionsUncertaintyWhereTheTrackStatesIt) {
   const Track t = Parse(
-      "frame,t,u,v,radius_px,x,z,quality,note,u_x,u_px\n"
-      "0,0.5,100.25,200.5,30,12.5,-3,0.95,a,0.021,0.083\n"
-      "1,0.51,,,,,,0,b,,\n");
+      "frame,t,u,v,radius_px,x,z,quality,note,u_x,u_outline_px,u_px\n"
+      "0,0.5,100.25,200.5,30,12.5,-3,0.95,a,0.021,0.0371,0.083\n"
+      "1,0.51,,,,,,0,b,,,\n");
   ASSERT_EQ(t.frames.size(), 2u);
   EXPECT_DOUBLE_EQ(t.frames[0].u_px, 0.083);
   EXPECT_DOUBLE_EQ(t.frames[0].u_x, 0.021e-3);
+  EXPECT_DOUBLE_EQ(t.frames[0].u_outline_px, 0.0371);
   EXPECT_EQ(t.frames[1].u_px, 0.0);
+  EXPECT_EQ(Parse("frame,t,u,v,radius_px,x,z,quality,u_px,u_x\n0,0.5,100,200,30,12.5,-3,0.95,0.1,0.02\n")
+                .frames[0]
+                .u_outline_px,
+            0.0);
   EXPECT_EQ(Parse("frame,t,u,v,radius_px,x,z,quality\n0,0.5,100,200,30,12.5,-3,0.95\n").frames[0].u_x, 0.0);
   const std::string h = "frame,t,u,v,radius_px,x,z,quality,u_px,u_x\n";
   EXPECT_NE(ErrorOf(h + "0,0,1,1,30,1,1,1,,0.02\n").find("row 2, column u_px: is empty in a frame with a position"),
             std::string::npos);
   EXPECT_NE(ErrorOf(h + "0,0,1,1,30,1,1,1,0.08,-0.02\n").find("row 2, column u_x: must be >= 0"), std::string::npos);
   EXPECT_NE(ErrorOf(h + "0,0,1,1,30,1,1,1,inf,0.02\n").find("row 2, column u_px"), std::string::npos);
+  EXPECT_NE(ErrorOf("frame,t,u,v,radius_px,x,z,quality,u_outline_px\n0,0,1,1,30,1,1,1,-0.1\n")
+                .find("row 2, column u_outline_px: must be >= 0"),
+            std::string::npos);
 }
 
 TEST(TrackTable, BadRowsNameFileRowAndColumn) {

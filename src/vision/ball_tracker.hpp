@@ -170,6 +170,10 @@ struct BallObservation {
   double misfit = 0;         // RMS residual of the inlier rays in units of the pixel noise
                              // (fast path: the edge points' RMS in units of 0.1 px)
   bool full_model = false;   // measured by the model (background, colours, smear), not the fast path
+  // The centre's dependence on the part of the outline its edges came from, px (the edge fit's
+  // sector spread, internal/edge_fit.hpp): a steady error that the frames at rest share. Stated
+  // where the edge fit measured the frame; 0 where the model did (not stated).
+  double outline_spread_px = 0;
 };
 
 class BallTracker {

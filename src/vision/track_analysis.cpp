@@ -81,6 +81,7 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
       s.u.push_back(f.u);
       s.v.push_back(f.v);
       s.time_u.push_back(f.v * track.row_delay_u);
+      s.outline.push_back(f.radius_px > 0 ? f.u_outline_px * scene.body().across / f.radius_px : 0.0);
       s.rows.push_back(f.row);
       a.measured.emplace_back(f.t, f.x);
     }
@@ -111,8 +112,15 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
   for (const TrackFrame& f : track.frames)
     if (f.found && f.radius_px > 0) radii.push_back(f.radius_px);
   const double floor_m = radii.empty() ? 0.0 : o.tracker_floor_px * scene.body().across / Median(radii);
-  const auto with_floor = [&](Estimate e) {
-    e.u = std::hypot(e.u.value_or(0.0), floor_m);
+  // Where the track states how far its frames' centres depend on the part of the outline their
+  // edges came from (u_outline_px), that is this track's own systematic error at rest, shared by
+  // the frames like the floor: the larger of the two, the median over the frames [begin, end),
+  // a frame that states none counting 0 (where the model measured most of them, the floor stays:
+  // the edge fit's spread on a few frames says little of the model's).
+  const auto with_floor = [&](Estimate e, int begin, int end) {
+    const double outline =
+        end > begin ? Median(std::vector<double>(s.outline.begin() + begin, s.outline.begin() + end)) : 0.0;
+    e.u = std::hypot(e.u.value_or(0.0), std::max(floor_m, outline));
     return e;
   };
   // Mean ± scatter/√n of the frames [begin, end) within 3σ of their median (a glitch does not
@@ -125,7 +133,7 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
     if (kept.empty()) kept.push_back(m);
     const auto [mean, sd] = MeanAndSd(kept, 0, static_cast<int>(kept.size()));
     const int count = static_cast<int>(kept.size());
-    return std::pair{with_floor(Estimate{mean, (count >= 3 ? sd : sigma) / std::sqrt(count)}), sd};
+    return std::pair{with_floor(Estimate{mean, (count >= 3 ? sd : sigma) / std::sqrt(count)}, begin, end), sd};
   };
 
   // Release.
@@ -193,7 +201,7 @@ TrackAnalysis AnalyseTrack(const Track& track, const Scene& scene, const TrackAn
     for (double z : zt) steady_z = steady_z && std::abs(z - zm) <= band;
     const std::optional<RestFit> rest = FitRest(s, r0, n, o.rest_frames);
     if (*tail >= o.rest_frames && r0 > i_out && steady_z && rest && rest->x.value < scene.x_max() - band) {
-      a.rest = TrackEvent{"comes to rest", {rest->t, std::nullopt}, with_floor(rest->x),
+      a.rest = TrackEvent{"comes to rest", {rest->t, std::nullopt}, with_floor(rest->x, n - rest->frames, n),
                           "fit of the final " + std::to_string(*tail) + " frames within " + Mm(band) +
                               ": constant from t on (" + std::to_string(rest->frames) +
                               " frames), a quadratic approach before; u from the scatter and the tracker's "

@@ -34,7 +34,12 @@
 //    Every position estimate at rest (release, rest) adds the tracker's systematic error in
 //    quadrature to its scatter: the frames at rest share one bias, which averaging does not
 //    reduce; tracker_floor_px at the body's scale (Body::across over the median outline radius
-//    in pixels; an underestimate by 1/cos of the path's foreshortening, ≤ 20 % from the side).
+//    in pixels; an underestimate by 1/cos of the path's foreshortening, ≤ 20 % from the side),
+//    or, where the track states it and it is larger, the median over those frames of their
+//    outline spread (TrackFrame::u_outline_px at the body's scale, 0 in a frame that states
+//    none, as where the model measured it: how far the centre moves when one part of the
+//    outline is left out, which a body whose limb is half lost against the table shows and the
+//    floor does not).
 //    Position estimates (release, rest) use the frames within min(k, 3)·σ, not k·σ: the wider
 //    band also holds the first frames of the motion.
 //  - fall-off: the motion ends up at x_max: the last frames found reach x_max within k·σ plus

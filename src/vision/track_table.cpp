@@ -41,7 +41,8 @@ Track FromTable(const CsvTable& table) {
     const auto at = std::find(table.header.begin() + static_cast<long>(columns.size()), table.header.end(), name);
     return at == table.header.end() ? -1 : static_cast<int>(at - table.header.begin());
   };
-  const int u_px_column = optional_column("u_px"), u_x_column = optional_column("u_x");
+  const int u_px_column = optional_column("u_px"), u_x_column = optional_column("u_x"),
+            u_outline_column = optional_column("u_outline_px");
   // A standard uncertainty in the column's unit (px, or mm): filled, finite and >= 0.
   const auto uncertainty = [&](const CsvRow& row, int column) {
     if (column < 0) return 0.0;
@@ -92,6 +93,7 @@ Track FromTable(const CsvTable& table) {
       f.found = f.quality > 0.0;
       f.u_px = uncertainty(row, u_px_column);
       f.u_x = uncertainty(row, u_x_column) * 1e-3;
+      f.u_outline_px = uncertainty(row, u_outline_column);
     }
     track.frames.push_back(f);
   }

@@ -3,10 +3,11 @@
 //
 // CSV format (the one `uphill track` writes): the header starts exactly with
 //   frame,t,u,v,radius_px,x,z,quality
-// and may have more columns after these. Of those, u_px and u_x are read when present (`uphill
-// track` writes them): the standard uncertainty of a found frame's centre, raw pixels (each image
-// axis) and millimetres along the rails, each ≥ 0 and filled in every frame with a position;
-// others are ignored. frame: integer ≥ 0, strictly increasing;
+// and may have more columns after these. Of those, u_px, u_x and u_outline_px are read when
+// present (`uphill track` writes them), each ≥ 0 and filled in every frame with a position: the
+// standard uncertainty of a found frame's centre, raw pixels (each image axis) and millimetres
+// along the rails, and the part of it that the frame's outline shows (px; 0: not stated; see
+// TrackFrame); others are ignored. frame: integer ≥ 0, strictly increasing;
 // t: seconds from the container's timestamps, finite, strictly increasing; u, v: the projected
 // ball centre in raw pixels; radius_px: pixels, > 0; x, z: the centre in millimetres in the
 // apparatus frame (docs/physics.md "Frame and apparatus"); quality: a confidence in [0, 1]. Cells are plain numbers (the
@@ -40,6 +41,9 @@ struct TrackFrame {
   // Standard uncertainty of the centre: raw pixels (each image axis) and m along the rails; 0
   // where the track does not state it (no u_px, u_x columns).
   double u_px = 0, u_x = 0;
+  // The centre's spread over the parts of its outline, raw pixels (BallObservation::
+  // outline_spread_px): an error the frames at rest share; 0 where not stated.
+  double u_outline_px = 0;
 };
 
 struct Track {

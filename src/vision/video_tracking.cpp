@@ -5,6 +5,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -45,7 +46,9 @@ void AddUncertainties(double body_across, std::vector<TrackRow>* rows) {
   const TrackAnalysisOptions error_model;
   for (std::size_t i = 0; i < found.size(); ++i) {
     TrackRow& r = *found[i];
-    r.u_px = std::hypot(error_model.tracker_floor_px + error_model.tracker_blur * speed[i], kPositionScatterPx);
+    const double systematic = std::max(error_model.tracker_floor_px + error_model.tracker_blur * speed[i],
+                                       r.ball.outline_spread_px);
+    r.u_px = std::hypot(systematic, kPositionScatterPx);
     r.u_x = r.ball.radius_px > 0 ? r.u_px * body_across / r.ball.radius_px : 0.0;
   }
 }
@@ -313,15 +316,15 @@ TrackResult TrackVideo(const std::string& video_path, const Scene& scene, const 
 
 void WriteTrack(const std::string& csv_path, const TrackResult& result, const TrackSources& sources) {
   std::ostringstream csv;
-  csv << "frame,t,u,v,radius_px,x,z,quality,u_px,u_x\n";
+  csv << "frame,t,u,v,radius_px,x,z,quality,u_px,u_x,u_outline_px\n";
   char line[256];
   for (const TrackRow& r : result.rows) {
     if (r.ball.found)
-      std::snprintf(line, sizeof line, "%d,%.6f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", r.frame, r.t, r.ball.u,
+      std::snprintf(line, sizeof line, "%d,%.6f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", r.frame, r.t, r.ball.u,
                     r.ball.v, r.ball.radius_px, r.ball.x * 1e3, r.ball.z * 1e3, std::max(1e-4, r.ball.quality), r.u_px,
-                    r.u_x * 1e3);
+                    r.u_x * 1e3, r.ball.outline_spread_px);
     else
-      std::snprintf(line, sizeof line, "%d,%.6f,,,,,,0,,\n", r.frame, r.t);
+      std::snprintf(line, sizeof line, "%d,%.6f,,,,,,0,,,\n", r.frame, r.t);
     csv << line;
   }
   int found = 0;

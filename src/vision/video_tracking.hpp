@@ -39,9 +39,11 @@ struct TrackRow {
   // axis) and along the path (m, at the body's scale: Body::across over radius_px). The tracker's
   // systematic error as analyse-track takes it (TrackAnalysisOptions: tracker_floor_px +
   // tracker_blur × the pixels the centre moves per frame interval, from the found frames before
-  // and after) and, in quadrature, a single position's scatter beyond it, 0.10 px (calibrated on
-  // random ray-traced scenes: video_tracking.cpp). `uphill bench track --random` states how often
-  // the truth lies within 2.45 u_px (95 % expected).
+  // and after), or this frame's own outline spread where larger (BallObservation::
+  // outline_spread_px, which analyse-track also reads at rest), and, in quadrature, a single
+  // position's scatter beyond it, 0.10 px (calibrated on random ray-traced scenes:
+  // video_tracking.cpp). `uphill bench track --random` states how often the truth lies within
+  // 2.45 u_px (95 % expected).
   double u_px = 0, u_x = 0;
 };
 
@@ -97,7 +99,7 @@ struct TrackSources {
   std::string video, camera, scene, body;
 };
 
-// Writes the CSV (header `frame,t,u,v,radius_px,x,z,quality,u_px,u_x`; x z u_x in mm) and the sidecar, each
+// Writes the CSV (header `frame,t,u,v,radius_px,x,z,quality,u_px,u_x,u_outline_px`; x z u_x in mm) and the sidecar, each
 // atomically, creating the CSV's folder if needed. Throws EnvironmentError when a file cannot be
 // written.
 void WriteTrack(const std::string& csv_path, const TrackResult& result, const TrackSources& sources);

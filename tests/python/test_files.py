@@ -162,6 +162,8 @@ def test_track_csv_of_the_program_reads_back(clip, tmp_path):
     assert (run["u_px"][run["found"]] > 0).all() and (run["u_x"][run["found"]] > 0).all()
     assert np.max(np.abs(from_cli["u_px"] - run["u_px"])) < 1e-4
     assert np.max(np.abs(from_cli["u_x"] - run["u_x"])) < 1e-7  # 4 decimals of a mm
+    # The outline spread (NaN where the model measured the frame) likewise, to the CSV's 4 decimals.
+    np.testing.assert_allclose(np.nan_to_num(from_cli["u_outline_px"]), np.nan_to_num(run["u_outline_px"]), atol=1e-4)
     camera = uphill.read_camera(str(clip / "cam.json"))
     pose = uphill.read_scene_calibration(str(clip / "scene.json"))
     assert camera["width"] == pose["camera"]["width"] and camera["fx"] == pytest.approx(pose["camera"]["fx"])
@@ -181,3 +183,4 @@ def test_lost_frames_stay_missing(tmp_path):
     assert np.isnan(t["x"][1]) and t["quality"][1] == 0
     assert t["x"][2] == pytest.approx(0.301) and t["t"][1] == 0.04
     assert np.isnan(t["u_px"]).all() and np.isnan(t["u_x"]).all()  # this track states no uncertainty
+    assert np.isnan(t["u_outline_px"]).all()

@@ -83,6 +83,7 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
   std::vector<Vector2d> edges;
   std::vector<double> contrasts;
   std::vector<int> signs;
+  std::vector<int> sectors;  // of each edge point's ray, for the sector spread
   const cv::Mat& occluder = *g.occluder;
   for (int k = 0; k < n; ++k) {
     const Vector2d radial = image[k] - q;
@@ -155,6 +156,7 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
     }
     const double along = start + (moment / weight) * kStep;
     edges.push_back(image[k] + along * dir);
+    sectors.push_back(k * kOutlineSectors / n);
     // The grey step across the edge (what the fast path's trust reads), and its sign; 0 for an
     // edge read in hue, which says nothing of the grey polarity.
     const double grey_step = luminance[std::min(samples - 1, hi + 3)] - luminance[std::max(0, lo - 3)];
@@ -199,8 +201,35 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
   fit.x = solution.x;
   fit.z = solution.z;
   fit.rms_px = fit.inliers ? std::sqrt(sum2 / fit.inliers) : 0;
+  fit.problem = std::move(problem);
+  fit.sectors = std::move(sectors);
+  fit.solution = solution;
   if (polarity_ == 0 && voters > 0) polarity_ = votes >= 0 ? 1 : -1;
   return fit;
+}
+
+double SectorSpreadPx(const OutlineGeometry& geometry, const EdgeFitOutcome& fit) {
+  if (!fit.ok || fit.sectors.size() != fit.problem.rays.size()) return 0;
+  const EdgeRaysSolution& all = fit.solution;
+  const Vector2d centre = geometry.Project(all.x, all.z);
+  std::vector<Vector2d> shifts;
+  for (int sector = 0; sector < kOutlineSectors; ++sector) {
+    EdgeRays kept = fit.problem;
+    kept.rays.clear();
+    for (std::size_t i = 0; i < fit.sectors.size(); ++i)
+      if (fit.sectors[i] != sector) kept.rays.push_back(fit.problem.rays[i]);
+    if (kept.rays.size() == fit.problem.rays.size() || kept.rays.size() < 8) continue;
+    const EdgeRaysSolution without = FitEdgeRays(kept, all.x, all.z, all.bias);
+    if (without.finite) shifts.push_back(geometry.Project(without.x, without.z) - centre);
+  }
+  const int groups = static_cast<int>(shifts.size());
+  if (groups < 3) return 0;
+  Vector2d mean = Vector2d::Zero();
+  for (const Vector2d& d : shifts) mean += d;
+  mean /= groups;
+  double sum2 = 0;
+  for (const Vector2d& d : shifts) sum2 += (d - mean).squaredNorm();
+  return std::sqrt(sum2 * (groups - 1) / groups);
 }
 
 EdgeFit::EdgeFit(const OutlineGeometry& geometry, int points, Transfer transfer) : geometry_(geometry), points_(points) {

@@ -80,7 +80,7 @@ double EdgeRayResidualPx(const EdgeRays& problem, const Vector3d& ray, double x,
   return (phi - std::asin(problem.a / c.norm())) * problem.px_per_rad - bias;
 }
 
-EdgeRaysSolution FitEdgeRays(const EdgeRays& problem, double x0, double z0) {
+EdgeRaysSolution FitEdgeRays(const EdgeRays& problem, double x0, double z0, double bias0) {
   const SolverFunction function{problem};
   ceres::TinySolver<SolverFunction> solver;
   solver.options.max_num_iterations = 30;
@@ -88,7 +88,7 @@ EdgeRaysSolution FitEdgeRays(const EdgeRays& problem, double x0, double z0) {
   // points' scatter; tighter only adds iterations.
   solver.options.parameter_tolerance = 1e-9;
   solver.options.function_tolerance = 1e-12;  // px², absolute (TinySolver's convention)
-  Eigen::Vector3d p(x0, z0, 0.0);
+  Eigen::Vector3d p(x0, z0, bias0);
   solver.Solve(function, &p);
   EdgeRaysSolution out;
   out.x = p[0];

@@ -49,7 +49,7 @@ void RobustEdgeResiduals(const EdgeRays& problem, const double* p, double* resid
 // Residual e of one edge point (px) for the centre (x, z) and the bias.
 double EdgeRayResidualPx(const EdgeRays& problem, const Eigen::Vector3d& ray, double x, double z, double bias);
 
-// The robust fit from the start (x0, z0) and bias 0.
-EdgeRaysSolution FitEdgeRays(const EdgeRays& problem, double x0, double z0);
+// The robust fit from the start (x0, z0) and bias0 (px).
+EdgeRaysSolution FitEdgeRays(const EdgeRays& problem, double x0, double z0, double bias0 = 0.0);
 
 }  // namespace uphill::internal

@@ -18,6 +18,7 @@ struct Series {
   std::vector<double> t, x, z;
   std::vector<double> u, v;  // raw pixels of the centre (the tracker's systematic error is in pixels)
   std::vector<double> time_u;  // s: each time's uncertainty shared by all frames (Track::row_delay_u)
+  std::vector<double> outline;  // m: TrackFrame::u_outline_px at the body's scale (0: not stated)
   std::vector<int> rows;
   int size() const { return static_cast<int>(t.size()); }
 };

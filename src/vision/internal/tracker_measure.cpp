@@ -204,6 +204,7 @@ BallObservation BallTracker::Impl::ObserveEdges(const internal::EdgeFitOutcome& 
   const double fraction = std::min(1.0, static_cast<double>(e.inliers) / std::max(1, e.attempted));
   o.quality = fraction * std::exp(-e.rms_px * e.rms_px / (2 * 0.25));
   o.full_model = false;
+  o.outline_spread_px = internal::SectorSpreadPx(geometry, e);
   return o;
 }
 
