@@ -165,6 +165,13 @@
 #             frames 1-1.3 px off the truth were reported: 0.74 px, 32 of 40, 7 silent wrong (the
 #             baseline found none). Now a fit off the path is fitted again without the profile
 #             and taken where that lies on the path (OnPathWithoutLimb), also when refitted.
+#   seed 5942582223994907444, 6b66baea: striped ball (R 12.8 mm) at rest on cloth behind 9.1 mm
+#             painted rods, 640x360 30 fps. Its first frame was measured on the path (0.26 px);
+#             from frame 4 the model's fits, held by the stripes, lay 5.9 px below it, were left
+#             out as off the path, and after ten in a row their height was adopted as the path's
+#             (kOnPathAdoptFrames): 23 frames reported 5.9 px off (the baseline 0.32 px, 30 of
+#             30). Now a height is not adopted within a body radius of a frame reported on the
+#             calibrated path: those frames stay not found (1 of 30 found, none wrong).
 #   bash tests/bench_track_random_acquisition.sh UPHILL_VISION_PROGRAM CACHE_DIR PART
 set -euo pipefail
 program="$1"
@@ -183,7 +190,7 @@ draws=(
   "2 17093003944487397490 c4b6408c" "2 17093003944487397490 78ea526f" "2 11339591480978857371 bed4dec5"
   "2 17747053619211448336 0783b577" "2 10961322922834187387 533defb6" "2 8882055501653666445 fc3256a3"
   "2 3471206893078657273 9166e91b" "2 16165027434125150366 b3a4dfa6" "2 16165027434125150366 837f417a"
-  "2 8538950433673931810 6b97f61e" "2 8538950433673931810 642e4077"
+  "2 8538950433673931810 6b97f61e" "2 8538950433673931810 642e4077" "2 5942582223994907444 6b66baea"
 )
 for entry in "${draws[@]}"; do
   read -r in_part seed draw <<< "$entry"
@@ -206,7 +213,7 @@ import json, pathlib, sys
 # just over 1 px off (before the hold 0.45 px, 36, 0, with frames at 0.98-0.99 px). b3a4dfa6 0.17 px,
 # 40 of 40, 0 (was 0 of 40). 6b97f61e 0.090 px, 40 of 40, 0 (was 17 of 40). 642e4077 0.134 px,
 # 40 of 40, 0 (was 0 of 40). 837f417a 0.144 px, 40 of 40, 0 (was 26 of 40). 762801aa 0.297 px,
-# 40 of 40, 0 (was 0.74 px, 32 of 40, 7).
+# 40 of 40, 0 (was 0.74 px, 32 of 40, 7). 6b66baea 0.26 px, 1 of 30, 0 (was 5.8 px, 24 of 30, 23).
 bounds = {"ce3de63a": (0.3, 40, 0), "53032858": (0.1, 40, 0), "bed4dec5": (0.15, 40, 0),
           "0783b577": (0.7, 40, 0), "a48dc08e": (0.25, 40, 0), "f49a1ef3": (0.25, 30, 0),
           "ea3d7415": (0.6, 35, 1), "b7f73885": (0.6, 29, 1),
@@ -215,7 +222,8 @@ bounds = {"ce3de63a": (0.3, 40, 0), "53032858": (0.1, 40, 0), "bed4dec5": (0.15,
           "38509762": (0.15, 40, 0), "7e8ad8e9": (0.7, 24, 2), "fc3256a3": (0.6, 37, 0),
           "c4b6408c": (0.15, 40, 0), "78ea526f": (0.3, 30, 0), "9166e91b": (1.3, 10, 6),
           "b3a4dfa6": (0.25, 40, 0), "6b97f61e": (0.15, 40, 0),
-          "642e4077": (0.2, 40, 0), "837f417a": (0.25, 40, 0), "762801aa": (0.4, 40, 0)}
+          "642e4077": (0.2, 40, 0), "837f417a": (0.25, 40, 0), "762801aa": (0.4, 40, 0),
+          "6b66baea": (0.4, 1, 0)}
 replayed = {p.stem for p in pathlib.Path(sys.argv[1]).glob("*.json")}
 assert replayed and replayed <= bounds.keys(), replayed
 for name in sorted(replayed):

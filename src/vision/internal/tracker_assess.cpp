@@ -31,6 +31,7 @@ BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObserv
   if (!o.found) return o;
   auto reported = [&](const BallObservation& r) {
     const double height = AcrossPathPx(r.x, r.z);
+    if (std::abs(height) <= kOnPathPx) on_path_x = r.x;
     if (adopted_left > 0) --adopted_left, provisional.push_back({frame_index, height, true});
     else if (across_path.size() < kOnPathMinFrames && std::abs(height) > kOnPathPx)
       provisional.push_back({frame_index, height, false});
@@ -58,7 +59,8 @@ BallObservation BallTracker::Impl::Assess(const cv::Mat& frame, const BallObserv
   // row lie at one height off it. From kOnPathAdoptFrames of them on, that height is the path's.
   left_heights.push_back(height);
   const auto [low, high] = std::minmax_element(left_heights.begin(), left_heights.end());
-  if (left_heights.size() >= kOnPathAdoptFrames && *high - *low <= kOnPathUsualPx) {
+  const bool seen_on_path_here = on_path_x && std::abs(o.x - *on_path_x) < scene.body().across;
+  if (left_heights.size() >= kOnPathAdoptFrames && *high - *low <= kOnPathUsualPx && !seen_on_path_here) {
     across_path.assign(left_heights.begin(), std::prev(left_heights.end()));  // reported(o) adds this frame's
     left_heights.clear();
     adopted_left = kOnPathFrames;

@@ -70,6 +70,9 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   std::deque<double> across_path;                   // AcrossPathPx of the last frames reported
   long left_off_path = 0;                           // frames not reported for lying off the path
   std::deque<double> left_heights;                  // AcrossPathPx of the frames left out in a row
+  // x (m) of the last frame reported within kOnPathPx of the calibrated path: where a body was
+  // seen on it, a height off it is the fit's, not the calibration's (Assess).
+  std::optional<double> on_path_x;
   // A frame reported before the path's height was known: one of the first, or one of the
   // kOnPathFrames reported from an adopted height on (kOnPathAdoptFrames). Its height is kept as
   // revised since.
@@ -260,7 +263,11 @@ struct BallTracker::Impl : internal::TrackerThresholds {
   // A frame's position as reported (the tracker's own state keeps what it measured): o where it
   // lies on the path; else the edge fit's, where that finds the body's outline on the path; else
   // not found (counted in left_off_path), unless the frames left out in a row say that the
-  // calibration puts the path that far off (kOnPathAdoptFrames).
+  // calibration puts the path that far off (kOnPathAdoptFrames) and no frame was reported on the
+  // calibrated path within a body radius of this one (on_path_x): a body cannot change its
+  // height on the rails where it is, so there the offset is the fit's (a striped ball at rest
+  // behind a thick rod, found on the path in its first frame, was then fitted 5.9 px below it,
+  // and that height was adopted for 23 frames).
   BallObservation Assess(const cv::Mat& frame, const BallObservation& o);
   // The revisions that may be reported: a revised position off the path leaves the frame's row
   // as it was. The provisional frames among them take their revised height (or leave the list,
