@@ -175,6 +175,19 @@
 #             body was found anew by its faint outline (14 grey levels, its edges within 1 px on
 #             52 of 56 rays), and a frame off the path now takes the edge fit's outline by the
 #             same criterion: 28 of 30 found at 0.24 px.
+#   seed 9560672533767502382, aa1b58a0: green ball with a blue band (R 16.5 mm) at rest on tiles,
+#             its lower part behind 5.3 mm steel rods, 960x540 120 fps. In its first frame the
+#             model's fit at a place over the rods 19 mm down the path stood out by 32 noise
+#             levels, the ball's own by 13, and the search took the place: 31 frames 18 px off,
+#             the rest position 21.8 mm off (the baseline found none). That place's outline is in
+#             view nowhere but through the near rail's band (the edge fit searched no ray there):
+#             such a place is no longer a body, and the ball is found in 40 of 40 at 0.23 px.
+#   seed 9560672533767502382, 7ecb5c01: purple and yellow-green two-tone spheroid at rest in full
+#             view against a grey wall, 1280x720 30 fps. Its model fit was plausible, 1 px from the
+#             truth, but its halves step up and down against the wall: the edge fit, with the sign
+#             its edges voted for, found half the outline, and no place was a body in any of its
+#             30 frames (the baseline found none). Where no place is a body the outlines are now
+#             looked for again with edges of either sign: 30 of 30 at 0.15 px.
 #   bash tests/bench_track_random_acquisition.sh UPHILL_VISION_PROGRAM CACHE_DIR PART
 set -euo pipefail
 program="$1"
@@ -194,6 +207,7 @@ draws=(
   "2 17747053619211448336 0783b577" "2 10961322922834187387 533defb6" "2 8882055501653666445 fc3256a3"
   "2 3471206893078657273 9166e91b" "2 16165027434125150366 b3a4dfa6" "2 16165027434125150366 837f417a"
   "2 8538950433673931810 6b97f61e" "2 8538950433673931810 642e4077" "2 5942582223994907444 6b66baea"
+  "2 9560672533767502382 aa1b58a0" "2 9560672533767502382 7ecb5c01"
 )
 for entry in "${draws[@]}"; do
   read -r in_part seed draw <<< "$entry"
@@ -215,9 +229,10 @@ import json, pathlib, sys
 # of 30); 9166e91b 1.01 px, 11 of 40, 6 (was 84.7 px, 40, 40). ea3d7415 0.41 px, 35 of 40, 1, a frame
 # just over 1 px off (before the hold 0.45 px, 36, 0, with frames at 0.98-0.99 px). b3a4dfa6 0.17 px,
 # 40 of 40, 0 (was 0 of 40). 6b97f61e 0.090 px, 40 of 40, 0 (was 17 of 40). 642e4077 0.134 px,
-# 40 of 40, 0 (was 0 of 40). 837f417a 0.144 px, 40 of 40, 0 (was 26 of 40). 762801aa 0.297 px,
+# 40 of 40, 0 (was 0 of 40). 837f417a 0.140 px, 40 of 40, 0 (was 26 of 40). 762801aa 0.297 px,
 # 40 of 40, 0 (was 0.74 px, 32 of 40, 7). 6b66baea 0.24 px, 28 of 30, 0 (was 5.8 px, 24 of 30, 23,
-# then 0.26 px, 1 of 30, 0).
+# then 0.26 px, 1 of 30, 0). aa1b58a0 0.23 px, 40 of 40, 0 (was 18 px, 31 of 40, 31).
+# 7ecb5c01 0.15 px, 30 of 30, 0 (was 0 of 30).
 bounds = {"ce3de63a": (0.3, 40, 0), "53032858": (0.1, 40, 0), "bed4dec5": (0.15, 40, 0),
           "0783b577": (0.7, 40, 0), "a48dc08e": (0.25, 40, 0), "f49a1ef3": (0.25, 30, 0),
           "ea3d7415": (0.6, 35, 1), "b7f73885": (0.6, 29, 1),
@@ -227,7 +242,8 @@ bounds = {"ce3de63a": (0.3, 40, 0), "53032858": (0.1, 40, 0), "bed4dec5": (0.15,
           "c4b6408c": (0.15, 40, 0), "78ea526f": (0.3, 30, 0), "9166e91b": (1.3, 10, 6),
           "b3a4dfa6": (0.25, 40, 0), "6b97f61e": (0.15, 40, 0),
           "642e4077": (0.2, 40, 0), "837f417a": (0.25, 40, 0), "762801aa": (0.4, 40, 0),
-          "6b66baea": (0.4, 28, 0)}
+          "6b66baea": (0.4, 28, 0), "aa1b58a0": (0.3, 40, 0),
+          "7ecb5c01": (0.25, 30, 0)}
 replayed = {p.stem for p in pathlib.Path(sys.argv[1]).glob("*.json")}
 assert replayed and replayed <= bounds.keys(), replayed
 for name in sorted(replayed):

@@ -89,5 +89,28 @@ TEST(EdgeFit, FindsAnOutlineThatDiffersOnlyInHue) {
   EXPECT_LT(isoluminant.fit.contrast, 1.0);
 }
 
+// A body between the greys of what lies around it (a two-tone ball on a wall between its two
+// greys, or a grey ball half on a dark and half on a light table, drawn here): its outline steps
+// up on one side and down on the other. Edges of the sign the fit voted for find one half; with
+// edges of either sign (EitherPolarity, the search's second look where it found no body) the
+// whole outline is found, where it is drawn. Truth: the ray-cast centre.
+TEST(EdgeFit, FindsAnOutlineSteppingUpAndDownWithEdgesOfEitherSign) {
+  OutlineGeometry g = TestOutlineGeometry(kRadius);
+  const cv::Mat occluder = cv::Mat::zeros(g.cal.camera.height, g.cal.camera.width, CV_8U);
+  g.occluder = &occluder;
+  const double x = 0.41, z = 0.105;
+  const Vector2d centre = g.Project(x, z);
+  const Vector3d grey(0.15, 0.15, 0.15), dark(0.03, 0.03, 0.03), light(0.6, 0.6, 0.6);
+  const cv::Mat frame = DrawBallOver(g, kRadius, x, z, &grey, [&](int u, int) { return u < centre.x() ? dark : light; });
+  EdgeFit one_sign(g, 96, Transfer::kSrgb), either_sign(g, 96, Transfer::kSrgb);
+  const EdgeFitOutcome one = one_sign.Measure(frame, x + 0.002, z - 0.001, 6);
+  either_sign.EitherPolarity(true);
+  const EdgeFitOutcome both = either_sign.Measure(frame, x + 0.002, z - 0.001, 6);
+  EXPECT_LT(one.inliers, 60);
+  ASSERT_TRUE(both.ok);
+  EXPECT_GE(both.inliers, 88);
+  EXPECT_LT((g.Project(both.x, both.z) - centre).norm(), 0.03);
+}
+
 }  // namespace
 }  // namespace uphill::internal

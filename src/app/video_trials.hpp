@@ -50,7 +50,7 @@ namespace uphill {
 
 // Changes to the tracker or the analysis that change their results bump this: old cache entries
 // are then not used.
-inline constexpr int kVideoTrackerVersion = 47;
+inline constexpr int kVideoTrackerVersion = 49;
 
 // What a progress callback is told. Calls are serialised (never two at once), from the threads
 // that do the work.

@@ -164,7 +164,7 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
     signs.push_back(by_hue ? 0 : sign);
   }
   fit.edge_points = static_cast<int>(edges.size());
-  if (fit.edge_points < 8) return fit;
+  if (fit.edge_points < kEdgeFitMinPoints) return fit;
   {
     std::vector<double> c = contrasts;
     for (double& v : c) v = std::abs(v);
@@ -204,7 +204,7 @@ EdgeFitOutcome EdgeFit::FitOnce(const cv::Mat& bgr, double x, double z, double h
   fit.problem = std::move(problem);
   fit.sectors = std::move(sectors);
   fit.solution = solution;
-  if (polarity_ == 0 && voters > 0) polarity_ = votes >= 0 ? 1 : -1;
+  if (polarity_ == 0 && voters > 0 && !either_polarity_) polarity_ = votes >= 0 ? 1 : -1;
   return fit;
 }
 
@@ -218,7 +218,7 @@ double SectorSpreadPx(const OutlineGeometry& geometry, const EdgeFitOutcome& fit
     kept.rays.clear();
     for (std::size_t i = 0; i < fit.sectors.size(); ++i)
       if (fit.sectors[i] != sector) kept.rays.push_back(fit.problem.rays[i]);
-    if (kept.rays.size() == fit.problem.rays.size() || kept.rays.size() < 8) continue;
+    if (kept.rays.size() == fit.problem.rays.size() || kept.rays.size() < static_cast<std::size_t>(kEdgeFitMinPoints)) continue;
     const EdgeRaysSolution without = FitEdgeRays(kept, all.x, all.z, all.bias);
     if (without.finite) shifts.push_back(geometry.Project(without.x, without.z) - centre);
   }

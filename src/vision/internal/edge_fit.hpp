@@ -75,6 +75,10 @@ double SectorSpreadPx(const OutlineGeometry& geometry, const EdgeFitOutcome& fit
 // Sectors of the outline's rays for SectorSpreadPx: 45° each.
 inline constexpr int kOutlineSectors = 8;
 
+// Edge points a fit needs: below it EdgeFitOutcome::ok is false (three parameters, and enough
+// points beyond them for the Cauchy loss to set outliers aside).
+inline constexpr int kEdgeFitMinPoints = 8;
+
 class EdgeFit {
  public:
   // bgr frames are 8-bit BGR encoded by `transfer` (linear_light.hpp).
@@ -84,6 +88,10 @@ class EdgeFit {
   EdgeFitOutcome Measure(const cv::Mat& bgr, double x, double z, double half_width);
   // Forget the edge polarity (a body found anew).
   void Reset() { polarity_ = 0; }
+  // Look for edges of either sign on every ray and set no polarity, while `either` holds: a
+  // two-tone body on a background between its two greys steps up on one half of its outline and
+  // down on the other.
+  void EitherPolarity(bool either) { either_polarity_ = either; }
   int points() const { return points_; }
 
  private:
@@ -93,6 +101,7 @@ class EdgeFit {
   const OutlineGeometry& geometry_;
   int points_;
   std::array<float, 256> linear_;  // each 8-bit code's linear value, 0..255
+  bool either_polarity_ = false;
   int polarity_ = 0;  // sign of the grey step from inside to outside the body; 0: unknown
 };
 

@@ -90,39 +90,57 @@ std::optional<BallTracker::Impl::Found> BallTracker::Impl::Acquire(const cv::Mat
   std::optional<Found> best;
   double best_score = 0;
   std::vector<bool> body_at(windows.size(), false);
-  for (const Plausible& p : plausible) {
-    // Where the background is unknown, the edge fit looks for the body's outline: a print or a
-    // reflection can hold the model's outline off a body, a patch of the table has no such
-    // outline.
-    std::optional<internal::EdgeFitOutcome> outline;
-    if (p.fit.rays_without_background > 0) {
-      edges->Reset();
-      outline = edges->Measure(frame, p.fit.p[internal::kCentreX], p.fit.p[internal::kCentreZ], 2 * options.search_half_width_px);
+  // Where no place is a body, the outlines are looked for again with edges of either sign on
+  // every ray: a two-tone spheroid against a wall between its two greys (purple and yellow-green
+  // on grey) steps up on one half and down on the other, so that edges of one sign found half its
+  // outline, and it was found in none of its 30 frames. Only then: with either sign a place of a
+  // two-tone ball's surroundings 60 px off it had its outline found, where one sign found it in
+  // part only and the ball itself stood out more.
+  for (const bool either_sign : {false, true}) {
+    if (either_sign && best) break;
+    for (const Plausible& p : plausible) {
+      if (either_sign && p.fit.rays_without_background == 0) continue;  // the same as the first time
+      // Where the background is unknown, the edge fit looks for the body's outline: a print or a
+      // reflection can hold the model's outline off a body, a patch of the table has no such
+      // outline.
+      std::optional<internal::EdgeFitOutcome> outline;
+      if (p.fit.rays_without_background > 0) {
+        edges->Reset();
+        edges->EitherPolarity(either_sign);
+        outline = edges->Measure(frame, p.fit.p[internal::kCentreX], p.fit.p[internal::kCentreZ], 2 * options.search_half_width_px);
+        edges->EitherPolarity(false);
+      }
+      // A faint outline counts where its edges lie on it sharply (FaintOutlineFound): a dark body in
+      // dim light steps by fewer grey levels than the fast path asks for, and stands out of the
+      // noise less than a body in good light, but no patch of the table has its edges that sharply
+      // on one outline.
+      const bool faint = outline && !OutlineFound(*outline) && FaintOutlineFound(*outline);
+      // A place whose outline the picture shows nowhere but through the near rail's band (fewer
+      // rays in view than an edge fit needs, searched as wide as here) is not a body: the rods'
+      // edges run along the path and meet an outline anywhere between them, and a model fit there
+      // can stand out more than the body beside it (a banded ball behind a 5.3 mm rod: a place over
+      // the rods 19 mm down the path stood out by 32 noise levels, the ball by 13).
+      if (outline && outline->attempted < internal::kEdgeFitMinPoints) continue;
+      const bool found_outline = outline && (OutlineFound(*outline) || faint), clean = outline && CleanOutline(*outline);
+      // Its stand-out in its own fit's noise levels, or, where its outline was found (a printed
+      // body's own residuals hold its print), in the frame's. Where the edge fit found the outline
+      // elsewhere (a dotted body's print pulled the model 10 px along the path), the contrast is
+      // also read from the model fitted again there, and the better of the two fits counts: the
+      // contrast belongs to the body's outline, wherever the print pulled the first fit. Which of
+      // the two positions measures the frame is decided below, as for any found outline.
+      if (!p.accepted && !found_outline) continue;
+      const FitOutcome at_outline = found_outline ? ContrastAtOutline(frame, gain, *outline, p.fit) : p.fit;
+      const double stand_out = at_outline.contrast / std::max(noise, at_outline.noise);
+      const double least = faint || (found_outline && SharpOutline(*outline)) ? kAcquireMinStandOutSharp : kAcquireMinStandOut;
+      if (stand_out < least && !(found_outline && at_outline.contrast / frame_noise >= least)) continue;
+      body_at[p.place] = true;
+      // A clean outline all round comes before any other, then an outline found where it was
+      // looked for, then one found in part, then the stand-out. Where the outline was found it
+      // measures the frame if the model put the body elsewhere (below).
+      const bool partly_found = outline && OutlinePartlyFound(*outline);
+      const double score = stand_out + (clean ? 1e6 : 0) + (found_outline ? 1e3 : 0) + (partly_found ? 1e2 : 0);
+      if (!best || score > best_score) best = Found{p.fit, p.request, found_outline ? outline : std::nullopt}, best_score = score;
     }
-    // A faint outline counts where its edges lie on it sharply (FaintOutlineFound): a dark body in
-    // dim light steps by fewer grey levels than the fast path asks for, and stands out of the
-    // noise less than a body in good light, but no patch of the table has its edges that sharply
-    // on one outline.
-    const bool faint = outline && !OutlineFound(*outline) && FaintOutlineFound(*outline);
-    const bool found_outline = outline && (OutlineFound(*outline) || faint), clean = outline && CleanOutline(*outline);
-    // Its stand-out in its own fit's noise levels, or, where its outline was found (a printed
-    // body's own residuals hold its print), in the frame's. Where the edge fit found the outline
-    // elsewhere (a dotted body's print pulled the model 10 px along the path), the contrast is
-    // also read from the model fitted again there, and the better of the two fits counts: the
-    // contrast belongs to the body's outline, wherever the print pulled the first fit. Which of
-    // the two positions measures the frame is decided below, as for any found outline.
-    if (!p.accepted && !found_outline) continue;
-    const FitOutcome at_outline = found_outline ? ContrastAtOutline(frame, gain, *outline, p.fit) : p.fit;
-    const double stand_out = at_outline.contrast / std::max(noise, at_outline.noise);
-    const double least = faint || (found_outline && SharpOutline(*outline)) ? kAcquireMinStandOutSharp : kAcquireMinStandOut;
-    if (stand_out < least && !(found_outline && at_outline.contrast / frame_noise >= least)) continue;
-    body_at[p.place] = true;
-    // A clean outline all round comes before any other, then an outline found where it was
-    // looked for, then one found in part, then the stand-out. Where the outline was found it
-    // measures the frame if the model put the body elsewhere (below).
-    const bool partly_found = outline && OutlinePartlyFound(*outline);
-    const double score = stand_out + (clean ? 1e6 : 0) + (found_outline ? 1e3 : 0) + (partly_found ? 1e2 : 0);
-    if (!best || score > best_score) best = Found{p.fit, p.request, found_outline ? outline : std::nullopt}, best_score = score;
   }
   for (size_t k = 0; k < windows.size(); ++k)
     if (!body_at[k]) rejected.Remember(frame, windows[k]);
